@@ -1,0 +1,121 @@
+"""Quaternion and Euler-angle helpers (thesis Eq. 19-29, 41-44, 52).
+
+Quaternions are scalar-last, q = [q1, q2, q3, q4] with q4 the scalar part (Markley and
+Crassidis, the thesis' convention). The product is the thesis' "circle cross" (Eq. 42):
+
+    p (x) q = [p4 q_v + q4 p_v - p_v x q_v ;  p4 q4 - p_v . q_v]
+
+With this product, successive rotations compose as q_total = q_second (x) q_first, and the
+attitude matrix A(q) (Eq. 22) maps N-frame components to B-frame components.
+
+These run once per communication step on 3- and 4-vectors, where plain float arithmetic is
+several times faster than numpy's per-call overhead, so they work on tuples/lists of floats.
+"""
+import math
+
+
+def cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
+
+
+def dot(a, b):
+    return a[0] * b[0] + a[1] * b[1] + a[2] * b[2]
+
+
+def norm(v):
+    return math.sqrt(sum(x * x for x in v))
+
+
+def circle_cross(p, q):
+    """Quaternion product p (x) q of Eq. 42."""
+    p4, q4 = p[3], q[3]
+    pv, qv = p[:3], q[:3]
+    c = cross(pv, qv)
+    return (p4 * qv[0] + q4 * pv[0] - c[0],
+            p4 * qv[1] + q4 * pv[1] - c[1],
+            p4 * qv[2] + q4 * pv[2] - c[2],
+            p4 * q4 - dot(pv, qv))
+
+
+def conjugate(q):
+    """Eq. 44."""
+    return (-q[0], -q[1], -q[2], q[3])
+
+
+def inverse(q):
+    """Eq. 43 as written in Appendix C: the conjugate divided by the norm.
+
+    The thesis' scripts divide by ||q|| (not ||q||^2 as Eq. 43 reads); for the unit
+    quaternions the controllers receive as targets the two agree, and the scripts are what
+    the published numbers came from.
+    """
+    n = norm(q)
+    return (-q[0] / n, -q[1] / n, -q[2] / n, q[3] / n)
+
+
+def error_quaternion(q, q_d):
+    """delta_q = q (x) q_d^-1 (Eq. 41)."""
+    return circle_cross(q, inverse(q_d))
+
+
+def xi(q):
+    """Xi(q) of Eq. 20 as a 4x3 nested tuple."""
+    q1, q2, q3, q4 = q
+    return ((q4, -q3, q2), (q3, q4, -q1), (-q2, q1, q4), (-q1, -q2, -q3))
+
+
+def quaternion_rate(q, w):
+    """q_dot = 1/2 Xi(q) omega (Eq. 19), written out."""
+    q1, q2, q3, q4 = q
+    w1, w2, w3 = w
+    return (0.5 * (q4 * w1 - q3 * w2 + q2 * w3),
+            0.5 * (q3 * w1 + q4 * w2 - q1 * w3),
+            0.5 * (-q2 * w1 + q1 * w2 + q4 * w3),
+            0.5 * (-q1 * w1 - q2 * w2 - q3 * w3))
+
+
+def normalized(q, what="quaternion"):
+    n = norm(q)
+    if not math.isfinite(n) or n < 1e-12:
+        raise ValueError(f"{what} {list(q)} has zero or non-finite norm; give a non-zero quaternion")
+    return tuple(x / n for x in q)
+
+
+def from_axis_angle(axis, angle):
+    """Eq. 52: rotation by `angle` (rad) about unit `axis`."""
+    e = normalized(axis, "rotation axis")
+    s = math.sin(angle / 2.0)
+    return (e[0] * s, e[1] * s, e[2] * s, math.cos(angle / 2.0))
+
+
+def attitude_matrix(q):
+    """A(q) of Eq. 22 for a unit quaternion (rows: B axes in N components)."""
+    q1, q2, q3, q4 = q
+    return ((q1 * q1 - q2 * q2 - q3 * q3 + q4 * q4, 2 * (q1 * q2 + q3 * q4), 2 * (q1 * q3 - q2 * q4)),
+            (2 * (q1 * q2 - q3 * q4), -q1 * q1 + q2 * q2 - q3 * q3 + q4 * q4, 2 * (q2 * q3 + q1 * q4)),
+            (2 * (q1 * q3 + q2 * q4), 2 * (q2 * q3 - q1 * q4), -q1 * q1 - q2 * q2 + q3 * q3 + q4 * q4))
+
+
+def euler123(q):
+    """1-2-3 Euler angles (phi, theta, psi) in rad from q (Eq. 25-29, Appendix C q_to_Euler).
+
+    q is normalized first, so a quaternion whose norm drifted under the thesis' explicit Euler
+    integration still gives angles of the attitude it represents. theta is in [-pi/2, pi/2],
+    phi and psi in (-pi, pi].
+    """
+    A = attitude_matrix(normalized(q))
+    s = max(-1.0, min(1.0, A[2][0]))
+    return (math.atan2(-A[2][1], A[2][2]), math.asin(s), math.atan2(-A[1][0], A[0][0]))
+
+
+def from_euler123(phi, theta, psi):
+    """Quaternion of D123 = D(e3, psi) D(e2, theta) D(e1, phi) (Eq. 25)."""
+    qx = from_axis_angle((1.0, 0.0, 0.0), phi)
+    qy = from_axis_angle((0.0, 1.0, 0.0), theta)
+    qz = from_axis_angle((0.0, 0.0, 1.0), psi)
+    return circle_cross(qz, circle_cross(qy, qx))
+
+
+def sign(x):
+    """sign() with sign(0) = 0, as FreeFlyer's sign and numpy.sign define it."""
+    return (x > 0) - (x < 0)

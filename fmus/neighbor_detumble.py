@@ -1,0 +1,59 @@
+"""FMU `DetumbleController` (instance `detumble`): PD rate damping with thruster thresholds.
+
+Wraps components.detumble.DetumbleController (thesis Eq. 9-16, Appendix C `Detumble`,
+stop test of Appendix D). Stateless: every output is a function of the current inputs.
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave
+
+from components import detumble, thruster_control
+
+RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+ACCEL_INPUTS = [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)]
+
+
+class DetumbleController(NeighborSlave):
+    description = ("Detumble controller: PD on body rates quantized to RCS thruster-pair torques (NEIGHBOR thesis "
+                   "Eq. 9-16); done when the rates are within tolerance (Appendix D)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter_array("Kp", [100.0] * 3, "N.m.s", "Proportional gain on the rate error (Eq. 32)")
+        self.parameter_array("Kd", [1.0] * 3, "N.m.s2", "Derivative gain on the angular acceleration (Eq. 33)")
+        self.parameter_array("omega_d", [0.0] * 3, "rad/s", "Desired angular velocity (Eq. 8)")
+        self.parameter_array("omega_tol", [math.radians(0.01)] * 3, "rad/s",
+                             "Rate tolerance: no firing inside it, done when all rates are inside it (> 0)")
+        self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
+                             "Torque of one thruster pair per axis (Eq. 16, > 0)")
+        self.parameter("signed_stop_test", True, None,
+                       "True: Appendix D's one-sided test omega - omega_d <= tol; false: |omega - omega_d| <= tol",
+                       bool)
+        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
+        self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2", "Angular acceleration of the last step")
+        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
+
+        deps = RATE_INPUTS + ACCEL_INPUTS + ["enabled"]
+        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(self._command)[0], "N.m",
+                          "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
+        self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._command)[1], None,
+                          "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
+                          depends_on=deps)
+        self.output("done", lambda: self.feedthrough(self._done), None,
+                    "Detumble complete: rates within tolerance (Appendix D stop test)", bool, depends_on=RATE_INPUTS)
+
+    def build_model(self):
+        return detumble.DetumbleController(self.vector("Kp", 3), self.vector("Kd", 3), self.vector("omega_d", 3),
+                                           self.vector("omega_tol", 3), self.vector("torque_level", 3),
+                                           self.values["signed_stop_test"])
+
+    def _command(self):
+        if not self.values["enabled"]:
+            return [0.0, 0.0, 0.0], [0, 0, 0]
+        return self.model.command(self.vector("omega_BN_B", 3), self.vector("omega_dot_BN_B", 3))
+
+    def _done(self):
+        return self.model.done(self.vector("omega_BN_B", 3))
+
+    def do_step(self, current_time, step_size):
+        return True

@@ -1,0 +1,150 @@
+"""Shared base class for the product's pythonfmu wrappers.
+
+Bundled into every FMU next to the wrapper script (its module name is product-specific so
+that it cannot collide with another vendor's helper in the same process).
+
+A wrapper declares its variables with `parameter`, `input`, `output` (or the `*_array`
+forms, which give FMI structured names `name[1]`..`name[n]`), each with a unit and a
+description. The declarations also record what pythonfmu cannot write itself: the unit, the
+direct dependencies of each output on inputs, and whether the FMU restores its full state.
+`build_fmus.py` reads that record (`fmu_meta`) to complete modelDescription.xml.
+
+Values live in `self.values` (name -> value). Parameters rebuild the model lazily: setting
+one drops the current model, and the next access of `self.model` builds a fresh one from
+the parameter values through `build_model()`, which the wrapper implements. Outputs are
+getters, so an output that depends directly on inputs is recomputed from the inputs as they
+are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
+"""
+import copy
+
+from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
+
+_TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
+
+
+class ParameterError(ValueError):
+    """A parameter or input value outside its allowed range (message names the variable)."""
+
+
+class NeighborSlave(Fmi2Slave):
+    author = "neighbor-cosim"
+    license = "MIT"
+    version = "0.1.0"
+    # A wrapper whose get_state/set_state capture the whole model sets this True.
+    can_get_and_set_state = True
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.values = {}
+        self.fmu_meta = {}
+        self._model = None
+        self._input_version = 0
+
+    # ---- declarations -------------------------------------------------------------------
+    def _register(self, name, kind, causality, variability, unit, description, start=None,
+                  getter=None, setter=None, initial=None, depends_on=None):
+        if not description:
+            raise ValueError(f"variable {name!r} needs a description")
+        cls = _TYPES[kind]
+        kwargs = dict(causality=causality, variability=variability, description=description)
+        if initial is not None:
+            kwargs["initial"] = initial
+        if getter is None:
+            getter = lambda: self.values[name]  # noqa: E731
+        var = cls(name, getter=getter, setter=setter, **kwargs)
+        self.register_variable(var, nested=False)
+        self.fmu_meta[name] = {
+            "unit": unit if kind is float else None,
+            "causality": causality.name,
+            "depends_on": list(depends_on or []),
+        }
+        return var
+
+    def parameter(self, name, start, unit, description, kind=float):
+        self.values[name] = kind(start)
+
+        def setter(value, name=name):
+            self.values[name] = kind(value)
+            self._model = None  # rebuilt from the new parameter values on next use
+
+        self._register(name, kind, Fmi2Causality.parameter, Fmi2Variability.fixed, unit, description,
+                       setter=setter, initial=Fmi2Initial.exact)
+
+    def parameter_array(self, name, starts, unit, description, kind=float):
+        for i, start in enumerate(starts, 1):
+            self.parameter(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
+
+    def input(self, name, start, unit, description, kind=float):
+        self.values[name] = kind(start)
+
+        def setter(value, name=name):
+            self.values[name] = kind(value)
+            self._input_version += 1
+
+        variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
+        self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
+
+    def input_array(self, name, starts, unit, description, kind=float):
+        for i, start in enumerate(starts, 1):
+            self.input(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
+
+    def output(self, name, getter, unit, description, kind=float, depends_on=()):
+        """`depends_on`: input names this output depends on directly (feedthrough)."""
+        variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
+        self._register(name, kind, Fmi2Causality.output, variability, unit, description,
+                       getter=lambda: kind(getter()), initial=Fmi2Initial.calculated,
+                       depends_on=depends_on)
+
+    def output_array(self, name, n, getter, unit, description, kind=float, depends_on=()):
+        """`getter()` returns the whole vector; element i is output as `name[i+1]`."""
+        for i in range(n):
+            self.output(f"{name}[{i + 1}]", lambda i=i: getter()[i], unit,
+                        f"{description} (component {i + 1})", kind, depends_on)
+
+    # ---- helpers for wrappers -----------------------------------------------------------
+    def feedthrough(self, compute):
+        """Value of `compute()` cached until an input or parameter changes.
+
+        Several outputs of a controller come from one computation on the current inputs;
+        this runs it once per set of inputs rather than once per output read."""
+        key = (self._input_version, id(self._model), compute.__name__)
+        cache = self.__dict__.setdefault("_feedthrough_cache", {})
+        hit = cache.get(compute.__name__)
+        if hit is None or hit[0] != key:
+            hit = (key, compute())
+            cache[compute.__name__] = hit
+        return hit[1]
+
+    def vector(self, name, n):
+        return [self.values[f"{name}[{i}]"] for i in range(1, n + 1)]
+
+    @property
+    def model(self):
+        if self._model is None:
+            try:
+                self._model = self.build_model()
+            except (ValueError, TypeError) as exc:
+                raise ParameterError(f"{type(self).__name__} instance '{self.instance_name}': {exc}") from exc
+        return self._model
+
+    def build_model(self):  # pragma: no cover - every wrapper implements it
+        raise NotImplementedError
+
+    def exit_initialization_mode(self):
+        # Build (and so validate) the model from the final parameter values.
+        self.model  # noqa: B018
+
+    # ---- FMU state: every value plus the model's full (hidden) state --------------------
+    def _get_fmu_state(self):
+        return {
+            "values": copy.deepcopy(self.values),
+            "model": None if self._model is None else self._model.get_state(),
+            "input_version": self._input_version,
+        }
+
+    def _set_fmu_state(self, state):
+        self.values = copy.deepcopy(state["values"])
+        self._input_version = state["input_version"] + 1
+        self._model = None
+        if state["model"] is not None:
+            self.model.set_state(state["model"])

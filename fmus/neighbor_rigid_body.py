@@ -1,0 +1,60 @@
+"""FMU `RigidBody` (instance `dynamics` in the systems): rigid-body attitude dynamics.
+
+Wraps components.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
+Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave
+
+from components import rigid_body
+
+
+class RigidBody(NeighborSlave):
+    description = ("Rigid-body attitude dynamics: Euler's equation and quaternion kinematics (NEIGHBOR thesis "
+                   "Eq. 4-29); body torque in, attitude quaternion, rates and 1-2-3 Euler angles out")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("mass", 12.0, "kg", "Spacecraft mass for the box inertia (Eq. 4)")
+        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
+        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
+        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
+        self.parameter("inertia_from_box", True, None,
+                       "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
+        for i in range(1, 4):
+            for j in range(1, 4):
+                self.parameter(f"inertia_B[{i},{j}]", 0.0, "kg.m2",
+                               f"Inertia tensor element ({i},{j}) in B, used when inertia_from_box is false")
+        self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
+                             "Initial attitude quaternion q_BN, scalar last (normalized; zero norm is an error)")
+        self.parameter_array("omega0", [0.0, 0.0, 0.0], "rad/s", "Initial angular velocity omega_BN_B")
+        self.parameter("integrator", "rk4", None,
+                       "'euler': one explicit Euler step per communication step, no normalization (thesis "
+                       "scripts); 'rk4': Runge-Kutta 4 sub-stepped, quaternion normalized", str)
+        self.parameter("max_substep", 0.005, "s", "Largest RK4 sub-step (rk4 only), > 0")
+
+        self.input_array("torque_B", [0.0, 0.0, 0.0], "N.m", "External torque on the body in B, held over a step")
+
+        m = lambda: self.model  # noqa: E731
+        self.output_array("q_BN", 4, lambda: m().q, "1", "Attitude quaternion of B relative to N, scalar last")
+        self.output_array("omega_BN_B", 3, lambda: m().omega, "rad/s", "Angular velocity of B relative to N, in B")
+        self.output_array("omega_dot_BN_B", 3, lambda: m().omega_dot, "rad/s2",
+                          "Angular acceleration over the last step (euler: the derivative the step used; "
+                          "rk4: mean over the step; zero before the first step)")
+        self.output_array("euler123", 3, lambda: m().euler123(), "rad",
+                          "1-2-3 Euler angles phi, theta, psi of q_BN (Eq. 25-29)")
+        self.output_array("H_B", 3, lambda: m().angular_momentum(), "N.m.s", "Angular momentum I omega in B")
+
+    def build_model(self):
+        if self.values["inertia_from_box"]:
+            J = rigid_body.box_inertia(self.values["mass"], self.values["edge_a"], self.values["edge_b"],
+                                       self.values["edge_c"])
+        else:
+            J = [[self.values[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
+        return rigid_body.RigidBody(J, self.vector("q0", 4), self.vector("omega0", 3),
+                                    self.values["integrator"], self.values["max_substep"])
+
+    def do_step(self, current_time, step_size):
+        self.model.step(self.vector("torque_B", 3), step_size)
+        return True

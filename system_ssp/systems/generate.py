@@ -1,0 +1,254 @@
+"""Write the maneuver systems' .ssd and .ssv files from the short descriptions below.
+
+    python build_fmus.py && python system_ssp/systems/generate.py
+
+The generated files are committed; this script keeps them consistent with the FMUs: every
+component lists all its inputs, outputs and parameters as SSD connectors with the FMU's
+types and units (read from build/fmus/*.fmu), connections are checked against those
+connectors, and numbers are written with full precision.
+
+Parameter files, one per concern (CONVENTIONS.md):
+- spacecraft.ssv   host mass and box edges (thesis Appendix A), for `dynamics`;
+- thrusters.ssv    RCS thruster force, lever-arm edges, Isp, g0, for `thrusters`;
+- detumble_gains.ssv, slew_gains.ssv   controller gains and tolerances (Eq. 32-33, 45);
+- <system>_initial_state.ssv   the default initial state and integrator of `dynamics` (the
+  values of the system's first thesis case), so the SSP alone runs a thesis case in any SSP
+  tool (libcosim reads component-level parameter sets without prefixes only);
+- <system>_caseN.ssv   one per thesis validation case: initial state, integrator and the
+  case's gains. Names are `component.variable`; a case is applied on top of the SSD's own
+  bindings with `simulate(..., parameter_sets=["parameters/detumble_case2.ssv"])` or `--ssv`.
+"""
+import math
+import sys
+import zipfile
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from fmpy import read_model_description
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parents[1]
+sys.path.insert(0, str(ROOT))
+
+from components import attitude  # noqa: E402
+from components.thruster_control import pair_torques  # noqa: E402
+
+FMU_DIR = ROOT / "build" / "fmus"
+MASTER_NS = "https://neighbor-cosim.org/ssp/master"
+DT = 0.015  # thesis time step (s)
+
+SPACECRAFT = {"mass": 12.0, "edge_a": 0.1, "edge_b": 0.2, "edge_c": 0.3, "inertia_from_box": True}
+THRUSTERS = {"thrust": 0.025, "edge_a": 0.1, "edge_c": 0.3, "Isp": 42.0, "g0": 9.81}
+RATE_TOL = math.radians(0.01)
+LEVELS = pair_torques(0.025, 0.1, 0.3)
+
+
+def vec(name, values):
+    return {f"{name}[{i}]": v for i, v in enumerate(values, 1)}
+
+
+DETUMBLE_GAINS = {**vec("Kp", [100.0] * 3), **vec("Kd", [1.0] * 3), **vec("omega_d", [0.0] * 3),
+                  **vec("omega_tol", [RATE_TOL] * 3), **vec("torque_level", LEVELS), "signed_stop_test": True}
+SLEW_GAINS = {**vec("Kp", [10.0] * 3), **vec("Kd", [17.5] * 3), **vec("q_d", [0.0, 0.0, 0.0, 1.0]),
+              **vec("omega_d", [0.0] * 3), "q_tol": 0.01, **vec("omega_tol", [RATE_TOL] * 3),
+              **vec("torque_level", LEVELS), "accept_antipodal": False}
+
+W0_DETUMBLE = [math.radians(10.0)] * 3  # Eq. 7
+# Eq. 36: the thesis' case-2 quaternion, q4 from the unit-norm condition (Eq. 35).
+Q0_CASE2 = [0.5597, 0.3484, 0.1653]
+Q0_CASE2.append(math.sqrt(1.0 - sum(x * x for x in Q0_CASE2)))
+
+CASES = {
+    "detumble_case1": {"description": "Thesis detumble validation case 1 (Eq. 6-7, 32-34)",
+                       "dynamics": {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_DETUMBLE),
+                                    "integrator": "euler"}},
+    "detumble_case2": {"description": "Thesis detumble validation case 2 (Eq. 35-38)",
+                       "dynamics": {**vec("q0", Q0_CASE2), **vec("omega0", W0_DETUMBLE), "integrator": "euler"}},
+    # Slew cases 1 and 2 start from the printed end state of the detumble cases (Eq. 39, 48).
+    "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47), printed initial state of Eq. 39",
+                   "dynamics": {**vec("q0", [0.1460, 0.4400, 0.2256, 0.8573]),
+                                **vec("omega0", [math.radians(x) for x in (0.0019, 0.0013, -0.0003)]),
+                                "integrator": "euler"},
+                   "slew": {**vec("Kd", [17.5] * 3)}},
+    "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50), printed initial state of Eq. 48",
+                   "dynamics": {**vec("q0", [0.5928, 0.5193, 0.5026, 0.3566]),
+                                **vec("omega0", [math.radians(x) for x in (0.0019, 0.0013, -0.0003)]),
+                                "integrator": "euler"},
+                   "slew": {**vec("Kd", [22.5] * 3)}},
+}
+# Slew case 3 (Eq. 51-66): three 180 deg rotations with their own gains (Appendix G). The
+# targets follow from the start attitude, so system_ssp.thesis computes them at run time;
+# these files carry the gains and the Appendix G stop test.
+for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.items():
+    CASES[f"slew_case3_{axis}"] = {
+        "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 61/63/65, Appendix G)",
+        "dynamics": {"integrator": "euler"},
+        "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), "accept_antipodal": True}}
+
+SYSTEMS = {
+    "detumble": {
+        "description": "NEIGHBOR detumble maneuver: PD rate controller, RCS thruster pairs, rigid body",
+        "components": [("detumble", "DetumbleController", ["detumble_gains"]),
+                       ("thrusters", "RcsThrusters", ["thrusters"]),
+                       ("dynamics", "RigidBody", ["spacecraft"])],
+        "connections": [("dynamics", "omega_BN_B", "detumble", "omega_BN_B", 3),
+                        ("dynamics", "omega_dot_BN_B", "detumble", "omega_dot_BN_B", 3),
+                        ("detumble", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
+                        ("thrusters", "torque_B", "dynamics", "torque_B", 3)],
+        "default_case": "detumble_case1",
+        "stop": [("detumble", "done")],
+        "order": ["detumble", "thrusters", "dynamics"],
+        "stop_time": 20.0,  # the Appendix D loop limit
+    },
+    "slew": {
+        "description": "NEIGHBOR slew maneuver: quaternion PD controller, RCS thruster pairs, rigid body",
+        "components": [("slew", "SlewController", ["slew_gains"]),
+                       ("thrusters", "RcsThrusters", ["thrusters"]),
+                       ("dynamics", "RigidBody", ["spacecraft"])],
+        "connections": [("dynamics", "q_BN", "slew", "q_BN", 4),
+                        ("dynamics", "omega_BN_B", "slew", "omega_BN_B", 3),
+                        ("slew", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
+                        ("thrusters", "torque_B", "dynamics", "torque_B", 3)],
+        "default_case": "slew_case1",
+        "stop": [("slew", "done")],
+        "order": ["slew", "thrusters", "dynamics"],
+        "stop_time": 1500.0,  # the Appendix G loop limit
+    },
+}
+
+CONCERNS = {"spacecraft": ("Host spacecraft mass and box edges (thesis Appendix A)", SPACECRAFT),
+            "thrusters": ("RCS thruster force, lever-arm edges, Isp and g0 (Appendix A, Eq. 16, 74)", THRUSTERS),
+            "detumble_gains": ("Detumble PD gains and tolerances (Eq. 8, 32-33, Appendix D)", DETUMBLE_GAINS),
+            "slew_gains": ("Slew PD gains, target and tolerances (Eq. 40, 45, Appendix E)", SLEW_GAINS)}
+
+NS = ('xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription" '
+      'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" '
+      'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues"')
+OSP_NS = 'xmlns:osp="http://opensimulationplatform.com/SSP/OSPAnnotations"'
+
+
+def fmu_variables(fmu_name):
+    md = read_model_description(str(FMU_DIR / f"{fmu_name}.fmu"))
+    units = {u.name: u.baseUnit for u in md.unitDefinitions}
+    return md.modelVariables, units
+
+
+def typed_value(value):
+    if isinstance(value, bool):
+        return f'<ssv:Boolean value="{str(value).lower()}"/>'
+    if isinstance(value, int):
+        return f'<ssv:Integer value="{value}"/>'
+    if isinstance(value, float):
+        return f'<ssv:Real value="{value!r}"/>'
+    return f"<ssv:String value={quoteattr(value)}/>"
+
+
+def write_ssv(path, name, description, params):
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+             f'<!-- {description} -->',
+             f'<ssv:ParameterSet {NS.split(" ")[2]} version="1.0" name={quoteattr(name)}>',
+             "  <ssv:Parameters>"]
+    for key, value in params.items():
+        lines.append(f'    <ssv:Parameter name={quoteattr(key)}>{typed_value(value)}</ssv:Parameter>')
+    lines += ["  </ssv:Parameters>", "</ssv:ParameterSet>", ""]
+    path.write_text("\n".join(lines))
+
+
+def case_parameters(case):
+    return {f"{comp}.{k}": v for comp, params in CASES[case].items() if comp != "description"
+            for k, v in params.items()}
+
+
+def connector_xml(var):
+    kind = var.causality
+    if var.type == "Real":
+        t = f'<ssc:Real unit="{var.unit}"/>' if var.unit else "<ssc:Real/>"
+    else:
+        t = f"<ssc:{var.type}/>"
+    return f'        <ssd:Connector name={quoteattr(var.name)} kind="{kind}">{t}</ssd:Connector>'
+
+
+def write_ssd(name, spec):
+    all_units = {}
+    comp_vars = {}
+    out = ['<?xml version="1.0" encoding="UTF-8"?>',
+           # Namespace on the root: libcosim's parser takes xmlns attributes on inner
+           # elements for child elements.
+           f'<ssd:SystemStructureDescription {NS} {OSP_NS} version="1.0" name="{name}">',
+           f'  <ssd:System name="{name}" description={quoteattr(spec["description"])}>',
+           "    <ssd:Elements>"]
+    for inst, fmu, concerns in spec["components"]:
+        variables, units = fmu_variables(fmu)
+        all_units.update(units)
+        comp_vars[inst] = {v.name: v for v in variables}
+        out.append(f'      <ssd:Component name="{inst}" type="application/x-fmu-sharedlibrary" '
+                   f'source="resources/{fmu}.fmu">')
+        out.append("        <ssd:Connectors>")
+        out += ["  " + connector_xml(v) for v in variables if v.causality in ("input", "output", "parameter")]
+        out.append("        </ssd:Connectors>")
+        if inst == "dynamics":
+            # First: libcosim applies only a component's first ParameterBinding; the
+            # spacecraft values it then skips equal the FMU's defaults.
+            concerns = [f"{name}_initial_state"] + concerns
+        bindings = [f'<ssd:ParameterBinding source="parameters/{c}.ssv"/>' for c in concerns]
+        out.append("        <ssd:ParameterBindings>")
+        out += [f"          {b}" for b in bindings]
+        out.append("        </ssd:ParameterBindings>")
+        out.append("      </ssd:Component>")
+    out.append("    </ssd:Elements>")
+    out.append("    <ssd:Connections>")
+    for src, sname, dst, dname, n in spec["connections"]:
+        for i in range(1, n + 1):
+            a, b = f"{sname}[{i}]", f"{dname}[{i}]"
+            if comp_vars[src][a].causality != "output" or comp_vars[dst][b].causality != "input":
+                raise SystemExit(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
+            out.append(f'      <ssd:Connection startElement="{src}" startConnector="{a}" '
+                       f'endElement="{dst}" endConnector="{b}"/>')
+    out.append("    </ssd:Connections>")
+    for comp, var in spec["stop"]:
+        if comp_vars[comp][var].type != "Boolean" or comp_vars[comp][var].causality != "output":
+            raise SystemExit(f"{name}: stop signal {comp}.{var} must be a Boolean output")
+    out += ["    <ssd:Annotations>",
+            '      <ssc:Annotation type="org.neighbor-cosim.master">',
+            f'        <nc:Master xmlns:nc="{MASTER_NS}" stepSize="{DT!r}" algorithm="gauss-seidel">',
+            f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>']
+    out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec["stop"]]
+    out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
+    out.append("  <ssd:Units>")
+    for uname in sorted(all_units):
+        bu = all_units[uname]
+        attrs = " ".join(f'{k}="{getattr(bu, k)}"' for k in ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
+                         if bu is not None and getattr(bu, k))
+        out.append(f'    <ssc:Unit name="{uname}"><ssc:BaseUnit {attrs}/></ssc:Unit>')
+    out.append("  </ssd:Units>")
+    # libcosim takes its fixed step from this OSP annotation (our master reads its own).
+    out += [f'  <ssd:DefaultExperiment startTime="0.0" stopTime="{spec["stop_time"]!r}">',
+            "    <ssd:Annotations>",
+            '      <ssc:Annotation type="com.opensimulationplatform">',
+            '        <osp:Algorithm>',
+            f'          <osp:FixedStepAlgorithm baseStepSize="{DT!r}"/>',
+            "        </osp:Algorithm>",
+            "      </ssc:Annotation>",
+            "    </ssd:Annotations>",
+            "  </ssd:DefaultExperiment>"]
+    out += ["</ssd:SystemStructureDescription>", ""]
+    (HERE / f"{name}.ssd").write_text("\n".join(out))
+
+
+def main():
+    params_dir = HERE / "parameters"
+    params_dir.mkdir(exist_ok=True)
+    for concern, (description, values) in CONCERNS.items():
+        write_ssv(params_dir / f"{concern}.ssv", concern, description, values)
+    for case, spec in CASES.items():
+        write_ssv(params_dir / f"{case}.ssv", case, spec["description"], case_parameters(case))
+    for name, spec in SYSTEMS.items():
+        initial = CASES[spec["default_case"]]["dynamics"]
+        write_ssv(params_dir / f"{name}_initial_state.ssv", f"{name}_initial_state",
+                  f"Default initial state of {name}: {CASES[spec['default_case']]['description']}", initial)
+        write_ssd(name, spec)
+    print(f"wrote {len(SYSTEMS)} systems and {len(CONCERNS) + len(CASES)} parameter sets in {HERE}")
+
+
+if __name__ == "__main__":
+    main()
