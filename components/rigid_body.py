@@ -61,7 +61,12 @@ class RigidBody:
         self.max_substep = float(max_substep)
         self.J = tuple(tuple(row) for row in J.tolist())
         self.Jinv = tuple(tuple(row) for row in np.linalg.inv(J).tolist())
-        self.q = attitude.normalized(tuple(float(x) for x in q0), "q0")
+        q0 = tuple(float(x) for x in q0)
+        unit_q0 = attitude.normalized(q0, "q0")  # also rejects a zero or non-finite q0
+        # The thesis scripts carry q from one maneuver to the next without normalizing it
+        # (the slews start from a detumble end state of norm 1.0008), so "euler" keeps q0 as
+        # given; "rk4" normalizes.
+        self.q = q0 if integrator == "euler" else unit_q0
         self.omega = omega0
         self.omega_dot = (0.0, 0.0, 0.0)  # no step taken yet (thesis: w_dot = [0; 0; 0])
 

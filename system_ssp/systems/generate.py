@@ -31,7 +31,10 @@ ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT))
 
 from components import attitude  # noqa: E402
+from components.detumble import DetumbleController  # noqa: E402
+from components.rigid_body import RigidBody, box_inertia  # noqa: E402
 from components.thruster_control import pair_torques  # noqa: E402
+from components.thrusters import ThrusterPairs  # noqa: E402
 
 FMU_DIR = ROOT / "build" / "fmus"
 MASTER_NS = "https://neighbor-cosim.org/ssp/master"
@@ -58,32 +61,60 @@ W0_DETUMBLE = [math.radians(10.0)] * 3  # Eq. 7
 Q0_CASE2 = [0.5597, 0.3484, 0.1653]
 Q0_CASE2.append(math.sqrt(1.0 - sum(x * x for x in Q0_CASE2)))
 
+
+def detumble_end_state(q0):
+    """End state of a thesis detumble case (Appendix D loop, explicit Euler, 15 ms).
+
+    The thesis ran each slew case from the full-precision end state of a detumble case, not
+    from the four decimals it prints (Eq. 39, 48, 51), and the slews are sensitive to it: from
+    the printed values slew case 1 ends one step later with q4 = 1.00021 instead of 1.00060,
+    and slew case 2 does not converge within 200 s. The slew case files therefore carry the
+    end state computed here with the same component code the FMUs run (a test checks that
+    it equals the co-simulated detumble end state)."""
+    inertia = box_inertia(SPACECRAFT["mass"], SPACECRAFT["edge_a"], SPACECRAFT["edge_b"], SPACECRAFT["edge_c"])
+    body = RigidBody(inertia, q0, W0_DETUMBLE, "euler")
+    ctrl = DetumbleController(DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD, torque_level=LEVELS)
+    pairs = ThrusterPairs()
+    while not ctrl.done(body.omega):
+        cmd, _ = ctrl.command(body.omega, body.omega_dot)
+        pairs.step(cmd, DT)
+        body.step(pairs.applied_torque(cmd), DT)
+    return list(body.q), list(body.omega)
+
+
+DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD = [100.0] * 3, [1.0] * 3
+Q_END_1, W_END_1 = detumble_end_state([0.0, 0.0, 0.0, 1.0])
+Q_END_2, W_END_2 = detumble_end_state(Q0_CASE2)
+
 CASES = {
     "detumble_case1": {"description": "Thesis detumble validation case 1 (Eq. 6-7, 32-34)",
                        "dynamics": {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_DETUMBLE),
                                     "integrator": "euler"}},
     "detumble_case2": {"description": "Thesis detumble validation case 2 (Eq. 35-38)",
                        "dynamics": {**vec("q0", Q0_CASE2), **vec("omega0", W0_DETUMBLE), "integrator": "euler"}},
-    # Slew cases 1 and 2 start from the printed end state of the detumble cases (Eq. 39, 48).
-    "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47), printed initial state of Eq. 39",
-                   "dynamics": {**vec("q0", [0.1460, 0.4400, 0.2256, 0.8573]),
-                                **vec("omega0", [math.radians(x) for x in (0.0019, 0.0013, -0.0003)]),
-                                "integrator": "euler"},
+    "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47): from the end state of detumble "
+                                  "case 1 (full precision; Eq. 39 prints it to 4 decimals)",
+                   "dynamics": {**vec("q0", Q_END_1), **vec("omega0", W_END_1), "integrator": "euler"},
                    "slew": {**vec("Kd", [17.5] * 3)}},
-    "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50), printed initial state of Eq. 48",
-                   "dynamics": {**vec("q0", [0.5928, 0.5193, 0.5026, 0.3566]),
-                                **vec("omega0", [math.radians(x) for x in (0.0019, 0.0013, -0.0003)]),
-                                "integrator": "euler"},
+    "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50): from the end state of detumble "
+                                  "case 2 (full precision; Eq. 48 prints it to 4 decimals)",
+                   "dynamics": {**vec("q0", Q_END_2), **vec("omega0", W_END_2), "integrator": "euler"},
                    "slew": {**vec("Kd", [22.5] * 3)}},
 }
-# Slew case 3 (Eq. 51-66): three 180 deg rotations with their own gains (Appendix G). The
-# targets follow from the start attitude, so system_ssp.thesis computes them at run time;
-# these files carry the gains and the Appendix G stop test.
+# Slew case 3 (Eq. 51-66, Appendix G): three 180 deg rotations from the end state of
+# detumble case 1, targets q_x (x) q0, q_y (x) q_d,x, q_z (x) q_d,y (Eq. 57-59), each with its
+# own gains and the Appendix G stop test. The y and z rotations start where the previous one
+# ended, so their files carry no initial state: system_ssp.thesis chains them.
+_target = tuple(Q_END_1)
 for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.items():
+    _rot = attitude.from_axis_angle({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}[axis],
+                                    math.pi)
+    _target = attitude.circle_cross(_rot, _target)
     CASES[f"slew_case3_{axis}"] = {
-        "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 61/63/65, Appendix G)",
-        "dynamics": {"integrator": "euler"},
-        "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), "accept_antipodal": True}}
+        "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 57-66, Appendix G)",
+        "dynamics": ({**vec("q0", Q_END_1), **vec("omega0", W_END_1)} if axis == "x" else {}) | {"integrator": "euler"},
+        "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), **vec("q_d", list(_target)),
+                 "accept_antipodal": True}}
 
 SYSTEMS = {
     "detumble": {

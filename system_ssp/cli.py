@@ -1,0 +1,94 @@
+"""Command line: `python -m system_ssp run PATH ...` and `python -m system_ssp info PATH`."""
+import argparse
+import sys
+
+from .errors import SSPError
+
+
+def _parser():
+    ap = argparse.ArgumentParser(prog="python -m system_ssp", description="Run SSP 1.0 co-simulations.")
+    sub = ap.add_subparsers(dest="command", required=True)
+    r = sub.add_parser("run", help="run a system (.ssp or .ssd)")
+    r.add_argument("path")
+    r.add_argument("--stop-time", type=float)
+    r.add_argument("--step-size", type=float)
+    r.add_argument("--start-time", type=float)
+    r.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
+                   help="override a parameter or start value (repeatable)")
+    r.add_argument("--ssv", action="append", default=[], metavar="FILE",
+                   help="extra parameter set, names component.variable (repeatable)")
+    r.add_argument("--algorithm", choices=["jacobi", "gauss-seidel"])
+    r.add_argument("--order", help="component order, comma-separated")
+    r.add_argument("--step-multiple", action="append", default=[], metavar="COMP=K")
+    r.add_argument("--stop-when", action="append", default=None, metavar="COMP.VAR",
+                   help="Boolean output that stops the run when true (repeatable)")
+    r.add_argument("--output", help="CSV results file")
+    r.add_argument("--outputs", help="signals to record, comma-separated component.variable")
+    r.add_argument("--record-every", type=int, default=1)
+    r.add_argument("--no-progress", action="store_true")
+    r.add_argument("--print-final", action="store_true", help="print all final values")
+    r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
+    i = sub.add_parser("info", help="describe a system")
+    i.add_argument("path")
+    i.add_argument("--no-validate", action="store_true")
+    return ap
+
+
+def _parse_sets(items):
+    out = {}
+    for s in items:
+        if "=" not in s:
+            raise SSPError(f"--set {s!r}: expected component.variable=value")
+        k, v = s.split("=", 1)
+        out[k.strip()] = v.strip()
+    return out
+
+
+def _parse_multiples(items):
+    out = {}
+    for s in items:
+        k, _, v = s.partition("=")
+        try:
+            out[k.strip()] = int(v)
+        except ValueError:
+            raise SSPError(f"--step-multiple {s!r}: expected component=integer") from None
+    return out
+
+
+def main(argv=None):
+    args = _parser().parse_args(argv)
+    from .master import System
+
+    try:
+        with System(args.path, validate=not args.no_validate) as system:
+            if args.command == "info":
+                print(system.info())
+                return 0
+            result = system.run(
+                stop_time=args.stop_time, step_size=args.step_size, start_time=args.start_time,
+                parameters=_parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
+                algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
+                stop_when=args.stop_when, output_file=args.output, progress=not args.no_progress,
+                record_every=args.record_every)
+    except SSPError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    except KeyboardInterrupt:
+        print("interrupted", file=sys.stderr)
+        return 130
+    except Exception as exc:  # unexpected: still no traceback for users
+        print(f"error: unexpected {type(exc).__name__}: {exc}", file=sys.stderr)
+        return 3
+    print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
+    print(f"steps:       {result.steps} (h = {result.step_size:g} s, {result.algorithm}, order "
+          f"{' '.join(result.order)})")
+    print(f"wall time:   {result.wall_time:.3f} s")
+    if args.output:
+        print(f"results:     {args.output}")
+    items = sorted(result.final.items())
+    shown = items if args.print_final else items[:10]
+    print("final values:" if args.print_final else f"final values (first {len(shown)} of {len(items)}; "
+          "--print-final for all):")
+    for k, v in shown:
+        print(f"  {k} = {v!r}")
+    return 0

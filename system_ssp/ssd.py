@@ -1,0 +1,503 @@
+"""Reading SSP 1.0 system descriptions (.ssd), parameter sets (.ssv) and mappings (.ssm).
+
+Every file is checked against the SSP 1.0 XML schemas shipped with FMPy (`fmpy/ssp/schema`).
+The result is a plain description (`SystemDescription`) that the master turns into running
+FMU instances; nothing here loads an FMU.
+
+Parameter names coming out of this module are already prefixed (`prefix` attribute) and
+mapped (`ssd:ParameterMapping` / `.ssm`): for a component binding they are variable names of
+that component, for a binding on the root system they are `component.variable`.
+"""
+from collections import namedtuple
+from dataclasses import dataclass, field
+import math
+import os
+from pathlib import Path
+import urllib.parse
+
+from lxml import etree
+
+from .errors import SSPError
+from .units import BASE_NAMES, Unit
+
+NS_SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
+NS_SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
+NS_SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
+NS_SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
+NS_NC = "https://neighbor-cosim.org/ssp/master"
+ANNOTATION_TYPE = "org.neighbor-cosim.master"
+
+NS = {"ssd": NS_SSD, "ssc": NS_SSC, "ssv": NS_SSV, "ssm": NS_SSM, "nc": NS_NC}
+
+SCHEMA_FILES = {
+    "ssd": "SystemStructureDescription.xsd",
+    "ssv": "SystemStructureParameterValues.xsd",
+    "ssm": "SystemStructureParameterMapping.xsd",
+}
+ROOT_TAGS = {
+    "ssd": f"{{{NS_SSD}}}SystemStructureDescription",
+    "ssv": f"{{{NS_SSV}}}ParameterSet",
+    "ssm": f"{{{NS_SSM}}}ParameterMapping",
+}
+TYPE_TAGS = ("Real", "Integer", "Boolean", "String", "Enumeration", "Binary")
+
+_schemas = {}
+
+
+def _schema(kind):
+    if kind not in _schemas:
+        import fmpy
+
+        path = Path(fmpy.__file__).parent / "ssp" / "schema" / SCHEMA_FILES[kind]
+        _schemas[kind] = etree.XMLSchema(etree.parse(str(path)))
+    return _schemas[kind]
+
+
+def _q(prefix, tag):
+    return f"{{{NS[prefix]}}}{tag}"
+
+
+def _local(el):
+    return etree.QName(el).localname
+
+
+# A parameter value from an .ssv (or the caller), before it is matched to an FMU variable.
+# type: "Real" | "Integer" | "Boolean" | "String" | "Enumeration"; unit: unit name or None;
+# units: dict of Unit defined next to the value (the .ssv's ssv:Units); origin: "file:line".
+ParamValue = namedtuple("ParamValue", "name type value unit units origin")
+
+
+@dataclass
+class Connector:
+    name: str
+    kind: str
+    type: str = None  # declared type (ssc:Real, ...) or None
+    unit: str = None
+    origin: str = ""
+
+
+@dataclass
+class Component:
+    name: str
+    source: str
+    fmu_path: Path
+    type: str
+    connectors: dict = field(default_factory=dict)
+    parameters: list = field(default_factory=list)  # [ParamValue], names = variable names
+    origin: str = ""
+
+
+@dataclass
+class Connection:
+    start_element: str  # None = system connector
+    start_connector: str
+    end_element: str
+    end_connector: str
+    transform: tuple = None  # ("linear", factor, offset) | ("boolmap", {..}) | ("intmap", {..})
+    suppress_unit_conversion: bool = False
+    origin: str = ""
+
+    def label(self):
+        a = f"{self.start_element}.{self.start_connector}" if self.start_element else self.start_connector
+        b = f"{self.end_element}.{self.end_connector}" if self.end_element else self.end_connector
+        return f"{a} -> {b}"
+
+
+@dataclass
+class MasterSettings:
+    """Contents of the `org.neighbor-cosim.master` annotation(s)."""
+    step_size: float = None
+    algorithm: str = None
+    order: list = None
+    step_multiples: dict = field(default_factory=dict)
+    stop_conditions: list = field(default_factory=list)
+    origin: str = ""
+
+
+@dataclass
+class SystemDescription:
+    path: Path  # the .ssd file
+    display: str  # how files are named in messages
+    name: str
+    system_name: str
+    components: list = field(default_factory=list)  # [Component] in SSD order
+    system_connectors: dict = field(default_factory=dict)
+    connections: list = field(default_factory=list)
+    units: dict = field(default_factory=dict)  # name -> Unit (ssd:Units)
+    start_time: float = None
+    stop_time: float = None
+    parameters: list = field(default_factory=list)  # root-system bindings, names comp.var
+    master: MasterSettings = field(default_factory=MasterSettings)
+
+    def component(self, name):
+        for c in self.components:
+            if c.name == name:
+                return c
+        return None
+
+
+class FileNamer:
+    """Turns a path on disk into the name used in messages (archive-relative for .ssp)."""
+
+    def __init__(self, root=None, archive=None):
+        self.root = Path(root) if root else None
+        self.archive = archive
+
+    def __call__(self, path):
+        path = Path(path)
+        if self.archive and self.root:
+            try:
+                return f"{self.archive}!/{path.relative_to(self.root).as_posix()}"
+            except ValueError:
+                pass
+        return str(path)
+
+
+def load_xml(path, kind, namer, validate=True):
+    """Parse (and schema-check) an SSP file; SSPError names the file and line on failure."""
+    display = namer(path)
+    if not Path(path).is_file():
+        raise SSPError(f"{display}: file not found")
+    try:
+        doc = etree.parse(str(path))
+    except etree.XMLSyntaxError as exc:
+        line = exc.lineno if exc.lineno is not None else "?"
+        raise SSPError(f"{display}:{line}: malformed XML: {exc.msg}") from None
+    root = doc.getroot()
+    if validate:
+        schema = _schema(kind)
+        if not schema.validate(doc):
+            errors = [f"{display}:{e.line}: schema violation: {e.message}" for e in schema.error_log]
+            more = f"\n(and {len(errors) - 5} more)" if len(errors) > 5 else ""
+            raise SSPError("\n".join(errors[:5]) + more)
+    elif root.tag != ROOT_TAGS[kind]:
+        raise SSPError(f"{display}:{root.sourceline}: expected root element {ROOT_TAGS[kind]}, found {root.tag}")
+    return root
+
+
+def resolve_uri(uri, base_dir):
+    """A relative (or file:) URI from an SSP file, as a path on disk."""
+    parsed = urllib.parse.urlparse(uri)
+    if parsed.scheme in ("http", "https"):
+        raise SSPError(f"remote sources are not supported: {uri}")
+    if parsed.scheme == "file":
+        return Path(urllib.parse.unquote(parsed.path))
+    p = Path(urllib.parse.unquote(uri))
+    return p if p.is_absolute() else Path(base_dir) / p
+
+
+def _float_attr(el, name, origin, default=None):
+    v = el.get(name)
+    if v is None:
+        return default
+    try:
+        x = float(v)
+    except ValueError:
+        raise SSPError(f"{origin}: attribute {name}={v!r} is not a number") from None
+    return x
+
+
+def parse_units(parent, namer):
+    """ssc:Unit children of an ssd:Units / ssv:Units element -> {name: Unit}."""
+    units = {}
+    if parent is None:
+        return units
+    for u in parent.findall("ssc:Unit", NS):
+        origin = f"{namer(u.getroottree().docinfo.URL)}:{u.sourceline}"
+        b = u.find("ssc:BaseUnit", NS)
+        exps, factor, offset = (0,) * 8, 1.0, 0.0
+        if b is not None:
+            exps = tuple(int(b.get(n, "0")) for n in BASE_NAMES)
+            factor = _float_attr(b, "factor", origin, 1.0)
+            offset = _float_attr(b, "offset", origin, 0.0)
+        units[u.get("name")] = Unit(u.get("name"), exps, factor, offset)
+    return units
+
+
+def _type_child(el):
+    """The ssc type element (Real, Integer, ...) under a connector, or None."""
+    for child in el:
+        if etree.QName(child).namespace == NS_SSC and _local(child) in TYPE_TAGS:
+            return child
+    return None
+
+
+def _parse_transform(parent, origin):
+    for child in parent:
+        tag = _local(child) if isinstance(child.tag, str) else ""
+        if tag == "LinearTransformation":
+            return ("linear", _float_attr(child, "factor", origin, 1.0), _float_attr(child, "offset", origin, 0.0))
+        if tag in ("BooleanMappingTransformation", "IntegerMappingTransformation",
+                   "EnumerationMappingTransformation"):
+            conv = {"BooleanMappingTransformation": _parse_bool,
+                    "IntegerMappingTransformation": int}.get(tag, str)
+            mapping = {}
+            for e in child.findall("ssc:MapEntry", NS):
+                try:
+                    mapping[conv(e.get("source"))] = conv(e.get("target"))
+                except ValueError:
+                    raise SSPError(f"{origin}: bad MapEntry {e.get('source')!r} -> {e.get('target')!r}") from None
+            kind = {"BooleanMappingTransformation": "boolmap", "IntegerMappingTransformation": "intmap"}.get(tag, "enummap")
+            return (kind, mapping)
+    return None
+
+
+def _parse_bool(text):
+    t = str(text).strip().lower()
+    if t in ("true", "1"):
+        return True
+    if t in ("false", "0"):
+        return False
+    raise ValueError(f"not a Boolean: {text!r}")
+
+
+def parse_ssv(root, namer):
+    """An ssv:ParameterSet element -> [ParamValue]."""
+    display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
+    units = parse_units(root.find("ssv:Units", NS), namer)
+    values = []
+    params = root.find("ssv:Parameters", NS)
+    for p in ([] if params is None else params.findall("ssv:Parameter", NS)):
+        origin = f"{display}:{p.sourceline}"
+        tv = None
+        for child in p:
+            if isinstance(child.tag, str) and etree.QName(child).namespace == NS_SSV and _local(child) in TYPE_TAGS:
+                tv = child
+                break
+        if tv is None:
+            raise SSPError(f"{origin}: parameter {p.get('name')!r} has no value")
+        kind = _local(tv)
+        raw = tv.get("value")
+        try:
+            if kind == "Real":
+                value = float(raw)
+            elif kind == "Integer":
+                value = int(raw)
+            elif kind == "Boolean":
+                value = _parse_bool(raw)
+            elif kind == "String":
+                value = raw
+            elif kind == "Enumeration":
+                value = raw  # an item name, resolved against the FMU's type later
+            else:
+                raise SSPError(f"{origin}: parameter {p.get('name')!r}: {kind} values are not supported")
+        except (TypeError, ValueError):
+            raise SSPError(f"{origin}: parameter {p.get('name')!r}: {raw!r} is not a valid {kind}") from None
+        values.append(ParamValue(p.get("name"), kind, value, tv.get("unit") if kind == "Real" else None, units, origin))
+    return values
+
+
+def parse_ssm(root, namer):
+    """An ssm:ParameterMapping element -> {source name: (target name, transform, suppress)}."""
+    display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
+    mapping = {}
+    for e in root.findall("ssm:MappingEntry", NS):
+        origin = f"{display}:{e.sourceline}"
+        mapping[e.get("source")] = (e.get("target"), _parse_transform(e, origin),
+                                    e.get("suppressUnitConversion", "false") == "true", origin)
+    return mapping
+
+
+def _apply_transform(transform, value, kind, origin, name):
+    if transform is None:
+        return value
+    if transform[0] == "linear":
+        if kind not in ("Real", "Integer"):
+            raise SSPError(f"{origin}: LinearTransformation on {kind} parameter {name!r}")
+        return transform[1] * float(value) + transform[2]
+    mapping = transform[1]
+    return mapping.get(value, value)
+
+
+def parse_bindings(el, namer, base_dir, validate, component_dir=None):
+    """ssd:ParameterBindings under a component or system -> [ParamValue] (prefixed, mapped)."""
+    out = []
+    bindings = el.find("ssd:ParameterBindings", NS)
+    if bindings is None:
+        return out
+    for b in bindings.findall("ssd:ParameterBinding", NS):
+        ssd_display = namer(b.getroottree().docinfo.URL)
+        origin = f"{ssd_display}:{b.sourceline}"
+        btype = b.get("type", "application/x-ssp-parameter-set")
+        if btype != "application/x-ssp-parameter-set":
+            raise SSPError(f"{origin}: parameter binding type {btype!r} is not supported")
+        base = component_dir if (b.get("sourceBase") == "component" and component_dir) else base_dir
+        src = b.get("source")
+        if src:
+            path = resolve_uri(src, base)
+            if not path.is_file():
+                raise SSPError(f"{origin}: parameter set {src!r} not found (tried {namer(path)})")
+            values = parse_ssv(load_xml(path, "ssv", namer, validate), namer)
+        else:
+            inline = b.find("ssd:ParameterValues/ssv:ParameterSet", NS)
+            if inline is None:
+                raise SSPError(f"{origin}: parameter binding has neither a source nor inline ssv:ParameterSet")
+            values = parse_ssv(inline, namer)
+        mapping = {}
+        m = b.find("ssd:ParameterMapping", NS)
+        if m is not None:
+            msrc = m.get("source")
+            if msrc:
+                mbase = component_dir if (m.get("sourceBase") == "component" and component_dir) else base_dir
+                mpath = resolve_uri(msrc, mbase)
+                if not mpath.is_file():
+                    raise SSPError(f"{origin}: parameter mapping {msrc!r} not found (tried {namer(mpath)})")
+                mapping = parse_ssm(load_xml(mpath, "ssm", namer, validate), namer)
+            else:
+                inline = m.find("ssm:ParameterMapping", NS)
+                if inline is not None:
+                    mapping = parse_ssm(inline, namer)
+        prefix = b.get("prefix", "")
+        for v in values:
+            name = prefix + v.name
+            if name in mapping:
+                target, transform, _suppress, morigin = mapping[name]
+                value = _apply_transform(transform, v.value, v.type, morigin, name)
+                kind = "Real" if (transform and transform[0] == "linear") else v.type
+                v = v._replace(name=target, value=value, type=kind, origin=f"{v.origin} (mapped by {morigin})")
+            else:
+                v = v._replace(name=name)
+            out.append(v)
+    return out
+
+
+def _parse_connectors(el, namer):
+    out = {}
+    conns = el.find("ssd:Connectors", NS)
+    if conns is None:
+        return out
+    for c in conns.findall("ssd:Connector", NS):
+        t = _type_child(c)
+        out[c.get("name")] = Connector(
+            name=c.get("name"), kind=c.get("kind"),
+            type=_local(t) if t is not None else None,
+            unit=t.get("unit") if (t is not None and _local(t) == "Real") else None,
+            origin=f"{namer(c.getroottree().docinfo.URL)}:{c.sourceline}")
+    return out
+
+
+def parse_master_annotation(el, namer, settings):
+    """Read `org.neighbor-cosim.master` annotations under `el` into `settings` (later wins)."""
+    # SSP 1.0: ssd:System and ssd:DefaultExperiment hold ssd:Annotations (of type ssc:TAnnotations)
+    anns = el.find("ssd:Annotations", NS)
+    if anns is None:
+        anns = el.find("ssc:Annotations", NS)
+    if anns is None:
+        return
+    for ann in anns.findall("ssc:Annotation", NS):
+        if ann.get("type") != ANNOTATION_TYPE:
+            continue
+        origin = f"{namer(ann.getroottree().docinfo.URL)}:{ann.sourceline}"
+        masters = [c for c in ann if isinstance(c.tag, str)]
+        if len(masters) != 1 or masters[0].tag != _q("nc", "Master"):
+            raise SSPError(f"{origin}: annotation {ANNOTATION_TYPE} must contain exactly one "
+                           f"<nc:Master xmlns:nc=\"{NS_NC}\"> element")
+        m = masters[0]
+        settings.origin = origin
+        unknown = set(m.attrib) - {"stepSize", "algorithm"}
+        if unknown:
+            raise SSPError(f"{origin}: unknown attribute(s) on nc:Master: {', '.join(sorted(unknown))}")
+        if m.get("stepSize") is not None:
+            h = _float_attr(m, "stepSize", origin)
+            if not (h > 0 and math.isfinite(h)):
+                raise SSPError(f"{origin}: nc:Master stepSize must be a positive number, got {m.get('stepSize')!r}")
+            settings.step_size = h
+        if m.get("algorithm") is not None:
+            settings.algorithm = m.get("algorithm")
+        for child in m:
+            if not isinstance(child.tag, str):
+                continue
+            corigin = f"{namer(child.getroottree().docinfo.URL)}:{child.sourceline}"
+            if child.tag == _q("nc", "Order"):
+                settings.order = (child.text or "").split()
+            elif child.tag == _q("nc", "StepMultiple"):
+                comp, mult = child.get("component"), child.get("multiple")
+                try:
+                    k = int(mult)
+                except (TypeError, ValueError):
+                    k = 0
+                if not comp or k < 1:
+                    raise SSPError(f"{corigin}: nc:StepMultiple needs component=\"name\" and multiple=\"k\" (k >= 1)")
+                settings.step_multiples[comp] = k
+            elif child.tag == _q("nc", "StopCondition"):
+                comp, conn = child.get("component"), child.get("connector")
+                if not comp or not conn:
+                    raise SSPError(f"{corigin}: nc:StopCondition needs component=\"name\" and connector=\"name\"")
+                settings.stop_conditions.append(f"{comp}.{conn}")
+            else:
+                raise SSPError(f"{corigin}: unknown element {child.tag} in nc:Master "
+                               "(expected nc:Order, nc:StepMultiple, nc:StopCondition)")
+
+
+def parse_ssd(ssd_path, namer, validate=True):
+    """Read a .ssd file (and the .ssv/.ssm files it references) into a SystemDescription."""
+    ssd_path = Path(ssd_path)
+    base_dir = ssd_path.parent
+    root = load_xml(ssd_path, "ssd", namer, validate)
+    display = namer(ssd_path)
+    system = root.find("ssd:System", NS)
+    if system is None:
+        raise SSPError(f"{display}: no ssd:System element")
+    desc = SystemDescription(path=ssd_path, display=display, name=root.get("name"),
+                             system_name=system.get("name"))
+    desc.units = parse_units(root.find("ssd:Units", NS), namer)
+    desc.system_connectors = _parse_connectors(system, namer)
+
+    elements = system.find("ssd:Elements", NS)
+    for el in ([] if elements is None else elements):
+        if not isinstance(el.tag, str):
+            continue
+        origin = f"{display}:{el.sourceline}"
+        tag = _local(el)
+        if tag == "System":
+            raise SSPError(f"{origin}: nested system {el.get('name')!r} inside {desc.system_name!r}: only flat "
+                           "systems (components directly under the root system) are supported")
+        if tag == "SignalDictionaryReference":
+            raise SSPError(f"{origin}: signal dictionary references are not supported")
+        if tag != "Component":
+            continue
+        name = el.get("name")
+        ctype = el.get("type", "application/x-fmu-sharedlibrary")
+        if ctype != "application/x-fmu-sharedlibrary":
+            raise SSPError(f"{origin}: component {name!r} has type {ctype!r}; only FMUs are supported")
+        if desc.component(name) is not None:
+            raise SSPError(f"{origin}: duplicate component name {name!r}")
+        source = el.get("source")
+        fmu_path = resolve_uri(source, base_dir)
+        comp = Component(name=name, source=source, fmu_path=fmu_path, type=ctype,
+                         connectors=_parse_connectors(el, namer), origin=origin)
+        comp.parameters = parse_bindings(el, namer, base_dir, validate, component_dir=None)
+        desc.components.append(comp)
+
+    desc.parameters = parse_bindings(system, namer, base_dir, validate)
+
+    conns = system.find("ssd:Connections", NS)
+    for c in ([] if conns is None else conns.findall("ssd:Connection", NS)):
+        origin = f"{display}:{c.sourceline}"
+        desc.connections.append(Connection(
+            start_element=c.get("startElement") or None, start_connector=c.get("startConnector"),
+            end_element=c.get("endElement") or None, end_connector=c.get("endConnector"),
+            transform=_parse_transform(c, origin),
+            suppress_unit_conversion=c.get("suppressUnitConversion", "false") in ("true", "1"),
+            origin=origin))
+
+    parse_master_annotation(system, namer, desc.master)
+    de = root.find("ssd:DefaultExperiment", NS)
+    if de is not None:
+        origin = f"{display}:{de.sourceline}"
+        desc.start_time = _float_attr(de, "startTime", origin)
+        desc.stop_time = _float_attr(de, "stopTime", origin)
+        parse_master_annotation(de, namer, desc.master)
+    return desc
+
+
+def read_parameter_set_file(path, namer, validate=True):
+    """A caller-supplied .ssv (names `component.variable`) -> [ParamValue]."""
+    return parse_ssv(load_xml(path, "ssv", namer, validate), namer)
+
+
+def relpath_or_abs(p):
+    try:
+        return os.path.relpath(p)
+    except ValueError:
+        return str(p)
