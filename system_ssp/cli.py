@@ -1,4 +1,5 @@
-"""Command line: `python -m system_ssp run PATH ...` and `python -m system_ssp info PATH`."""
+"""Command line: `python -m system_ssp run PATH ...`, `python -m system_ssp info PATH` and
+`python -m system_ssp thesis [--integrator euler|rk4]` (the thesis validation cases)."""
 import argparse
 import sys
 
@@ -31,6 +32,8 @@ def _parser():
     i = sub.add_parser("info", help="describe a system")
     i.add_argument("path")
     i.add_argument("--no-validate", action="store_true")
+    sub.add_parser("thesis", add_help=False,
+                   help="run the NEIGHBOR thesis validation cases and compare with the published numbers")
     return ap
 
 
@@ -56,6 +59,15 @@ def _parse_multiples(items):
 
 
 def main(argv=None):
+    argv = sys.argv[1:] if argv is None else list(argv)
+    if argv[:1] == ["thesis"]:
+        from . import thesis
+
+        try:
+            return thesis.main(argv[1:])
+        except SSPError as exc:
+            print(f"error: {exc}", file=sys.stderr)
+            return 2
     args = _parser().parse_args(argv)
     from .master import System
 

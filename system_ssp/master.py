@@ -274,7 +274,8 @@ class System:
         for i, decl in enumerate(self.desc.components):
             if not decl.fmu_path.is_file():
                 raise SSPError(f"{decl.origin}: component {decl.name!r}: FMU file not found "
-                               f"(source={decl.source!r}, tried {self.namer(decl.fmu_path)})")
+                               f"(source={decl.source!r}, tried {self.namer(decl.fmu_path)}); the product's "
+                               "systems are packed with their FMUs by `python build_fmus.py` into build/ssp/")
             try:
                 md = read_model_description(str(decl.fmu_path), validate=self.validate)
             except Exception as exc:  # fmpy raises various exceptions for broken FMUs

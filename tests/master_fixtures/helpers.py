@@ -20,17 +20,10 @@ repo, dest, scripts = sys.argv[1], sys.argv[2], json.loads(sys.argv[3])
 sys.path.insert(0, repo)
 sys.path.insert(0, str(Path(repo) / "fmus"))
 out = {}
-try:
-    from build_fmus import build_fmu
-    for key, script in scripts.items():
-        out[key] = str(build_fmu(script, dest))
-    out["_builder"] = "build_fmus.build_fmu"
-except Exception as exc:  # build_fmus not usable: plain pythonfmu (no units, no dependencies)
-    from pythonfmu.builder import FmuBuilder
-    for key, script in scripts.items():
-        out[key] = str(FmuBuilder.build_FMU(script, dest=dest,
-                                            project_files=[str(Path(repo) / "fmus" / "neighbor_fmu_support.py")]))
-    out["_builder"] = f"pythonfmu ({type(exc).__name__}: {exc})"
+from build_fmus import build_fmu
+for key, script in scripts.items():
+    out[key] = str(build_fmu(script, dest))
+out["_builder"] = "build_fmus.build_fmu"
 print(json.dumps(out))
 """
 

@@ -1,0 +1,166 @@
+"""The NEIGHBOR thesis' attitude validation cases, run through the master.
+
+    python -m system_ssp thesis [--integrator euler|rk4] [--ssp-dir build/ssp]
+
+Each case is the packed detumble or slew system with that case's parameter set
+(system_ssp/systems/parameters/<case>.ssv). The thesis ran its slews from the end state of a
+detumble case (slew 1 after detumble 1, slew 2 after detumble 2, slew 3 after detumble 1), and
+slew case 3 as three successive 180 deg rotations, each from where the previous one ended, to
+targets computed from the start attitude (Appendix G, Eq. 57-59). This module chains the runs
+the same way: the final q_BN and omega_BN_B of one run become q0 and omega0 of the next.
+
+Durations count communication steps of 15 ms from the start of a run to the first
+communication point where the controller's `done` holds (the state after n integration
+steps has time n * 15 ms). The detumble script of Appendix D breaks before stepping its clock,
+so its printed time counts one step less (664 updates: 9.96 s here, 9.945 s by the script's
+clock; the thesis prints "about 9.97 s"). Propellant is Eq. 74 over the summed pair firing
+time.
+"""
+import math
+from dataclasses import dataclass, field
+from pathlib import Path
+
+from components import attitude
+
+from .master import System
+
+DEFAULT_SSP_DIR = Path(__file__).resolve().parents[1] / "build" / "ssp"
+
+# Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
+# omega in deg/s as printed, durations in s, propellant in g.
+THESIS = {
+    "detumble_case1": dict(duration=9.97, propellant=2.36, q=(0.1460, 0.4400, 0.2256, 0.8573),
+                           omega=(0.0019, 0.0013, -0.0003), source="Eq. 34, section 3.3.9"),
+    "detumble_case2": dict(duration=9.97, propellant=2.36, q=(0.5928, 0.5193, 0.5026, 0.3566),
+                           omega=(0.0019, 0.0013, -0.0003), source="Eq. 38, section 3.3.9"),
+    "slew_case1": dict(duration=24.84, propellant=4.51, q=(0.00017, 0.00041, 0.00043, 1.00060),
+                       omega=(-0.0053, -0.0054, -0.0021), source="Eq. 47, section 3.3.9"),
+    "slew_case2": dict(duration=38.25, propellant=9.96, q=(0.00027, 0.00039, -0.00012, 1.00125),
+                       omega=(-0.0028, -0.0038, -0.0100), source="Eq. 50, section 3.3.9"),
+    "slew_case3_x": dict(duration=32.81, propellant=None, q=(0.8585, 0.2267, -0.4405, -0.1451),
+                         omega=(0.0019, -0.0004, -0.0018), source="Eq. 62"),
+    "slew_case3_y": dict(duration=82.5, propellant=None, q=(-0.4412, 0.1453, -0.8585, 0.2282),
+                         omega=(0.0001, -0.0004, 0.0028), source="Eq. 64"),
+    "slew_case3_z": dict(duration=50.96, propellant=None, q=(0.1460, 0.4413, 0.2254, 0.8601),
+                         omega=(-0.0034, -0.0083, 0.0029), source="Eq. 66"),
+    "slew_case3": dict(duration=166.26, propellant=16.03, q=None, omega=None, source="section 3.3.7, 3.3.9"),
+}
+
+AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
+
+
+@dataclass
+class CaseResult:
+    name: str
+    converged: bool
+    duration: float  # s
+    propellant: float  # g
+    q: tuple = None
+    omega_deg: tuple = None
+    steps: int = 0
+    wall_time: float = 0.0
+    parts: list = field(default_factory=list)
+
+    @property
+    def thesis(self):
+        return THESIS[self.name]
+
+
+def _state(result):
+    q = tuple(result.final[f"dynamics.q_BN[{i}]"] for i in range(1, 5))
+    w = tuple(result.final[f"dynamics.omega_BN_B[{i}]"] for i in range(1, 4))
+    return q, w
+
+
+def _initial(q, w):
+    out = {f"dynamics.q0[{i}]": v for i, v in enumerate(q, 1)}
+    out.update({f"dynamics.omega0[{i}]": v for i, v in enumerate(w, 1)})
+    return out
+
+
+def _case(name, system, integrator, stop_time, parameters=None):
+    params = {"dynamics.integrator": integrator}
+    params.update(parameters or {})
+    result = system.run(parameter_sets=[f"parameters/{name}.ssv"], parameters=params, stop_time=stop_time)
+    q, w = _state(result)
+    converged = result.stop_reason.startswith("stop condition")
+    duration = result.stop_time - float(result.data["time"][0])
+    res = CaseResult(name, converged, duration, result.final["thrusters.propellant_mass"] * 1e3, q,
+                     tuple(math.degrees(x) for x in w), result.steps, result.wall_time)
+    return res, (q, w)
+
+
+def slew_case3(slew, start, integrator="euler", stop_time=None):
+    """Appendix G: 180 deg about x, then y, then z; targets from the start attitude (Eq. 57-59)."""
+    q, w = start
+    target = q
+    parts = []
+    for axis in "xyz":
+        target = attitude.circle_cross(attitude.from_axis_angle(AXES[axis], math.pi), target)
+        params = _initial(q, w)
+        params.update({f"slew.q_d[{i}]": v for i, v in enumerate(target, 1)})
+        part, (q, w) = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params)
+        parts.append(part)
+        if not part.converged:
+            break
+    total = CaseResult("slew_case3", all(p.converged for p in parts) and len(parts) == 3,
+                       sum(p.duration for p in parts), sum(p.propellant for p in parts), q,
+                       tuple(math.degrees(x) for x in w), sum(p.steps for p in parts),
+                       sum(p.wall_time for p in parts), parts)
+    return total
+
+
+def run_cases(ssp_dir=DEFAULT_SSP_DIR, integrator="euler", slew_stop_time=None, cases=None):
+    """Run the thesis cases (all, or the names in `cases`); returns {name: CaseResult}."""
+    ssp_dir = Path(ssp_dir)
+    wanted = set(cases or ("detumble_case1", "detumble_case2", "slew_case1", "slew_case2", "slew_case3"))
+    out = {}
+    with System(ssp_dir / "detumble.ssp") as detumble, System(ssp_dir / "slew.ssp") as slew:
+        ends = {}
+        for k in (1, 2):
+            if {f"detumble_case{k}", f"slew_case{k}"} & wanted or (k == 1 and "slew_case3" in wanted):
+                res, ends[k] = _case(f"detumble_case{k}", detumble, integrator, None)
+                out[res.name] = res
+        for k in (1, 2):
+            if f"slew_case{k}" in wanted:
+                res, _ = _case(f"slew_case{k}", slew, integrator, slew_stop_time, _initial(*ends[k]))
+                out[res.name] = res
+        if "slew_case3" in wanted:
+            total = slew_case3(slew, ends[1], integrator, slew_stop_time)
+            for part in total.parts:
+                out[part.name] = part
+            out["slew_case3"] = total
+    return {k: v for k, v in out.items() if k in wanted or k.startswith("slew_case3")}
+
+
+def _fmt(values, digits):
+    return "[" + ", ".join(f"{v:.{digits}f}" for v in values) + "]" if values is not None else "-"
+
+
+def report(results, integrator):
+    lines = [f"NEIGHBOR thesis attitude validation cases, integrator={integrator}, 15 ms Gauss-Seidel steps",
+             f"{'case':<15}{'done':<6}{'time s':>9}{'thesis':>9}{'prop g':>8}{'thesis':>8}  final q / thesis q;"
+             " final omega deg/s / thesis"]
+    for name, r in results.items():
+        t = r.thesis
+        digits = 5 if name in ("slew_case1", "slew_case2") else 4
+        prop = f"{t['propellant']:.2f}" if t["propellant"] is not None else "-"
+        lines.append(f"{name:<15}{'yes' if r.converged else 'NO':<6}{r.duration:>9.3f}{t['duration']:>9.2f}"
+                     f"{r.propellant:>8.3f}{prop:>8}  {_fmt(r.q, digits)} / {_fmt(t['q'], digits)}")
+        if t["omega"] is not None:
+            lines.append(f"{'':<55}  {_fmt(r.omega_deg, 4)} / {_fmt(t['omega'], 4)}")
+    return "\n".join(lines)
+
+
+def main(argv=None):
+    import argparse
+
+    ap = argparse.ArgumentParser(prog="python -m system_ssp thesis", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--integrator", choices=["euler", "rk4"], default="euler")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--slew-stop-time", type=float, default=None,
+                    help="limit of each slew run in s (default: the SSD's 1500 s, Appendix G)")
+    args = ap.parse_args(argv)
+    results = run_cases(args.ssp_dir, args.integrator, args.slew_stop_time)
+    print(report(results, args.integrator))
+    return 0 if all(r.converged for r in results.values()) else 1

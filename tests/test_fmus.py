@@ -1,0 +1,139 @@
+"""Each FMU on its own through FMPy: a valid model description, standalone simulation,
+get/set of the full state, and the incremental build."""
+import math
+import shutil
+import zipfile
+
+import fmpy
+import numpy as np
+import pytest
+from fmpy.fmi2 import FMU2Slave
+from fmpy.validation import validate_fmu
+
+EXPECTED = {"RigidBody", "DetumbleController", "SlewController", "RcsThrusters"}
+
+
+def test_every_fmu_is_built_and_valid(fmu_paths):
+    assert EXPECTED <= set(fmu_paths)
+    for name, path in fmu_paths.items():
+        assert validate_fmu(str(path)) == [], name
+
+
+def test_every_variable_is_fully_declared(fmu_paths):
+    for name, path in fmu_paths.items():
+        md = fmpy.read_model_description(str(path))
+        units = {u.name for u in md.unitDefinitions}
+        for v in md.modelVariables:
+            assert v.causality and v.variability and v.description, (name, v.name)
+            if v.type == "Real":
+                assert v.unit in units, (name, v.name, v.unit)
+        assert md.coSimulation.canGetAndSetFMUstate, name
+        outputs = [v for v in md.modelVariables if v.causality == "output"]
+        assert {u.variable for u in md.outputs} == set(outputs)
+        assert {u.variable for u in md.initialUnknowns} == set(outputs)
+
+
+def test_module_names_are_unique(fmu_paths):
+    modules = []
+    for path in fmu_paths.values():
+        with zipfile.ZipFile(path) as zf:
+            modules.append(zf.read("resources/slavemodule.txt").decode().strip())
+    assert len(set(modules)) == len(modules) and all(m.startswith("neighbor_") for m in modules)
+
+
+def _deps(path):
+    md = fmpy.read_model_description(str(path))
+    return {u.variable.name: sorted(d.name for d in u.dependencies) for u in md.outputs}
+
+
+def test_output_dependencies_are_real(fmu_paths):
+    body = _deps(fmu_paths["RigidBody"])
+    assert body and all(d == [] for d in body.values())  # states: no direct feedthrough
+    det = _deps(fmu_paths["DetumbleController"])
+    assert det["torque_cmd_B[1]"] == sorted([f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+                                            + [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)] + ["enabled"])
+    assert det["done"] == [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+    thr = _deps(fmu_paths["RcsThrusters"])
+    assert thr["torque_B[2]"] == [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
+    assert thr["propellant_mass"] == [] and thr["fire_time[1]"] == []
+    slew = _deps(fmu_paths["SlewController"])
+    assert "q_BN[4]" in slew["torque_cmd_B[3]"] and "omega_BN_B[1]" in slew["done"]
+
+
+def test_each_fmu_simulates_alone(fmu_paths):
+    r = fmpy.simulate_fmu(str(fmu_paths["RigidBody"]), stop_time=2.0, output_interval=0.01,
+                          start_values={"omega0[3]": 0.2, "integrator": "rk4"})
+    assert r["time"][-1] == pytest.approx(2.0)
+    # torque-free spin about z: the quaternion rotates at 0.2 rad/s
+    assert r["q_BN[3]"][-1] == pytest.approx(math.sin(0.2), abs=1e-9)
+    r = fmpy.simulate_fmu(str(fmu_paths["RcsThrusters"]), stop_time=1.0, output_interval=0.01,
+                          start_values={"torque_cmd_B[1]": 0.0025})
+    assert r["fire_time[1]"][-1] == pytest.approx(1.0, abs=1e-9)
+    assert r["propellant_mass"][-1] == pytest.approx(2 * 0.025 * 1.0 / (42 * 9.81), rel=1e-9)
+    r = fmpy.simulate_fmu(str(fmu_paths["DetumbleController"]), stop_time=0.1, output_interval=0.01,
+                          start_values={"omega_BN_B[2]": 0.1})
+    assert list(r["thrust_flag[2]"][:3]) == [-1, -1, -1] and not r["done"][-1]
+    r = fmpy.simulate_fmu(str(fmu_paths["SlewController"]), stop_time=0.1, output_interval=0.01)
+    assert r["done"][-1] and r["attitude_error"][-1] == 0.0
+
+
+def _instance(path, tmp_path, name):
+    md = fmpy.read_model_description(str(path))
+    unzip = fmpy.extract(str(path), unzipdir=str(tmp_path / name))
+    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
+                    instanceName=name)
+    fmu.instantiate()
+    fmu.setupExperiment(startTime=0.0)
+    vrs = {v.name: v.valueReference for v in md.modelVariables}
+    return fmu, vrs
+
+
+def test_get_and_set_state_restores_hidden_state(fmu_paths, tmp_path):
+    # Rigid body: omega_dot (the last step's acceleration) is hidden state beyond the outputs'
+    # own values; thrusters: the accumulated firing times.
+    body, bv = _instance(fmu_paths["RigidBody"], tmp_path, "body")
+    thr, tv = _instance(fmu_paths["RcsThrusters"], tmp_path, "thr")
+    try:
+        body.setString([bv["integrator"]], ["euler"])
+        body.setReal([bv["omega0[1]"], bv["omega0[2]"]], [0.2, -0.1])
+        for f in (body, thr):
+            f.enterInitializationMode()
+            f.exitInitializationMode()
+        out = [bv[f"q_BN[{i}]"] for i in range(1, 5)] + [bv[f"omega_dot_BN_B[{i}]"] for i in range(1, 4)]
+        t = 0.0
+
+        def advance(n, torque):
+            nonlocal t
+            for _ in range(n):
+                thr.setReal([tv["torque_cmd_B[1]"], tv["torque_cmd_B[2]"]], torque)
+                thr.doStep(t, 0.015)
+                body.setReal([bv["torque_B[1]"], bv["torque_B[2]"]],
+                             thr.getReal([tv["torque_B[1]"], tv["torque_B[2]"]]))
+                body.doStep(t, 0.015)
+                t += 0.015
+            return body.getReal(out) + thr.getReal([tv["fire_time_total"], tv["propellant_mass"]])
+
+        advance(10, [0.0025, 0.0])
+        s_body, s_thr, t_saved = body.getFMUstate(), thr.getFMUstate(), t
+        first = advance(20, [0.0, -0.0025])
+        advance(5, [0.0025, 0.0025])  # wander off
+        body.setFMUstate(s_body)
+        thr.setFMUstate(s_thr)
+        t = t_saved
+        second = advance(20, [0.0, -0.0025])
+        assert first == second
+        body.freeFMUstate(s_body)
+        thr.freeFMUstate(s_thr)
+    finally:
+        for f in (body, thr):
+            f.terminate()
+            f.freeInstance()
+
+
+def test_build_is_incremental(tmp_path, monkeypatch, capsys):
+    import build_fmus
+
+    build_fmus.build_all(verbose=True)  # brings everything up to date
+    capsys.readouterr()
+    build_fmus.build_all(verbose=True)
+    assert "building" not in capsys.readouterr().out

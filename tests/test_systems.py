@@ -1,0 +1,154 @@
+"""The detumble and slew systems through our master: the thesis numbers, interoperability
+with libcosim, and clear errors for bad input."""
+import json
+import math
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import system_ssp
+from system_ssp import thesis
+
+HERE = Path(__file__).resolve().parent
+ROOT = HERE.parent
+
+
+@pytest.fixture(scope="module")
+def euler_cases(ssp_paths):
+    return thesis.run_cases(ssp_paths["detumble"].parent, "euler")
+
+
+# Tolerances: half a unit of the last printed decimal for q and omega; the thesis prints slew
+# case 3's z rotation q1 as 0.1460 where we get 0.14593, so that case gets one unit (1e-4).
+# Durations within one 15 ms step (the detumble script's clock stops one step early, see
+# system_ssp/thesis.py); propellant within the printed rounding (0.005 g).
+@pytest.mark.parametrize("name, q_decimals", [
+    ("detumble_case1", 4), ("detumble_case2", 4), ("slew_case1", 5), ("slew_case2", 5),
+    ("slew_case3_x", 4), ("slew_case3_y", 4), ("slew_case3_z", 4)])
+def test_euler_cosimulation_reproduces_thesis(euler_cases, name, q_decimals):
+    r, t = euler_cases[name], thesis.THESIS[name]
+    assert r.converged
+    q_tol = 1e-4 if name == "slew_case3_z" else 0.5 * 10 ** -q_decimals + 1e-12
+    np.testing.assert_allclose(r.q, t["q"], rtol=0, atol=q_tol)
+    np.testing.assert_allclose(r.omega_deg, t["omega"], rtol=0, atol=0.5e-4 + 1e-12)
+    assert abs(r.duration - t["duration"]) <= 0.015 + 1e-9
+    if t["propellant"] is not None:
+        assert r.propellant == pytest.approx(t["propellant"], abs=0.005)
+
+
+def test_euler_durations_and_slew_case3_totals(euler_cases):
+    assert euler_cases["detumble_case1"].steps == 664  # 9.96 s; the thesis prints "about 9.97 s"
+    assert euler_cases["slew_case1"].duration == pytest.approx(24.84, abs=1e-9)
+    assert euler_cases["slew_case2"].duration == pytest.approx(38.25, abs=1e-9)
+    total = euler_cases["slew_case3"]
+    assert total.converged and len(total.parts) == 3
+    assert total.duration == pytest.approx(166.26, abs=1e-9)  # 32.805 + 82.5 + 50.955
+    assert total.propellant == pytest.approx(16.03, abs=0.005)
+
+
+def test_slew_case_files_start_from_the_cosimulated_detumble_end(euler_cases, ssp_paths):
+    """The slew .ssv files carry the full-precision detumble end state (see generate.py)."""
+    import zipfile
+    from xml.etree import ElementTree as ET
+
+    with zipfile.ZipFile(ssp_paths["slew"]) as zf:
+        for case, det in (("slew_case1", "detumble_case1"), ("slew_case2", "detumble_case2"),
+                          ("slew_case3_x", "detumble_case1")):
+            root = ET.fromstring(zf.read(f"parameters/{case}.ssv"))
+            values = {p.get("name"): float(p[0].get("value")) for p in root.iter()
+                      if p.tag.endswith("}Parameter") and p[0].tag.endswith("}Real")}
+            q0 = [values[f"dynamics.q0[{i}]"] for i in range(1, 5)]
+            assert q0 == list(euler_cases[det].q), case
+
+
+def test_rk4_detumble_converges_like_the_thesis(ssp_paths):
+    r = thesis.run_cases(ssp_paths["detumble"].parent, "rk4", cases=["detumble_case1"])["detumble_case1"]
+    assert r.converged and r.steps == 664
+    assert math.sqrt(sum(x * x for x in r.q)) == pytest.approx(1.0, abs=1e-14)
+    # the accurate integrator moves the end attitude by about 1e-3 from the thesis' Euler result
+    np.testing.assert_allclose(r.q, thesis.THESIS["detumble_case1"]["q"], atol=2e-3)
+    assert max(abs(w) for w in r.omega_deg) <= 0.01
+    assert r.propellant == pytest.approx(2.38, abs=0.01)
+
+
+def test_rk4_slew_case1_holds_the_target_but_limit_cycles(ssp_paths):
+    """With the accurate integrator the thesis' slew law reaches the target attitude but its
+    15 ms pulses change omega_x by 0.043 deg/s, more than the +-0.01 deg/s stop window: the
+    rates keep cycling and the Appendix E test never holds (see README)."""
+    r = thesis.run_cases(ssp_paths["detumble"].parent, "rk4", slew_stop_time=60.0, cases=["slew_case1"])
+    s = r["slew_case1"]
+    assert not s.converged and s.duration == pytest.approx(60.0)
+    assert max(abs(x) for x in s.q[:3]) < 1e-3 and s.q[3] == pytest.approx(1.0, abs=1e-6)
+    assert max(abs(w) for w in s.omega_deg) < 0.1
+
+
+def test_jacobi_on_detumble_matches_libcosim(ssp_paths, tmp_path):
+    pytest.importorskip("libcosimpy")
+    names = ["dynamics.omega_BN_B[1]", "dynamics.omega_BN_B[2]", "dynamics.q_BN[4]", "thrusters.torque_B[1]",
+             "detumble.torque_cmd_B[3]", "thrusters.propellant_mass"]
+    n, h = 400, 0.015
+    out = tmp_path / "lc.json"
+    proc = subprocess.run([sys.executable, str(HERE / "master_fixtures" / "libcosim_run.py"),
+                           str(ssp_paths["detumble"]), str(h), str(n), str(out), *names],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    ref = np.array(json.loads(out.read_text()))
+    r = system_ssp.simulate(ssp_paths["detumble"], algorithm="jacobi", stop_time=n * h, stop_when=[])
+    ours = np.column_stack([r.data[k][1:] for k in names])
+    assert ours.shape == ref.shape
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-9)
+    assert abs(ref[-1, 0]) < abs(ref[0, 0])  # a real detumble trajectory, not a resting body
+
+
+def cli(*args):
+    return subprocess.run([sys.executable, "-m", "system_ssp", *args], capture_output=True, text=True,
+                          cwd=ROOT, timeout=120)
+
+
+def test_cli_runs_a_case_and_writes_csv(ssp_paths, tmp_path):
+    out = tmp_path / "det.csv"
+    p = cli("run", str(ssp_paths["detumble"]), "--ssv", "parameters/detumble_case2.ssv", "--output", str(out))
+    assert p.returncode == 0, p.stderr
+    assert "stop condition detumble.done at t=9.96 s" in p.stdout
+    header = out.read_text().splitlines()[0].split(",")
+    assert header[0] == "time" and "dynamics.q_BN[1]" in header
+    data = np.genfromtxt(out, delimiter=",", names=True, deletechars="")
+    assert data["time"][0] == 0.0 and data["time"][-1] == pytest.approx(9.96)
+    assert data["dynamics.q_BN[4]"][-1] == pytest.approx(0.3566, abs=5e-5)  # Eq. 38
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--set", "dynamicz.q0[1]=1"], "dynamicz"),
+    (["--set", "dynamics.q9[1]=1"], "q9[1]"),
+    (["--set", "dynamics.mass=heavy"], "dynamics.mass"),
+    (["--set", "dynamics.omega0[1]=nan"], "dynamics.omega0[1]"),
+    (["--set", "dynamics.q0[4]=0"], "q0"),
+    (["--set", "dynamics.integrator=rk5"], "integrator 'rk5' must be one of euler, rk4"),
+    (["--set", "detumble.Kp[1]=-1"], "Kp"),
+])
+def test_cli_rejects_bad_values_and_leaves_no_results_file(ssp_paths, tmp_path, args, message):
+    out = tmp_path / "r.csv"
+    p = cli("run", str(ssp_paths["detumble"]), "--output", str(out), *args)
+    assert p.returncode != 0
+    assert message in p.stderr, p.stderr
+    assert "Traceback" not in p.stderr
+    assert not out.exists()
+
+
+def test_cli_rejects_bad_system_files(ssp_paths, tmp_path):
+    bad = tmp_path / "bad.ssd"
+    bad.write_text("<ssd:SystemStructureDescription")
+    p = cli("run", str(bad))
+    assert p.returncode != 0 and "bad.ssd" in p.stderr and "line" in p.stderr
+    src = (ROOT / "system_ssp" / "systems" / "detumble.ssd").read_text()
+    invalid = tmp_path / "invalid.ssd"
+    invalid.write_text(src.replace("<ssd:Elements>", "<ssd:Elements><ssd:Bogus/>"))
+    p = cli("run", str(invalid))
+    assert p.returncode != 0 and "invalid.ssd" in p.stderr and "Bogus" in p.stderr
+    # the unpacked SSD without its FMUs next to it
+    p = cli("run", str(ROOT / "system_ssp" / "systems" / "detumble.ssd"))
+    assert p.returncode != 0 and "DetumbleController.fmu" in p.stderr and "'detumble'" in p.stderr
+    assert "build_fmus.py" in p.stderr
