@@ -1,0 +1,128 @@
+"""Benchmark the master on the detumble system and time the slew case 3 chain.
+
+    python bench/bench_master.py [--steps 4000] [--repeat 3]
+
+Prints, for build/ssp/detumble.ssp (Gauss-Seidel, 15 ms, stop condition off so every run
+takes the same number of steps):
+- communication steps per second, recording every connector and recording nothing extra;
+- the floor: the time spent inside the FMUs' own fmi2Set*/fmi2DoStep/fmi2Get* calls through
+  FMPy's ctypes functions, measured in the same run by timing each call;
+- the master's overhead per step: wall time per step of an untimed run minus the floor;
+- the wall time of thesis slew case 3 (three chained 180 deg slews, 11 084 steps).
+Build first: python build_fmus.py
+"""
+import argparse
+import statistics
+import sys
+import time
+from pathlib import Path
+
+ROOT = Path(__file__).resolve().parents[1]
+sys.path.insert(0, str(ROOT))
+
+import system_ssp  # noqa: E402
+from system_ssp import run as run_module  # noqa: E402
+from system_ssp import thesis  # noqa: E402
+
+SSP = ROOT / "build" / "ssp"
+
+
+class CallTimer:
+    """Wraps every FMU call the master prepared so the time inside them adds up."""
+
+    def __init__(self):
+        self.total = 0.0
+        self.calls = 0
+
+    def wrap(self, fn):
+        clock = time.perf_counter
+
+        def timed(*args):
+            t0 = clock()
+            status = fn(*args)
+            self.total += clock() - t0
+            self.calls += 1
+            return status
+
+        return timed
+
+    def install(self):
+        original = run_module.Run._prepare
+        timer = self
+
+        def prepare(run):
+            original(run)
+            w = timer.wrap
+            run.gets = [[(w(t[0]),) + t[1:] for t in lst] for lst in run.gets]
+            run.sets = [[(w(t[0]),) + t[1:] for t in lst] for lst in run.sets]
+            run.recs = [(w(t[0]),) + t[1:] for t in run.recs]
+            run.stop_ops = [(w(t[0]),) + t[1:] for t in run.stop_ops]
+            run.step_fns = [(w(f), c) for f, c in run.step_fns]
+
+        run_module.Run._prepare = prepare
+        return original
+
+
+def clock_cost():
+    """Cost of the two perf_counter calls and the wrapper around one call, to subtract."""
+    timer = CallTimer()
+    f = timer.wrap(lambda *a: 0)
+    n = 200000
+    t0 = time.perf_counter()
+    for _ in range(n):
+        f(1, 2, 3, 4)
+    return (time.perf_counter() - t0) / n, timer.total / n
+
+
+def run_detumble(system, steps, outputs=None):
+    r = system.run(stop_time=steps * 0.015, stop_when=[], outputs=outputs)
+    assert r.steps == steps, r.stop_reason
+    return r
+
+
+def main():
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--steps", type=int, default=4000)
+    ap.add_argument("--repeat", type=int, default=3)
+    args = ap.parse_args()
+    n = args.steps
+    print(f"detumble system, Gauss-Seidel, h = 15 ms, {n} steps per run, best of {args.repeat}")
+    with system_ssp.System(SSP / "detumble.ssp") as system:
+        few = ["dynamics.q_BN[4]"]
+        for label, outputs in (("all connectors recorded", None), ("one signal recorded", few)):
+            walls = []
+            for _ in range(args.repeat):
+                t0 = time.perf_counter()
+                run_detumble(system, n, outputs)
+                walls.append(time.perf_counter() - t0)
+            best = min(walls)
+            print(f"  {label:<26} {n / best:9.0f} steps/s   {best / n * 1e6:7.1f} us/step "
+                  f"(median {statistics.median(walls) / n * 1e6:.1f})")
+        untimed_one = best / n
+
+        wrapper_cost, inside_cost = clock_cost()
+        timer = CallTimer()
+        original = timer.install()
+        try:
+            run_detumble(system, n, few)
+        finally:
+            run_module.Run._prepare = original
+        calls_per_step = timer.calls / n
+        floor = (timer.total - timer.calls * inside_cost) / n
+        print(f"  FMU calls per step        {calls_per_step:9.1f}")
+        print(f"  floor (inside FMU calls)  {floor * 1e6:9.1f} us/step  "
+              f"({floor / calls_per_step * 1e6:.2f} us per call)")
+        print(f"  master overhead           {(untimed_one - floor) * 1e6:9.1f} us/step over the floor "
+              f"(one-signal run; timing wrapper cost {wrapper_cost * 1e9:.0f} ns/call excluded)")
+
+    t0 = time.perf_counter()
+    results = thesis.run_cases(SSP, "euler", cases=["slew_case3"])
+    wall = time.perf_counter() - t0
+    s3 = results["slew_case3"]
+    print(f"slew case 3 (after detumble case 1): {s3.steps} steps, {s3.duration:.3f} s simulated, "
+          f"{s3.propellant:.3f} g; wall {s3.wall_time:.2f} s in the master's runs "
+          f"({wall:.2f} s including loading both systems and the 664-step detumble run)")
+
+
+if __name__ == "__main__":
+    main()
