@@ -272,6 +272,18 @@ def _save_state(state):
 def build_all(clean=False, verbose=True):
     """Build what changed; returns (fmu paths, ssp paths)."""
     state = {} if clean else _load_state()
+
+    def refresh(key, digest, target, make, verb):
+        """`target` if its inputs' digest is unchanged, else the result of `make()`."""
+        if state.get(key) == digest and target.is_file():
+            return target
+        if verbose:
+            print(f"{verb} {target.relative_to(ROOT)}", flush=True)
+        made = make()
+        state[key] = digest
+        _save_state(state)
+        return made
+
     fmu_dir, ssp_dir = BUILD / "fmus", BUILD / "ssp"
     shared = _component_files() + [SUPPORT, Path(__file__).resolve()]
     fmus = []
@@ -281,31 +293,15 @@ def build_all(clean=False, verbose=True):
         if cls.__name__ in names:
             raise BuildError(f"{script.name} and {names[cls.__name__]} both define FMU {cls.__name__}")
         names[cls.__name__] = script.name
-        key = f"fmu:{cls.__name__}"
-        digest = _digest(shared + [script])
         target = fmu_dir / f"{cls.__name__}.fmu"
-        if state.get(key) == digest and target.is_file():
-            fmus.append(target)
-            continue
-        if verbose:
-            print(f"building {target.relative_to(ROOT)}", flush=True)
-        fmus.append(build_fmu(script, fmu_dir))
-        state[key] = digest
-        _save_state(state)
+        fmus.append(refresh(f"fmu:{cls.__name__}", _digest(shared + [script]), target,
+                            lambda script=script: build_fmu(script, fmu_dir), "building"))
     ssps = []
     for ssd in sorted(SYSTEMS.glob("*.ssd")):
         refs, used = _system_files(ssd)
         digest = _digest([ssd] + [ssd.parent / r for r in refs] + [fmu_dir / f for f in used if (fmu_dir / f).is_file()])
-        key = f"ssp:{ssd.stem}"
-        target = ssp_dir / f"{ssd.stem}.ssp"
-        if state.get(key) == digest and target.is_file():
-            ssps.append(target)
-            continue
-        if verbose:
-            print(f"packing {target.relative_to(ROOT)}", flush=True)
-        ssps.append(pack_ssp(ssd, fmu_dir, ssp_dir))
-        state[key] = digest
-        _save_state(state)
+        ssps.append(refresh(f"ssp:{ssd.stem}", digest, ssp_dir / f"{ssd.stem}.ssp",
+                            lambda ssd=ssd: pack_ssp(ssd, fmu_dir, ssp_dir), "packing"))
     return fmus, ssps
 
 

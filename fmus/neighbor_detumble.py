@@ -31,16 +31,9 @@ class DetumbleController(NeighborSlave):
                        bool)
         self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
         self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2", "Angular acceleration of the last step")
-        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
-
-        deps = RATE_INPUTS + ACCEL_INPUTS + ["enabled"]
-        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(self._command)[0], "N.m",
-                          "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
-        self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._command)[1], None,
-                          "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
-                          depends_on=deps)
-        self.output("done", lambda: self.feedthrough(self._done), None,
-                    "Detumble complete: rates within tolerance (Appendix D stop test)", bool, depends_on=RATE_INPUTS)
+        self.thruster_controller_interface(
+            self._command, self._done, RATE_INPUTS + ACCEL_INPUTS, RATE_INPUTS,
+            "Detumble complete: rates within tolerance (Appendix D stop test)")
 
     def build_model(self):
         return detumble.DetumbleController(self.vector("Kp", 3), self.vector("Kd", 3), self.vector("omega_d", 3),
@@ -48,8 +41,6 @@ class DetumbleController(NeighborSlave):
                                            self.values["signed_stop_test"])
 
     def _command(self):
-        if not self.values["enabled"]:
-            return [0.0, 0.0, 0.0], [0, 0, 0]
         return self.model.command(self.vector("omega_BN_B", 3), self.vector("omega_dot_BN_B", 3))
 
     def _done(self):

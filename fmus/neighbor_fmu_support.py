@@ -101,6 +101,26 @@ class NeighborSlave(Fmi2Slave):
             self.output(f"{name}[{i + 1}]", lambda i=i: getter()[i], unit,
                         f"{description} (component {i + 1})", kind, depends_on)
 
+    def thruster_controller_interface(self, command, done, inputs, done_inputs, done_description):
+        """The connectors every RCS attitude controller shares, so that a system swaps one
+        controller for another by replacing a component: an `enabled` input (false: zero
+        command), the quantized `torque_cmd_B[3]`, the pair signals `thrust_flag[3]` and `done`.
+
+        `command()` returns (torque, flags) from the current inputs, `done()` the stop test;
+        `inputs` / `done_inputs` are the input names they read (their output dependencies)."""
+        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
+
+        def gated():
+            return command() if self.values["enabled"] else ([0.0, 0.0, 0.0], [0, 0, 0])
+
+        deps = list(inputs) + ["enabled"]
+        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(gated)[0], "N.m",
+                          "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
+        self.output_array("thrust_flag", 3, lambda: self.feedthrough(gated)[1], None,
+                          "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
+                          depends_on=deps)
+        self.output("done", lambda: self.feedthrough(done), None, done_description, bool, depends_on=done_inputs)
+
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute):
         """Value of `compute()` cached until an input or parameter changes.

@@ -32,17 +32,9 @@ class SlewController(NeighborSlave):
                        bool)
         self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
         self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
-        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
-
-        deps = Q_INPUTS + RATE_INPUTS + ["enabled"]
-        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(self._command)[0], "N.m",
-                          "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
-        self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._command)[1], None,
-                          "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
-                          depends_on=deps)
-        self.output("done", lambda: self.feedthrough(self._done), None,
-                    "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test)", bool,
-                    depends_on=Q_INPUTS + RATE_INPUTS)
+        self.thruster_controller_interface(
+            self._command, self._done, Q_INPUTS + RATE_INPUTS, Q_INPUTS + RATE_INPUTS,
+            "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test)")
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
                     "Rotation angle from the current to the target attitude, 2 acos|dq4|", depends_on=Q_INPUTS)
 
@@ -52,8 +44,6 @@ class SlewController(NeighborSlave):
                                    self.vector("torque_level", 3), self.values["accept_antipodal"])
 
     def _command(self):
-        if not self.values["enabled"]:
-            return [0.0, 0.0, 0.0], [0, 0, 0]
         return self.model.command(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _done(self):
