@@ -458,10 +458,8 @@ class System:
             p = self.comps[lk.src]
             if p.depends_on_inputs(lk.src_var, connected_in[lk.src]):
                 self.feedthrough_outputs[lk.src].add(lk.src_var)
-                if lk.src != lk.dst:
-                    self.edges.setdefault((lk.src, lk.dst), []).append(lk.label)
-                else:
-                    self.edges.setdefault((lk.src, lk.dst), []).append(lk.label)
+                # a self-edge (a component feeding itself through feedthrough) is a loop too
+                self.edges.setdefault((lk.src, lk.dst), []).append(lk.label)
 
     def default_order(self):
         """Components in dependency order (feedthrough edges), ties by SSD order.

@@ -152,3 +152,11 @@ def test_cli_rejects_bad_system_files(ssp_paths, tmp_path):
     p = cli("run", str(ROOT / "system_ssp" / "systems" / "detumble.ssd"))
     assert p.returncode != 0 and "DetumbleController.fmu" in p.stderr and "'detumble'" in p.stderr
     assert "build_fmus.py" in p.stderr
+
+
+def test_default_gauss_seidel_order_follows_the_feedthrough_chain(ssp_paths):
+    """controller -> thrusters -> dynamics comes from the FMUs' declared dependencies alone,
+    the same order the SSD annotation states and the thesis scripts use."""
+    for name, controller in (("detumble", "detumble"), ("slew", "slew")):
+        with system_ssp.System(ssp_paths[name]) as system:
+            assert system.default_order() == [controller, "thrusters", "dynamics"]
