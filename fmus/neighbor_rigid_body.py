@@ -3,7 +3,6 @@
 Wraps components.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
 Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
 """
-import math
 
 from neighbor_fmu_support import NeighborSlave
 

@@ -23,16 +23,15 @@ import numbers
 import os
 from pathlib import Path
 import shutil
-import sys
 import tempfile
 import time
 import zipfile
 
 import numpy as np
 
-from .errors import SimulationError, SSPError
+from .errors import SSPError
 from . import ssd as ssdmod
-from .ssd import FileNamer, ParamValue
+from .ssd import FileNamer
 from .units import BUILTIN, Unit, conversion, describe
 
 ALGORITHMS = ("gauss-seidel", "jacobi")

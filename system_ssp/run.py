@@ -3,7 +3,6 @@
 Built by `System.run`; not meant to be used directly.
 """
 import ctypes
-import math
 import sys
 
 import numpy as np

@@ -1,11 +1,9 @@
 """Each FMU on its own through FMPy: a valid model description, standalone simulation,
 get/set of the full state, and the incremental build."""
 import math
-import shutil
 import zipfile
 
 import fmpy
-import numpy as np
 import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu

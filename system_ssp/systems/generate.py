@@ -20,7 +20,6 @@ Parameter files, one per concern (CONVENTIONS.md):
 """
 import math
 import sys
-import zipfile
 from pathlib import Path
 from xml.sax.saxutils import quoteattr
 

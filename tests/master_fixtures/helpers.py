@@ -1,11 +1,9 @@
 """Helpers for the master's tests: build the fixture FMUs once per session, write SSDs."""
 import json
-import os
 from pathlib import Path
 import shutil
 import subprocess
 import sys
-import tempfile
 import zipfile
 
 HERE = Path(__file__).resolve().parent
