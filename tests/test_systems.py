@@ -160,3 +160,15 @@ def test_default_gauss_seidel_order_follows_the_feedthrough_chain(ssp_paths):
     for name, controller in (("detumble", "detumble"), ("slew", "slew")):
         with system_ssp.System(ssp_paths[name]) as system:
             assert system.default_order() == [controller, "thrusters", "dynamics"]
+
+
+def test_initialization_exchanges_values_in_dependency_order(ssp_paths):
+    """At t = 0 the controller already sees omega0 (10 deg/s per axis) and the thrusters the
+    controller's command, so the first recorded row is consistent across the chain."""
+    r = system_ssp.simulate(ssp_paths["detumble"], stop_time=0.015)
+    row = r.data[0]
+    assert row["time"] == 0.0
+    assert row["detumble.omega_BN_B[2]"] == pytest.approx(math.radians(10.0))
+    assert [row[f"detumble.thrust_flag[{i}]"] for i in (1, 2, 3)] == [-1, -1, -1]
+    assert row["thrusters.torque_B[1]"] == -row["thrusters.torque_level[1]"] < 0
+    assert row["dynamics.torque_B[3]"] == row["thrusters.torque_B[3]"]
