@@ -39,6 +39,7 @@ class NeighborSlave(Fmi2Slave):
         self.fmu_meta = {}
         self._model = None
         self._input_version = 0
+        self._vector_keys = {}
 
     # ---- declarations -------------------------------------------------------------------
     def _register(self, name, kind, causality, variability, unit, description, start=None,
@@ -136,7 +137,12 @@ class NeighborSlave(Fmi2Slave):
         return hit[1]
 
     def vector(self, name, n):
-        return [self.values[f"{name}[{i}]"] for i in range(1, n + 1)]
+        """[values of name[1] .. name[n]] (the element names are built once, not per call)."""
+        keys = self._vector_keys.get((name, n))
+        if keys is None:
+            keys = self._vector_keys[(name, n)] = [f"{name}[{i}]" for i in range(1, n + 1)]
+        values = self.values
+        return [values[k] for k in keys]
 
     @property
     def model(self):
