@@ -309,6 +309,19 @@ def _apply_transform(transform, value, kind, origin, name):
     return mapping.get(value, value)
 
 
+def _referenced_or_inline(el, inline_path, kind, parse, what, origin, namer, base_dir, component_dir, validate):
+    """Parse the file `el` references (source, sourceBase) or its inline element; None if neither."""
+    src = el.get("source")
+    if src:
+        base = component_dir if (el.get("sourceBase") == "component" and component_dir) else base_dir
+        path = resolve_uri(src, base)
+        if not path.is_file():
+            raise SSPError(f"{origin}: {what} {src!r} not found (tried {namer(path)})")
+        return parse(load_xml(path, kind, namer, validate), namer)
+    inline = el.find(inline_path, NS)
+    return None if inline is None else parse(inline, namer)
+
+
 def parse_bindings(el, namer, base_dir, validate, component_dir=None):
     """ssd:ParameterBindings under a component or system -> [ParamValue] (prefixed, mapped)."""
     out = []
@@ -321,32 +334,16 @@ def parse_bindings(el, namer, base_dir, validate, component_dir=None):
         btype = b.get("type", "application/x-ssp-parameter-set")
         if btype != "application/x-ssp-parameter-set":
             raise SSPError(f"{origin}: parameter binding type {btype!r} is not supported")
-        base = component_dir if (b.get("sourceBase") == "component" and component_dir) else base_dir
-        src = b.get("source")
-        if src:
-            path = resolve_uri(src, base)
-            if not path.is_file():
-                raise SSPError(f"{origin}: parameter set {src!r} not found (tried {namer(path)})")
-            values = parse_ssv(load_xml(path, "ssv", namer, validate), namer)
-        else:
-            inline = b.find("ssd:ParameterValues/ssv:ParameterSet", NS)
-            if inline is None:
-                raise SSPError(f"{origin}: parameter binding has neither a source nor inline ssv:ParameterSet")
-            values = parse_ssv(inline, namer)
-        mapping = {}
+        values = _referenced_or_inline(b, "ssd:ParameterValues/ssv:ParameterSet", "ssv", parse_ssv, "parameter set",
+                                       origin, namer, base_dir, component_dir, validate)
+        if values is None:
+            raise SSPError(f"{origin}: parameter binding has neither a source nor inline ssv:ParameterSet")
         m = b.find("ssd:ParameterMapping", NS)
+        mapping = None
         if m is not None:
-            msrc = m.get("source")
-            if msrc:
-                mbase = component_dir if (m.get("sourceBase") == "component" and component_dir) else base_dir
-                mpath = resolve_uri(msrc, mbase)
-                if not mpath.is_file():
-                    raise SSPError(f"{origin}: parameter mapping {msrc!r} not found (tried {namer(mpath)})")
-                mapping = parse_ssm(load_xml(mpath, "ssm", namer, validate), namer)
-            else:
-                inline = m.find("ssm:ParameterMapping", NS)
-                if inline is not None:
-                    mapping = parse_ssm(inline, namer)
+            mapping = _referenced_or_inline(m, "ssm:ParameterMapping", "ssm", parse_ssm, "parameter mapping",
+                                            origin, namer, base_dir, component_dir, validate)
+        mapping = mapping or {}
         prefix = b.get("prefix", "")
         for v in values:
             name = prefix + v.name
