@@ -120,7 +120,7 @@ SYSTEMS = {
         "description": "NEIGHBOR detumble maneuver: PD rate controller, RCS thruster pairs, rigid body",
         "components": [("detumble", "DetumbleController", ["detumble_gains"]),
                        ("thrusters", "RcsThrusters", ["thrusters"]),
-                       ("dynamics", "RigidBody", ["spacecraft"])],
+                       ("dynamics", "RigidBody", ["detumble_initial_state", "spacecraft"])],
         "connections": [("dynamics", "omega_BN_B", "detumble", "omega_BN_B", 3),
                         ("dynamics", "omega_dot_BN_B", "detumble", "omega_dot_BN_B", 3),
                         ("detumble", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
@@ -134,7 +134,7 @@ SYSTEMS = {
         "description": "NEIGHBOR slew maneuver: quaternion PD controller, RCS thruster pairs, rigid body",
         "components": [("slew", "SlewController", ["slew_gains"]),
                        ("thrusters", "RcsThrusters", ["thrusters"]),
-                       ("dynamics", "RigidBody", ["spacecraft"])],
+                       ("dynamics", "RigidBody", ["slew_initial_state", "spacecraft"])],
         "connections": [("dynamics", "q_BN", "slew", "q_BN", 4),
                         ("dynamics", "omega_BN_B", "slew", "omega_BN_B", 3),
                         ("slew", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
@@ -198,7 +198,12 @@ def connector_xml(var):
     return f'        <ssd:Connector name={quoteattr(var.name)} kind="{kind}">{t}</ssd:Connector>'
 
 
-def write_ssd(name, spec):
+def write_ssd(name, spec, directory=HERE):
+    """Write <directory>/<name>.ssd from a spec (see SYSTEMS): components as (instance, FMU
+    model identifier, [parameter files in parameters/, without .ssv]), connections as
+    (source, output, destination, input, n) with n > 0 for structured names out[1]..out[n] or
+    n = 0 for a scalar, optional "stop" Boolean outputs, "order", "stop_time", "step_size".
+    libcosim applies only a component's first ParameterBinding: put the one that matters first."""
     all_units = {}
     comp_vars = {}
     out = ['<?xml version="1.0" encoding="UTF-8"?>',
@@ -216,10 +221,6 @@ def write_ssd(name, spec):
         out.append("        <ssd:Connectors>")
         out += ["  " + connector_xml(v) for v in variables if v.causality in ("input", "output", "parameter")]
         out.append("        </ssd:Connectors>")
-        if inst == "dynamics":
-            # First: libcosim applies only a component's first ParameterBinding; the
-            # spacecraft values it then skips equal the FMU's defaults.
-            concerns = [f"{name}_initial_state"] + concerns
         bindings = [f'<ssd:ParameterBinding source="parameters/{c}.ssv"/>' for c in concerns]
         out.append("        <ssd:ParameterBindings>")
         out += [f"          {b}" for b in bindings]
@@ -228,21 +229,22 @@ def write_ssd(name, spec):
     out.append("    </ssd:Elements>")
     out.append("    <ssd:Connections>")
     for src, sname, dst, dname, n in spec["connections"]:
-        for i in range(1, n + 1):
-            a, b = f"{sname}[{i}]", f"{dname}[{i}]"
+        pairs = [(f"{sname}[{i}]", f"{dname}[{i}]") for i in range(1, n + 1)] if n else [(sname, dname)]
+        for a, b in pairs:
             if comp_vars[src][a].causality != "output" or comp_vars[dst][b].causality != "input":
                 raise SystemExit(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
             out.append(f'      <ssd:Connection startElement="{src}" startConnector="{a}" '
                        f'endElement="{dst}" endConnector="{b}"/>')
     out.append("    </ssd:Connections>")
-    for comp, var in spec["stop"]:
+    dt = spec.get("step_size", DT)
+    for comp, var in spec.get("stop", []):
         if comp_vars[comp][var].type != "Boolean" or comp_vars[comp][var].causality != "output":
             raise SystemExit(f"{name}: stop signal {comp}.{var} must be a Boolean output")
     out += ["    <ssd:Annotations>",
             '      <ssc:Annotation type="org.neighbor-cosim.master">',
-            f'        <nc:Master xmlns:nc="{MASTER_NS}" stepSize="{DT!r}" algorithm="gauss-seidel">',
-            f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>']
-    out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec["stop"]]
+            f'        <nc:Master xmlns:nc="{MASTER_NS}" stepSize="{dt!r}" algorithm="gauss-seidel">',
+            *([f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>'] if spec.get("order") else [])]
+    out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec.get("stop", [])]
     out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
     out.append("  <ssd:Units>")
     for uname in sorted(all_units):
@@ -256,13 +258,13 @@ def write_ssd(name, spec):
             "    <ssd:Annotations>",
             '      <ssc:Annotation type="com.opensimulationplatform">',
             '        <osp:Algorithm>',
-            f'          <osp:FixedStepAlgorithm baseStepSize="{DT!r}"/>',
+            f'          <osp:FixedStepAlgorithm baseStepSize="{dt!r}"/>',
             "        </osp:Algorithm>",
             "      </ssc:Annotation>",
             "    </ssd:Annotations>",
             "  </ssd:DefaultExperiment>"]
     out += ["</ssd:SystemStructureDescription>", ""]
-    (HERE / f"{name}.ssd").write_text("\n".join(out))
+    (directory / f"{name}.ssd").write_text("\n".join(out))
 
 
 def main():
