@@ -5,9 +5,11 @@ stop test of Appendix D). Stateless: every output is a function of the current i
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
-from components import detumble, thruster_control
+use_bundled_components(__file__)
+
+from components import detumble, thruster_control  # noqa: E402 (after use_bundled_components)
 
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
 ACCEL_INPUTS = [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)]

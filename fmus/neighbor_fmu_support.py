@@ -16,10 +16,26 @@ getters, so an output that depends directly on inputs is recomputed from the inp
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
 """
 import copy
+import os
+import sys
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
+
+
+def use_bundled_components(wrapper_file):
+    """Let `import components.<x>` in a wrapper find this FMU's own bundled copy.
+
+    Every FMU bundles `components/` in its resources, and in one process the first FMU loaded
+    provides the `components` package for all. Its extracted folder may be gone by the time a
+    later FMU imports a submodule nobody imported yet (fmpy.simulate_fmu removes its folder),
+    so each wrapper puts its own folder first on the package's search path; missing folders
+    are skipped. Call it before importing from `components`; a no-op in the source tree."""
+    bundled = os.path.join(os.path.dirname(os.path.abspath(wrapper_file)), "components")
+    package = sys.modules.get("components")
+    if package is not None and os.path.isdir(bundled) and bundled not in package.__path__:
+        package.__path__.insert(0, bundled)
 
 
 class ParameterError(ValueError):

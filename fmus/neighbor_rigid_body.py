@@ -4,9 +4,11 @@ Wraps components.rigid_body.RigidBody: Euler's equation and quaternion kinematic
 Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
 """
 
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
-from components import rigid_body
+use_bundled_components(__file__)
+
+from components import rigid_body  # noqa: E402 (after use_bundled_components)
 
 
 class RigidBody(NeighborSlave):

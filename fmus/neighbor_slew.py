@@ -5,9 +5,11 @@ Appendix E, or of Appendix G with accept_antipodal). Stateless.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
-from components import attitude, slew, thruster_control
+use_bundled_components(__file__)
+
+from components import attitude, slew, thruster_control  # noqa: E402 (after use_bundled_components)
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]

@@ -4,9 +4,11 @@ Wraps components.thrusters.ThrusterPairs (thesis Eq. 13-16 and 74): commanded to
 applied torque and thrust flags out (direct feedthrough), firing time and propellant mass
 accumulated over the steps (states).
 """
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
-from components import thrusters
+use_bundled_components(__file__)
+
+from components import thrusters  # noqa: E402 (after use_bundled_components)
 
 CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
 

@@ -135,3 +135,21 @@ def test_build_is_incremental(tmp_path, monkeypatch, capsys):
     capsys.readouterr()
     build_fmus.build_all(verbose=True)
     assert "building" not in capsys.readouterr().out
+
+
+def test_fmus_load_their_bundled_components_after_another_fmu_is_gone(fmu_paths, tmp_path):
+    """In a fresh process, fmpy.simulate_fmu runs one FMU and deletes its extracted folder;
+    a second FMU that needs a `components` module nobody imported yet must still load it
+    (from its own bundled copy)."""
+    import subprocess
+    import sys
+
+    script = (
+        "import fmpy, sys\n"
+        "fmpy.simulate_fmu(sys.argv[1], stop_time=1.0)\n"
+        "r = fmpy.simulate_fmu(sys.argv[2], stop_time=1.0, start_values={'torque_cmd_B[1]': 0.0025})\n"
+        "print(r['fire_time[1]'][-1])\n")
+    p = subprocess.run([sys.executable, "-c", script, str(fmu_paths["SunEphemeris"]), str(fmu_paths["RcsThrusters"])],
+                       capture_output=True, text=True, cwd=tmp_path, timeout=120)
+    assert p.returncode == 0, p.stderr[-2000:]
+    assert float(p.stdout.strip().splitlines()[-1]) == pytest.approx(1.0)

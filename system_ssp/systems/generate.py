@@ -222,9 +222,10 @@ def write_ssd(name, spec, directory=HERE):
         out += ["  " + connector_xml(v) for v in variables if v.causality in ("input", "output", "parameter")]
         out.append("        </ssd:Connectors>")
         bindings = [f'<ssd:ParameterBinding source="parameters/{c}.ssv"/>' for c in concerns]
-        out.append("        <ssd:ParameterBindings>")
-        out += [f"          {b}" for b in bindings]
-        out.append("        </ssd:ParameterBindings>")
+        if bindings:  # the schema refuses an empty ParameterBindings element
+            out.append("        <ssd:ParameterBindings>")
+            out += [f"          {b}" for b in bindings]
+            out.append("        </ssd:ParameterBindings>")
         out.append("      </ssd:Component>")
     out.append("    </ssd:Elements>")
     out.append("    <ssd:Connections>")
