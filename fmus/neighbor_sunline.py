@@ -1,0 +1,47 @@
+"""FMU `SunlineEphemeris` (instance `sunline`): Sun heading in B from ephemeris (seed 004).
+
+Wraps components.sunline.SunlineEphemeris: d_N = (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N|,
+d_B = [BN(sigma_BN)] d_N, or A(q_BN) d_N with attitude_input = "quaternion". Stateless; both
+outputs are direct feedthrough of the inputs.
+"""
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import sunline  # noqa: E402 (after use_bundled_components)
+
+R_SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
+R_SC = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
+SIGMA = [f"sigma_BN[{i}]" for i in (1, 2, 3)]
+Q = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
+AU = 149597870700.0  # m (IAU 2012)
+
+
+class SunlineEphemeris(NeighborSlave):
+    description = ("Sunline from ephemeris: unit Sun heading in the body frame from the Sun and spacecraft "
+                   "positions and the attitude (MRP sigma_BN or quaternion q_BN), d_B = [BN] (r_sun - r_sc)/|...|")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("attitude_input", "mrp", None,
+                       "Attitude input used: 'mrp' (sigma_BN, the default) or 'quaternion' (q_BN)", str)
+        self.input_array("r_SN_N", [AU, 0.0, 0.0], "m", "Sun position in N")
+        self.input_array("r_BN_N", [0.0, 0.0, 0.0], "m", "Spacecraft position in N")
+        self.input_array("sigma_BN", [0.0, 0.0, 0.0], "1",
+                         "Attitude MRP sigma_BN (Schaub and Junkins), used when attitude_input = 'mrp'")
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         "Attitude quaternion q_BN, scalar last, used when attitude_input = 'quaternion'")
+        self.output_array("sun_heading_B", 3, lambda: self.feedthrough(self._heading)[0], "1",
+                          "Unit vector from the spacecraft to the Sun in B", depends_on=R_SUN + R_SC + SIGMA + Q)
+        self.output("sun_distance", lambda: self.feedthrough(self._heading)[1], "m",
+                    "Distance from the spacecraft to the Sun, |r_SN_N - r_BN_N|", depends_on=R_SUN + R_SC)
+
+    def build_model(self):
+        return sunline.SunlineEphemeris(self.values["attitude_input"])
+
+    def _heading(self):
+        v = self.vector
+        return self.model.heading(v("r_SN_N", 3), v("r_BN_N", 3), v("sigma_BN", 3), v("q_BN", 4))
+
+    def do_step(self, current_time, step_size):
+        return True

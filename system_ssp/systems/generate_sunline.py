@@ -1,0 +1,71 @@
+"""Write the sunline system (seed 004): a spinning rigid body feeding its attitude quaternion to
+the sunline-ephemeris FMU, with fixed Sun and spacecraft positions.
+
+    python -c "import build_fmus; from pathlib import Path; [build_fmus.build_fmu(Path(s), Path('build/fmus'))
+               for s in ('fmus/neighbor_rigid_body.py', 'fmus/neighbor_sunline.py')]"
+    python system_ssp/systems/generate_sunline.py
+
+Parameter files (system_ssp/systems/parameters/):
+- sunline_ephemeris.ssv       for `sunline`: attitude_input = "quaternion" and the fixed Sun and
+  spacecraft positions, given as start values of the unconnected position inputs;
+- sunline_initial_state.ssv   for `dynamics`: rk4, initial attitude (1-2-3 Euler angles
+  0.3, -0.2, 0.5 rad) and a spin of 0.1 rad/s about the body z axis (a principal axis, so the
+  torque-free rate stays constant and the heading in B turns at -0.1 rad/s about z);
+- sunline_spin_x.ssv          scenario (names `component.variable`): spin of 0.05 rad/s about
+  the body x axis instead.
+`dynamics` also binds the shared spacecraft.ssv (host mass and box edges).
+"""
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+
+from generate import ROOT, vec, write_ssd, write_ssv  # noqa: E402
+
+sys.path.insert(0, str(ROOT))
+from components import attitude  # noqa: E402
+
+AU = 149597870700.0  # m
+# Sun about 1 au away, off every axis; spacecraft in a low Earth orbit position.
+R_SUN_N = [0.8 * AU, -0.55 * AU, 0.24 * AU]
+R_SC_N = [4.2e6, 5.1e6, 1.9e6]
+Q0 = list(attitude.from_euler123(0.3, -0.2, 0.5))
+SPIN_Z = 0.1  # rad/s
+SPIN_X = 0.05  # rad/s
+
+EPHEMERIS = {"attitude_input": "quaternion", **vec("r_SN_N", R_SUN_N), **vec("r_BN_N", R_SC_N)}
+INITIAL_STATE = {"integrator": "rk4", **vec("q0", Q0), **vec("omega0", [0.0, 0.0, SPIN_Z])}
+SCENARIOS = {
+    "sunline_spin_x": ("Spin of 0.05 rad/s about the body x axis (principal) from the same attitude",
+                       {**vec("dynamics.omega0", [SPIN_X, 0.0, 0.0])}),
+}
+
+SYSTEM = {
+    "description": "Sunline from ephemeris: a spinning rigid body's attitude quaternion feeds the Sun heading in B",
+    "components": [("dynamics", "RigidBody", ["sunline_initial_state", "spacecraft"]),
+                   ("sunline", "SunlineEphemeris", ["sunline_ephemeris"])],
+    "connections": [("dynamics", "q_BN", "sunline", "q_BN", 4)],
+    "order": ["dynamics", "sunline"],
+    "stop_time": 20.0,
+    "step_size": 0.1,
+}
+
+
+def main(directory=HERE):
+    """Write sunline.ssd and its parameter files into `directory` (default: this folder)."""
+    params = directory / "parameters"
+    params.mkdir(exist_ok=True)
+    write_ssv(params / "sunline_ephemeris.ssv", "sunline_ephemeris",
+              "Sunline FMU: quaternion attitude input, fixed Sun and spacecraft positions in N (m)", EPHEMERIS)
+    write_ssv(params / "sunline_initial_state.ssv", "sunline_initial_state",
+              "Rigid body of the sunline system: rk4, initial attitude (1-2-3 Euler 0.3, -0.2, 0.5 rad), "
+              "spin 0.1 rad/s about body z", INITIAL_STATE)
+    for name, (description, values) in SCENARIOS.items():
+        write_ssv(params / f"{name}.ssv", name, description, values)
+    write_ssd("sunline", SYSTEM, directory)
+    print(f"wrote sunline.ssd and {2 + len(SCENARIOS)} parameter sets in {directory}")
+
+
+if __name__ == "__main__":
+    main()
