@@ -1,0 +1,45 @@
+"""FMU `CircularOrbit` (instance `orbit`): analytic circular two-body orbit.
+
+Wraps components.circular_orbit.CircularOrbit. No inputs; outputs are functions of time. The
+model keeps the simulation time: the start time at initialization, t + h after do_step(t, h).
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import circular_orbit  # noqa: E402 (after use_bundled_components)
+
+
+class CircularOrbit(NeighborSlave):
+    description = ("Circular two-body orbit (analytic): spacecraft position and velocity in N from altitude, "
+                   "inclination, RAAN and argument of latitude at the epoch")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self._start_time = 0.0
+        self.parameter("altitude", 420e3, "m", "Altitude above earth_radius (> 0)")
+        self.parameter("inclination", math.radians(51.6), "rad", "Orbit inclination, in [0, pi]")
+        self.parameter("raan", 0.0, "rad", "Right ascension of the ascending node")
+        self.parameter("arg_latitude0", 0.0, "rad", "Argument of latitude at simulation time 0 (from the node)")
+        self.parameter("mu", circular_orbit.MU_EARTH, "m3/s2", "Earth's gravitational parameter (> 0)")
+        self.parameter("earth_radius", circular_orbit.EARTH_RADIUS, "m", "Earth radius the altitude refers to (> 0)")
+        self.output_array("r_BN_N", 3, lambda: self.model.position(), "m",
+                          "Spacecraft position relative to Earth's centre in N")
+        self.output_array("v_BN_N", 3, lambda: self.model.velocity(), "m/s",
+                          "Spacecraft velocity relative to N, in N")
+        self.output("period", lambda: self.model.period, "s", "Orbit period 2 pi sqrt(a^3 / mu)")
+
+    def build_model(self):
+        v = self.values
+        return circular_orbit.CircularOrbit(v["altitude"], v["inclination"], v["raan"], v["arg_latitude0"],
+                                            v["mu"], v["earth_radius"], self._start_time)
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self._start_time = float(start_time)
+        self._model = None
+
+    def do_step(self, current_time, step_size):
+        self.model.advance_to(current_time + step_size)
+        return True

@@ -1,0 +1,80 @@
+"""Write the sun_eclipse system (.ssd) and its parameter files (.ssv).
+
+    python -c "import build_fmus, pathlib; [build_fmus.build_fmu(pathlib.Path(f'fmus/neighbor_{n}.py'), \
+pathlib.Path('build/fmus')) for n in ('circular_orbit', 'sun_ephemeris', 'earth_shadow')]"
+    python system_ssp/systems/generate_sun_eclipse.py
+
+System: a circular orbit (`orbit`), the Sun ephemeris (`sun`) and the conical Earth shadow
+(`shadow`), wired by name (r_BN_N, r_SN_N). Parameter files:
+- sun_eclipse_orbit.ssv    the default orbit: 420 km, 51.6 deg (ISS-like), RAAN 0, u0 0;
+- sun_eclipse_epoch.ssv    the scenario epoch (the thesis' start date, 2023-01-01T00:00:00Z);
+- sun_eclipse_shadow.ssv   Earth and Sun radii and the orbit-day threshold;
+- sun_eclipse_dawn_dusk.ssv  scenario (`component.variable` names): a 700 km Sun-synchronous
+  dawn-dusk orbit whose node is 90 deg east of the Sun at the epoch, beta about 75 deg, above
+  the 64 deg critical angle, so it never enters the shadow.
+Stop time: two orbits of the default orbit; communication step 10 s.
+"""
+import math
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parents[1]))
+
+from generate import write_ssd, write_ssv  # noqa: E402
+
+from components import circular_orbit, eclipse, sun, time_utils  # noqa: E402
+
+EPOCH = time_utils.DEFAULT_EPOCH
+ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0,
+         "mu": circular_orbit.MU_EARTH, "earth_radius": circular_orbit.EARTH_RADIUS}
+SHADOW = {"earth_radius": eclipse.EARTH_RADIUS, "sun_radius": eclipse.SUN_RADIUS,
+          "day_threshold": eclipse.DAY_THRESHOLD}
+PERIOD = circular_orbit.CircularOrbit(ORBIT["altitude"]).period  # 5576.5 s
+STEP = 10.0
+
+
+def dawn_dusk():
+    """700 km Sun-synchronous orbit (i = 98.19 deg from the J2 nodal rate) with its ascending
+    node 90 deg east of the Sun's right ascension at the epoch: the orbit plane faces the Sun."""
+    ra, _ = sun.right_ascension_declination(sun.SunEphemeris(EPOCH).position())
+    a = circular_orbit.EARTH_RADIUS + 700e3
+    j2 = 1.08262668e-3
+    rate = 2.0 * math.pi / (365.2422 * 86400.0)  # required nodal rate (rad/s)
+    cos_i = -rate / (1.5 * j2 * (circular_orbit.EARTH_RADIUS / a) ** 2 * math.sqrt(circular_orbit.MU_EARTH / a ** 3))
+    return {"orbit.altitude": 700e3, "orbit.inclination": math.acos(cos_i),
+            "orbit.raan": (ra + math.pi / 2) % (2 * math.pi), "orbit.arg_latitude0": 0.0}
+
+
+SYSTEM = {
+    "description": "Circular orbit, Sun ephemeris and conical Earth shadow: sunlit fraction, umbra, penumbra, "
+                   "orbit day",
+    "components": [("orbit", "CircularOrbit", ["sun_eclipse_orbit"]),
+                   ("sun", "SunEphemeris", ["sun_eclipse_epoch"]),
+                   ("shadow", "EarthShadow", ["sun_eclipse_shadow"])],
+    "connections": [("orbit", "r_BN_N", "shadow", "r_BN_N", 3),
+                    ("sun", "r_SN_N", "shadow", "r_SN_N", 3)],
+    "order": ["orbit", "sun", "shadow"],
+    "stop_time": math.ceil(2 * PERIOD / STEP) * STEP,  # two orbits: 11160 s
+    "step_size": STEP,
+}
+
+
+def main():
+    params = HERE / "parameters"
+    write_ssv(params / "sun_eclipse_orbit.ssv", "sun_eclipse_orbit",
+              "Circular orbit of the sun_eclipse system: 420 km, 51.6 deg, RAAN 0, u0 0 (SI units)", ORBIT)
+    write_ssv(params / "sun_eclipse_epoch.ssv", "sun_eclipse_epoch",
+              "Scenario epoch (simulation time 0), ISO 8601 UTC: the thesis' start date", {"epoch": EPOCH})
+    write_ssv(params / "sun_eclipse_shadow.ssv", "sun_eclipse_shadow",
+              "Earth and Sun radii (m) and the orbit-day threshold of the conical shadow", SHADOW)
+    write_ssv(params / "sun_eclipse_dawn_dusk.ssv", "sun_eclipse_dawn_dusk",
+              "Scenario: 700 km Sun-synchronous dawn-dusk orbit facing the Sun at the epoch (no eclipse)",
+              dawn_dusk())
+    write_ssd("sun_eclipse", SYSTEM)
+    print(f"wrote sun_eclipse.ssd and 4 parameter sets in {HERE}")
+
+
+if __name__ == "__main__":
+    main()
