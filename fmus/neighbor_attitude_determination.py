@@ -1,0 +1,72 @@
+"""FMU `AttitudeDetermination` (instance `ad`): TRIAD fixes from nadir and Sun vectors, gyro
+propagation between fixes.
+
+Wraps components.triad.AttitudeDetermination (thesis 3.3.1). At each communication point the
+estimate is the TRIAD fix of the current inputs when both vectors are valid (direct
+feedthrough), otherwise the estimate propagated with the measured rate over the last step
+(state). do_step propagates the estimate at the start of the step (fix or not) with the rate
+input held over the step.
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import triad  # noqa: E402 (after use_bundled_components)
+
+VECTORS = ([f"nadir_B[{i}]" for i in (1, 2, 3)] + ["nadir_valid"] + [f"sun_B[{i}]" for i in (1, 2, 3)]
+           + ["sun_valid"] + [f"r_BN_N[{i}]" for i in (1, 2, 3)] + [f"r_SN_N[{i}]" for i in (1, 2, 3)])
+RATE = [f"omega_meas_B[{i}]" for i in (1, 2, 3)]
+
+
+class AttitudeDetermination(NeighborSlave):
+    description = ("Attitude determination: TRIAD from the nadir (horizon sensor) and Sun vectors when both are "
+                   "valid, otherwise the estimate propagated with the gyro rate (NEIGHBOR thesis 3.3.1)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("nadir_sigma", math.radians(0.25), "rad",
+                       "Horizon sensor error RMS, >= 0; the vector with the smaller sigma goes first in TRIAD "
+                       "(nadir on a tie)")
+        self.parameter("sun_sigma", math.radians(0.5) / 3.0, "rad", "Sun sensor error RMS, >= 0")
+        self.parameter("min_separation", math.radians(5.0), "rad",
+                       "Smallest angle between nadir and Sun for a TRIAD fix, [0, pi/2)")
+        self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
+                             "Initial estimate q_BN (used until the first fix; normalized, non-zero)")
+        self.input_array("nadir_B", [0.0, 0.0, 0.0], "1", "Measured nadir unit vector in B")
+        self.input("nadir_valid", False, None, "Nadir measurement valid", bool)
+        self.input_array("sun_B", [0.0, 0.0, 0.0], "1", "Measured Sun unit vector in B")
+        self.input("sun_valid", False, None, "Sun measurement valid", bool)
+        self.input_array("omega_meas_B", [0.0, 0.0, 0.0], "rad/s", "Measured angular velocity in B (gyro)")
+        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N (e.g. GPS)")
+        self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N (ephemeris)")
+        self.output_array("q_est_BN", 4, lambda: self.feedthrough(self._estimate)[0], "1",
+                          "Estimated attitude quaternion q_BN, scalar last", depends_on=VECTORS)
+        self.output_array("omega_est_B", 3, lambda: self.feedthrough(self._rate), "rad/s",
+                          "Estimated angular velocity in B (the gyro measurement; no bias estimation)",
+                          depends_on=RATE)
+        self.output("fix", lambda: self.feedthrough(self._estimate)[1], None,
+                    "The estimate at this communication point is a TRIAD fix", bool, depends_on=VECTORS)
+        self.output("time_since_fix", lambda: self.feedthrough(self._estimate)[2], "s",
+                    "Time since the last TRIAD fix (since the start before the first fix)", depends_on=VECTORS)
+
+    def build_model(self):
+        return triad.AttitudeDetermination(self.values["nadir_sigma"], self.values["sun_sigma"],
+                                           self.vector("q0", 4), self.values["min_separation"])
+
+    def _measurements(self):
+        v = self.values
+        return (self.vector("nadir_B", 3), v["nadir_valid"], self.vector("sun_B", 3), v["sun_valid"],
+                self.vector("r_BN_N", 3), self.vector("r_SN_N", 3))
+
+    def _estimate(self):
+        return self.model.estimate(*self._measurements())
+
+    def _rate(self):
+        return self.vector("omega_meas_B", 3)
+
+    def do_step(self, current_time, step_size):
+        self.model.step(self._measurements(), self.vector("omega_meas_B", 3), step_size)
+        self._input_version += 1  # the propagated state changed: recompute the outputs
+        return True

@@ -1,0 +1,39 @@
+"""FMU `Gyro` (instance `gyro`): 3-axis rate gyro with bias and seeded white noise.
+
+Wraps components.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
+communication step, drawn in do_step; the output depends directly on the true rate.
+"""
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import sensors  # noqa: E402 (after use_bundled_components)
+
+RATE = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+
+
+class Gyro(NeighborSlave):
+    description = ("3-axis rate gyro: omega_meas = omega_BN_B + bias + N(0, sigma^2) white noise per "
+                   "communication step (NEIGHBOR thesis 3.3.1)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter_array("bias", [0.0, 0.0, 0.0], "rad/s", "Constant rate bias")
+        self.parameter("sigma", 5.5e-4, "rad/s",
+                       "White-noise standard deviation per sample per axis, >= 0 (BMG160 0.014 deg/s/sqrt(Hz) "
+                       "over a 5 Hz bandwidth, i.e. 10 Hz sampling)")
+        self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
+        self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "True angular velocity of B relative to N, in B")
+        self.output_array("omega_meas_B", 3, lambda: self.feedthrough(self._measure), "rad/s",
+                          "Measured angular velocity in B", depends_on=RATE)
+
+    def build_model(self):
+        return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"])
+
+    def _measure(self):
+        return self.model.measure(self.vector("omega_BN_B", 3))
+
+    def do_step(self, current_time, step_size):
+        self.model.step(step_size)
+        self._input_version += 1  # new noise sample: recompute the outputs
+        return True

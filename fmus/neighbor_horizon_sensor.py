@@ -1,0 +1,46 @@
+"""FMU `HorizonSensor` (instance `horizon`): nadir vector in B with seeded noise.
+
+Wraps components.sensors.HorizonSensor (thesis 3.3.1). The noise sample is drawn once per
+communication step in do_step; outputs are the current inputs' nadir direction perturbed by
+the current sample (direct feedthrough of r_BN_N and q_BN). The generator state is part of
+the FMU state.
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import sensors  # noqa: E402 (after use_bundled_components)
+
+POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
+QUAT = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
+
+
+class HorizonSensor(NeighborSlave):
+    description = ("Horizon sensor: unit nadir vector in the body frame, perturbed by a random rotation of "
+                   "angle ~ N(0, sigma) about a random perpendicular axis (NEIGHBOR thesis 3.3.1)")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("sigma", math.radians(0.25), "rad",
+                       "RMS error angle of the nadir vector (>= 0; 0.25 deg default, CubeSat IR horizon sensor class)")
+        self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
+        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N")
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
+        self.output_array("nadir_B", 3, lambda: self.feedthrough(self._measure)[0], "1",
+                          "Measured unit vector toward Earth's centre in B (zeros when invalid)",
+                          depends_on=POS + QUAT)
+        self.output("valid", lambda: self.feedthrough(self._measure)[1], None,
+                    "Nadir measurement valid (false only for a zero position)", bool, depends_on=POS)
+
+    def build_model(self):
+        return sensors.HorizonSensor(self.values["sigma"], self.values["seed"])
+
+    def _measure(self):
+        return self.model.measure(self.vector("r_BN_N", 3), self.vector("q_BN", 4))
+
+    def do_step(self, current_time, step_size):
+        self.model.step(step_size)
+        self._input_version += 1  # new noise sample: recompute the outputs
+        return True
