@@ -23,6 +23,9 @@ class _Failed(Exception):
         self.ci, self.call, self.status = ci, call, status
 
 
+_CALLBACKS_KEPT = []
+
+
 class _Instance:
     """One FMU instance plus the logger that collects its messages."""
 
@@ -66,6 +69,10 @@ class _Instance:
         except Exception:
             pass
         self.callbacks = cb
+        # pythonfmu keeps the logger of the instance created last and may call it after that
+        # instance is gone (messages of other instances, teardown at exit): the callbacks
+        # must outlive every instance, so they are kept for the life of the process.
+        _CALLBACKS_KEPT.append((self._logger, cb))
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=info.unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=info.name)
         self.fn = self.fmu._functions

@@ -1,4 +1,5 @@
 """Shared fixtures: the product's FMUs and SSPs, built (incrementally) once per session."""
+import os
 import sys
 from pathlib import Path
 
@@ -26,3 +27,23 @@ def fmu_paths(built):
 @pytest.fixture(scope="session")
 def ssp_paths(built):
     return built[1]
+
+
+_exit_status = {}
+
+
+def pytest_sessionfinish(session, exitstatus):
+    _exit_status["status"] = int(exitstatus)
+
+
+def pytest_unconfigure(config):
+    """Leave without the interpreter's teardown once pytest has reported.
+
+    pythonfmu's native side can call a logger callback that Python already freed while the
+    interpreter shuts down (seen here as an intermittent "corrupted double-linked list" abort
+    after all tests passed, from FMU instances fmpy.simulate_fmu created and dropped). Every
+    result is reported by now, so skip that teardown and keep pytest's own exit status."""
+    if "status" in _exit_status:
+        sys.stdout.flush()
+        sys.stderr.flush()
+        os._exit(_exit_status["status"])
