@@ -123,26 +123,7 @@ def quaternion_from_dcm(c):
 
     For a C that is only nearly orthonormal the result is normalized, i.e. the quaternion of
     a nearby rotation."""
-    tr = c[0][0] + c[1][1] + c[2][2]
-    big = max(tr, c[0][0], c[1][1], c[2][2])
-    if big == tr:
-        q4 = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
-        f = 0.25 / q4
-        q = ((c[1][2] - c[2][1]) * f, (c[2][0] - c[0][2]) * f, (c[0][1] - c[1][0]) * f, q4)
-    elif big == c[0][0]:
-        q1 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * c[0][0] - tr))
-        f = 0.25 / q1
-        q = (q1, (c[0][1] + c[1][0]) * f, (c[0][2] + c[2][0]) * f, (c[1][2] - c[2][1]) * f)
-    elif big == c[1][1]:
-        q2 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * c[1][1] - tr))
-        f = 0.25 / q2
-        q = ((c[0][1] + c[1][0]) * f, q2, (c[1][2] + c[2][1]) * f, (c[2][0] - c[0][2]) * f)
-    else:
-        q3 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * c[2][2] - tr))
-        f = 0.25 / q3
-        q = ((c[0][2] + c[2][0]) * f, (c[1][2] + c[2][1]) * f, q3, (c[0][1] - c[1][0]) * f)
-    q = attitude.normalized(q, "quaternion of dcm_BN")
-    return q if q[3] >= 0.0 else tuple(-x for x in q)
+    return attitude.dcm_to_quaternion(c)
 
 
 def euler321_from_quaternion(q):

@@ -96,6 +96,35 @@ def attitude_matrix(q):
             (2 * (q1 * q3 + q2 * q4), 2 * (q2 * q3 - q1 * q4), -q1 * q1 - q2 * q2 + q3 * q3 + q4 * q4))
 
 
+def dcm_to_quaternion(C):
+    """Unit q (scalar last, q4 >= 0) with attitude_matrix(q) == C, by Shepperd's method: the
+    largest of 4 q4^2 - 1 = tr C and 4 qi^2 - 1 = 2 C_ii - tr C comes from the diagonal, the
+    other elements from off-diagonal sums and differences. C is not checked for
+    orthonormality (callers that take a DCM from outside check it); the result is
+    normalized, so a nearly orthonormal C gives the quaternion of a nearby rotation."""
+    tr = C[0][0] + C[1][1] + C[2][2]
+    cands = (tr, C[0][0], C[1][1], C[2][2])
+    k = max(range(4), key=lambda i: cands[i])
+    if k == 0:
+        q4 = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
+        f = 0.25 / q4
+        q = ((C[1][2] - C[2][1]) * f, (C[2][0] - C[0][2]) * f, (C[0][1] - C[1][0]) * f, q4)
+    elif k == 1:
+        q1 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[0][0] - tr))
+        f = 0.25 / q1
+        q = (q1, (C[0][1] + C[1][0]) * f, (C[0][2] + C[2][0]) * f, (C[1][2] - C[2][1]) * f)
+    elif k == 2:
+        q2 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[1][1] - tr))
+        f = 0.25 / q2
+        q = ((C[0][1] + C[1][0]) * f, q2, (C[1][2] + C[2][1]) * f, (C[2][0] - C[0][2]) * f)
+    else:
+        q3 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[2][2] - tr))
+        f = 0.25 / q3
+        q = ((C[0][2] + C[2][0]) * f, (C[1][2] + C[2][1]) * f, q3, (C[0][1] - C[1][0]) * f)
+    q = normalized(q, "quaternion of the attitude matrix")
+    return q if q[3] >= 0.0 else tuple(-x for x in q)
+
+
 def euler123(q):
     """1-2-3 Euler angles (phi, theta, psi) in rad from q (Eq. 25-29, Appendix C q_to_Euler).
 

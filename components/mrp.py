@@ -125,29 +125,7 @@ def dcm_to_quaternion(C, tol=1e-6):
     det = attitude.dot(C[0], attitude.cross(C[1], C[2]))
     if abs(det - 1.0) > tol:
         raise ValueError(f"DCM {C} has determinant {det!r}; a rotation needs +1 (to {tol:g})")
-    tr = C[0][0] + C[1][1] + C[2][2]
-    # A(q) = (q4^2 - |qv|^2) I + 2 qv qv^T - 2 q4 [qv~]: C12 - C21 = 4 q3 q4 etc.
-    cands = (tr, C[0][0], C[1][1], C[2][2])
-    k = max(range(4), key=lambda i: cands[i])
-    if k == 0:
-        q4 = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
-        f = 0.25 / q4
-        q = ((C[1][2] - C[2][1]) * f, (C[2][0] - C[0][2]) * f, (C[0][1] - C[1][0]) * f, q4)
-    elif k == 1:
-        q1 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[0][0] - tr))
-        f = 0.25 / q1
-        q = (q1, (C[0][1] + C[1][0]) * f, (C[0][2] + C[2][0]) * f, (C[1][2] - C[2][1]) * f)
-    elif k == 2:
-        q2 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[1][1] - tr))
-        f = 0.25 / q2
-        q = ((C[0][1] + C[1][0]) * f, q2, (C[1][2] + C[2][1]) * f, (C[2][0] - C[0][2]) * f)
-    else:
-        q3 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * C[2][2] - tr))
-        f = 0.25 / q3
-        q = ((C[0][2] + C[2][0]) * f, (C[1][2] + C[2][1]) * f, q3, (C[0][1] - C[1][0]) * f)
-    if q[3] < 0.0:
-        q = tuple(-x for x in q)
-    return attitude.normalized(q)
+    return attitude.dcm_to_quaternion(C)
 
 
 def from_dcm(C, tol=1e-6):

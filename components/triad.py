@@ -55,33 +55,12 @@ def triad(b1, b2, r1, r2, min_sin=1e-9):
 
 
 def dcm_to_quaternion(A):
-    """Quaternion q (scalar last, q4 >= 0) with attitude.attitude_matrix(q) == A, by
-    Shepperd's method: the largest of 4 q4^2 - 1 = tr A and 4 qi^2 - 1 = 2 A_ii - tr A is
-    computed from the diagonal, the others from off-diagonal sums and differences."""
+    """Quaternion q (scalar last, q4 >= 0) with attitude.attitude_matrix(q) == A (Shepperd's
+    method, components.attitude.dcm_to_quaternion), after checking A is 3x3 and finite."""
     A = [[float(x) for x in row] for row in A]
     if len(A) != 3 or any(len(row) != 3 for row in A) or not all(math.isfinite(x) for row in A for x in row):
         raise ValueError("attitude matrix must be 3x3 with finite entries")
-    tr = A[0][0] + A[1][1] + A[2][2]
-    cand = (A[0][0], A[1][1], A[2][2], tr)
-    k = cand.index(max(cand))
-    if k == 3:
-        q4 = 0.5 * math.sqrt(max(0.0, 1.0 + tr))
-        f = 0.25 / q4
-        q = ((A[1][2] - A[2][1]) * f, (A[2][0] - A[0][2]) * f, (A[0][1] - A[1][0]) * f, q4)
-    elif k == 0:
-        q1 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * A[0][0] - tr))
-        f = 0.25 / q1
-        q = (q1, (A[0][1] + A[1][0]) * f, (A[0][2] + A[2][0]) * f, (A[1][2] - A[2][1]) * f)
-    elif k == 1:
-        q2 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * A[1][1] - tr))
-        f = 0.25 / q2
-        q = ((A[0][1] + A[1][0]) * f, q2, (A[1][2] + A[2][1]) * f, (A[2][0] - A[0][2]) * f)
-    else:
-        q3 = 0.5 * math.sqrt(max(0.0, 1.0 + 2.0 * A[2][2] - tr))
-        f = 0.25 / q3
-        q = ((A[0][2] + A[2][0]) * f, (A[1][2] + A[2][1]) * f, q3, (A[0][1] - A[1][0]) * f)
-    q = attitude.normalized(q, "quaternion from the attitude matrix")
-    return q if q[3] >= 0.0 else tuple(-x for x in q)
+    return attitude.dcm_to_quaternion(A)
 
 
 def triad_quaternion(b1, b2, r1, r2, min_sin=1e-9):
