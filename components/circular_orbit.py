@@ -18,7 +18,7 @@ MU_EARTH = 3.986004418e14  # m^3/s^2
 EARTH_RADIUS = 6378137.0  # m
 
 
-class CircularOrbit:
+class CircularOrbit(time_utils.Clock):
     def __init__(self, altitude=420e3, inclination=math.radians(51.6), raan=0.0, arg_latitude0=0.0,
                  mu=MU_EARTH, earth_radius=EARTH_RADIUS, t0=0.0):
         for name, value in (("mu", mu), ("earth_radius", earth_radius)):
@@ -68,15 +68,3 @@ class CircularOrbit:
         cO, sO, ci, si = (math.cos(self.raan), math.sin(self.raan), math.cos(self.inclination),
                           math.sin(self.inclination))
         return (sO * si, -cO * si, ci)
-
-    def advance_to(self, t):
-        self.t = time_utils.check_time(t, "time")
-
-    def step(self, h):
-        self.advance_to(self.t + h)
-
-    def get_state(self):
-        return {"t": self.t}
-
-    def set_state(self, state):
-        self.advance_to(state["t"])

@@ -49,7 +49,7 @@ def right_ascension_declination(r):
     return ra, math.atan2(r[2], math.hypot(r[0], r[1]))
 
 
-class SunEphemeris:
+class SunEphemeris(time_utils.Clock):
     """Position of the Sun relative to Earth, r_SN_N in m, at `t` seconds after `epoch`.
 
     State: the simulation time t only."""
@@ -74,15 +74,3 @@ class SunEphemeris:
         r = (x * AU, y * AU, z * AU)
         self._cache = (t, r)
         return r
-
-    def advance_to(self, t):
-        self.t = time_utils.check_time(t, "time")
-
-    def step(self, h):
-        self.advance_to(self.t + h)
-
-    def get_state(self):
-        return {"t": self.t}
-
-    def set_state(self, state):
-        self.advance_to(state["t"])

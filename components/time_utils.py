@@ -65,3 +65,23 @@ def check_time(t, name="t"):
     if not math.isfinite(t):
         raise ValueError(f"{name} = {t!r} must be a finite number of seconds")
     return t
+
+
+class Clock:
+    """Simulation time for models whose outputs are functions of time only (ephemerides,
+    analytic orbits): `t` is the current time in s since the epoch, and it is their only
+    state."""
+
+    t = 0.0
+
+    def advance_to(self, t):
+        self.t = check_time(t, "time")
+
+    def step(self, h):
+        self.advance_to(self.t + h)
+
+    def get_state(self):
+        return {"t": self.t}
+
+    def set_state(self, state):
+        self.advance_to(state["t"])
