@@ -18,7 +18,6 @@ class CircularOrbit(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._start_time = 0.0
         self.parameter("altitude", 420e3, "m", "Altitude above earth_radius (> 0)")
         self.parameter("inclination", math.radians(51.6), "rad", "Orbit inclination, in [0, pi]")
         self.parameter("raan", 0.0, "rad", "Right ascension of the ascending node")
@@ -34,11 +33,8 @@ class CircularOrbit(NeighborSlave):
     def build_model(self):
         v = self.values
         return circular_orbit.CircularOrbit(v["altitude"], v["inclination"], v["raan"], v["arg_latitude0"],
-                                            v["mu"], v["earth_radius"], self._start_time)
+                                            v["mu"], v["earth_radius"], self.start_time)
 
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._start_time = float(start_time)
-        self._model = None
 
     def do_step(self, current_time, step_size):
         self.model.advance_to(current_time + step_size)

@@ -56,6 +56,7 @@ class NeighborSlave(Fmi2Slave):
         self._model = None
         self._input_version = 0
         self._vector_keys = {}
+        self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
 
     # ---- declarations -------------------------------------------------------------------
     def _register(self, name, kind, causality, variability, unit, description, start=None,
@@ -171,6 +172,10 @@ class NeighborSlave(Fmi2Slave):
 
     def build_model(self):  # pragma: no cover - every wrapper implements it
         raise NotImplementedError
+
+    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+        self.start_time = float(start_time or 0.0)
+        self._model = None  # rebuilt so that a model that keeps time starts at start_time
 
     def exit_initialization_mode(self):
         # Build (and so validate) the model from the final parameter values.

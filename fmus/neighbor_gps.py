@@ -18,7 +18,6 @@ class GpsReceiver(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._start_time = 0.0
         self.parameter("sigma", 1.5, "m", "Position noise standard deviation per axis, >= 0 (OEM7700: 1.5 m RMS)")
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
         self.parameter("available", True, None, "Receiver has a fix; false models an outage (valid false)", bool)
@@ -30,13 +29,10 @@ class GpsReceiver(NeighborSlave):
                     "Time of the measurement (the simulation time): seconds since the scenario epoch")
         self.output("valid", lambda: self.model.available, None, "Position and time valid", bool)
 
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._start_time = float(start_time or 0.0)
-        self._model = None
 
     def build_model(self):
         return sensors.GpsReceiver(self.values["sigma"], self.values["seed"], self.values["available"],
-                                   self._start_time)
+                                   self.start_time)
 
     def _measure(self):
         return self.model.measure(self.vector("r_BN_N", 3))

@@ -23,7 +23,6 @@ class SunAvoidanceGuidance(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._start_time = 0.0
         self.parameter_array("boresight_B", [0.0, 0.0, 1.0], "1", "Body-fixed boresight direction P in B (non-zero; normalized)")
         self.parameter_array("sun_N", [1.0, 0.0, 0.0], "1", "Sun direction S in N (non-zero; normalized)")
         self.parameter("epsilon", math.radians(30.0), "rad", "Sun keep-out cone half-angle, in (0, pi/2)")
@@ -77,13 +76,9 @@ class SunAvoidanceGuidance(NeighborSlave):
         model = sun_avoidance.SunAvoidanceGuidance(
             self.vector("boresight_B", 3), self.vector("sun_N", 3), v["epsilon"], self.vector("q0", 4),
             self.vector("q_f", 4), v["w_max"], v["a_max"], J, v["margin"], v["t_start"])
-        model.time = self._start_time
+        model.time = self.start_time
         return model
 
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._start_time = float(start_time)
-        if self._model is not None:
-            self._model.time = self._start_time
 
     def do_step(self, current_time, step_size):
         self.model.step(current_time + step_size)

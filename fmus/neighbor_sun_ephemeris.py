@@ -17,7 +17,6 @@ class SunEphemeris(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._start_time = 0.0
         self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
                        "Scenario epoch (simulation time 0), ISO 8601 UTC 'YYYY-MM-DDThh:mm:ss[.fff]Z'", str)
         self.output_array("r_SN_N", 3, lambda: self.model.position(), "m",
@@ -25,11 +24,8 @@ class SunEphemeris(NeighborSlave):
                           "date, used as J2000 axes)")
 
     def build_model(self):
-        return sun.SunEphemeris(self.values["epoch"], self._start_time)
+        return sun.SunEphemeris(self.values["epoch"], self.start_time)
 
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
-        self._start_time = float(start_time)
-        self._model = None
 
     def do_step(self, current_time, step_size):
         self.model.advance_to(current_time + step_size)
