@@ -2,6 +2,13 @@
 
 Wraps components.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
 Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
+
+Momentum wheels: the inputs wheel_torque_B (the wheel motors' torque on the wheels; the body
+feels -wheel_torque_B) and wheel_momentum_B (the wheels' momentum relative to the body) turn
+Euler's equation into the gyrostat equation J omega_dot = L - wheel_torque_B - omega x
+(J omega + h_w). They are declared after every other variable so that the value references of
+the original variables are unchanged; left at zero the model is bit-identical to the wheel-less
+one. H_B stays the body's own J omega (the total is H_B + wheel_momentum_B).
 """
 
 from neighbor_fmu_support import NeighborSlave, use_bundled_components
@@ -45,7 +52,16 @@ class RigidBody(NeighborSlave):
                           "rk4: mean over the step; zero before the first step)")
         self.output_array("euler123", 3, lambda: m().euler123(), "rad",
                           "1-2-3 Euler angles phi, theta, psi of q_BN (Eq. 25-29)")
-        self.output_array("H_B", 3, lambda: m().angular_momentum(), "N.m.s", "Angular momentum I omega in B")
+        self.output_array("H_B", 3, lambda: m().angular_momentum(), "N.m.s",
+                          "Angular momentum I omega of the body alone in B (without the wheels' relative momentum)")
+
+        # Appended last: value references of the variables above stay as they were.
+        self.input_array("wheel_torque_B", [0.0, 0.0, 0.0], "N.m",
+                         "Torque the momentum-wheel motors apply to the wheels in B (the body feels the "
+                         "opposite), held over a step; 0 without wheels")
+        self.input_array("wheel_momentum_B", [0.0, 0.0, 0.0], "N.m.s",
+                         "Angular momentum of the wheels relative to the body in B at the step start "
+                         "(gyroscopic term omega x h_w); 0 without wheels")
 
     def build_model(self):
         if self.values["inertia_from_box"]:
@@ -57,5 +73,6 @@ class RigidBody(NeighborSlave):
                                     self.values["integrator"], self.values["max_substep"])
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.vector("torque_B", 3), step_size)
+        self.model.step(self.vector("torque_B", 3), step_size, self.vector("wheel_torque_B", 3),
+                        self.vector("wheel_momentum_B", 3))
         return True
