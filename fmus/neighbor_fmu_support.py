@@ -55,6 +55,7 @@ class NeighborSlave(Fmi2Slave):
         self.fmu_meta = {}
         self._model = None
         self._input_version = 0
+        self._model_generation = 0  # counts model builds: a cache key that is never reused
         self._vector_keys = {}
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
 
@@ -145,7 +146,8 @@ class NeighborSlave(Fmi2Slave):
 
         Several outputs of a controller come from one computation on the current inputs;
         this runs it once per set of inputs rather than once per output read."""
-        key = (self._input_version, id(self._model), compute.__name__)
+        self.model  # noqa: B018 - build it first, so that the key carries its generation
+        key = (self._input_version, self._model_generation)
         cache = self.__dict__.setdefault("_feedthrough_cache", {})
         hit = cache.get(compute.__name__)
         if hit is None or hit[0] != key:
@@ -166,6 +168,7 @@ class NeighborSlave(Fmi2Slave):
         if self._model is None:
             try:
                 self._model = self.build_model()
+                self._model_generation += 1
             except (ValueError, TypeError) as exc:
                 raise ParameterError(f"{type(self).__name__} instance '{self.instance_name}': {exc}") from exc
         return self._model
@@ -186,12 +189,11 @@ class NeighborSlave(Fmi2Slave):
         return {
             "values": copy.deepcopy(self.values),
             "model": None if self._model is None else self._model.get_state(),
-            "input_version": self._input_version,
         }
 
     def _set_fmu_state(self, state):
         self.values = copy.deepcopy(state["values"])
-        self._input_version = state["input_version"] + 1
+        self._input_version += 1  # never a version an earlier cache entry could carry
         self._model = None
         if state["model"] is not None:
             self.model.set_state(state["model"])

@@ -153,3 +153,30 @@ def test_fmus_load_their_bundled_components_after_another_fmu_is_gone(fmu_paths,
                        capture_output=True, text=True, cwd=tmp_path, timeout=120)
     assert p.returncode == 0, p.stderr[-2000:]
     assert float(p.stdout.strip().splitlines()[-1]) == pytest.approx(1.0)
+
+
+def test_feedthrough_cache_follows_parameters_and_restored_state():
+    """Outputs computed once per set of inputs must be recomputed after a parameter change
+    (a rebuilt model) and after a restored FMU state, however the memory is reused."""
+    import sys
+
+    from build_fmus import FMU_SOURCES
+
+    sys.path.insert(0, str(FMU_SOURCES))
+    from neighbor_detumble import DetumbleController
+
+    d = DetumbleController(instance_name="d")
+    vr = {v.name: v.value_reference for v in d.vars.values()}
+    w1, kp1, out = vr["omega_BN_B[1]"], vr["Kp[1]"], vr["torque_cmd_B[1]"]
+    d.set_real([w1], [0.1])
+    assert d.get_real([out])[0] < 0
+    for _ in range(3):  # parameter changes rebuild the model
+        d.set_real([kp1], [0.0])
+        assert d.get_real([out])[0] == 0.0
+        d.set_real([kp1], [100.0])
+        assert d.get_real([out])[0] < 0
+    saved = d._get_fmu_state()
+    d.set_real([w1], [-0.1])
+    assert d.get_real([out])[0] > 0
+    d._set_fmu_state(saved)
+    assert d.get_real([out])[0] < 0
