@@ -37,12 +37,24 @@ Laws (mode: dipole; wheel):
   gives az'' + D_a az' + K_a az = 0 below the rate limit. The limit (0.3 deg/s: Iy x 5.2e-3 =
   6.8e-4 N.m.s, 34 rad/s of wheel speed) keeps the wheel within its 628 rad/s limit while it
   carries the 567 rad/s of the spin momentum.
-  Elevation and momentum with the coils: tau_d = k_h (H_d - H) - k_p s_y |H_d| s_perp (as
-  Reorient with e_ref = 0), all three moments. Orbit Night uses the same law (the seed draws the
+  Elevation and momentum with the coils: tau_d = k_h (H_d - H) - k_pf e_H |H_d| s_perp (as
+  Reorient with e_ref = 0 and the gain k_pf = k_precession_fine), all three moments, where
+  e_H = s.H/|H| is the Sun elevation from the plane normal to the momentum (the wheel axis the
+  still body nutates about) rather than s_y: d(s.H)/dt = s.tau holds exactly for e_H, and s_y
+  also carries the nutation, which a proportional feedback on it pumps (a slowly growing X/Z
+  oscillation, 0.7 deg/s after 6000 s in Orbit Day with 0.2 A.m2 coils); the body's s_y
+  follows e_H as -k_h H_perp damps the nutation. k_pf = 5e-3
+  1/s (200 s time constant, 2.5x Reorient's): the elevation must be within the fine error (sin 2
+  deg) at dusk, since Orbit Night holds only with the fine Sun errors (Orbit Night col 4);
+  1e-2 1/s drove a slow nutation/elevation divergence at 5 s steps. Orbit Night uses the same law (the seed draws the
   attitude from the optical system at night; here the inputs are the same truth signals).
 - 6 Deploy Paddles: m = 0 ("cuts all magnetic moments to zero"); tau_w = 0 (holds the speed).
 - 9 Ground Command (our choice, safe): m = 0 and tau_w = 0 (wheel holds its speed) until ground
   commands or the mode manager returns to Detumble.
+Precession taper (all modes with a precession term): the term is multiplied by
+clamp(2 - |H - H_d| / precession_taper, 0, 1), full below precession_taper = 6e-4 N.m.s and off
+at twice it: saturated coils otherwise let the momentum error in Reorient cross the 1e-3 N.m.s
+spinup momentum error, which sends Reorient back to Spinup (Reorient col 4 fails: uncertain).
 When coils_enabled is false m = 0; when wheel_enabled is false tau_w = 0, whatever the mode.
 
 Reorient schedule: the draft's Reorient table holds the mode before RMD only while the Sun
@@ -79,10 +91,12 @@ PARAMETER_DEFAULTS = {
     "k_nutation": 2.0e-3,  # N.m.s
     "k_momentum": 2.0e-3,  # 1/s
     "k_precession": 2.0e-3,  # 1/s
+    "k_precession_fine": 5.0e-3,  # 1/s, Acquire / Orbit Day / Orbit Night (body still, H on the wheel)
     "K_azimuth": 2.5e-3,  # 1/s2
     "D_azimuth": 0.07,  # 1/s
     "k_wheel": 0.1,  # 1/s
     "max_slew_rate": math.radians(0.3),  # rad/s
+    "precession_taper": 6.0e-4,  # N.m.s: precession at full gain below this momentum error, off at twice it
     "reorient_hold_elevation": math.sin(math.radians(15.0)),  # 1 (a sine), above the 10 deg coarse error
     "reorient_duration": 6000.0,  # s, the seed's RMD
 }
@@ -126,13 +140,21 @@ class AcsControl:
         m = _cross(B, tau_d)
         return (m[0] / b2, m[1] / b2, m[2] / b2)
 
-    def _momentum_torque(self, H, s, e_ref):
+    def _momentum_torque(self, H, s, e_ref, kp=None, momentum_elevation=False):
         p = self.p
         hd = p["Iy"] * p["spin_rate"]
-        k, kp = p["k_momentum"], p["k_precession"]
+        k = p["k_momentum"]
+        kp = p["k_precession"] if kp is None else kp
         tau = [k * (0.0 - H[0]), k * (hd - H[1]), k * (0.0 - H[2])]
         if s is not None:
-            g = kp * (s[1] - e_ref) * hd
+            err = math.sqrt(H[0] * H[0] + (H[1] - hd) * (H[1] - hd) + H[2] * H[2])
+            taper = min(1.0, max(0.0, 2.0 - err / p["precession_taper"]))
+            hn = math.sqrt(H[0] * H[0] + H[1] * H[1] + H[2] * H[2])
+            # elevation of the momentum (the spin/wheel axis the body nutates about) when asked:
+            # free of the nutation, which a feedback on s_y itself pumps (position feedback on a
+            # gyroscopic mode)
+            e = (s[0] * H[0] + s[1] * H[1] + s[2] * H[2]) / hn if (momentum_elevation and hn > 0) else s[1]
+            g = taper * kp * (e - e_ref) * hd
             tau[0] -= g * s[0]
             tau[2] -= g * s[2]
         return tau
@@ -166,7 +188,7 @@ class AcsControl:
             tw = p["k_wheel"] * p["Iy"] * omega[1]
         elif mode in (ACQUIRE, ORBIT_DAY, ORBIT_NIGHT):
             if field:
-                m = self._coil_dipole(self._momentum_torque(H, s, 0.0), B, b2)
+                m = self._coil_dipole(self._momentum_torque(H, s, 0.0, p["k_precession_fine"], True), B, b2)
             if s is not None:
                 az = math.atan2(s[0], s[2]) if (s[0] != 0.0 or s[2] != 0.0) else 0.0
                 w_ref = p["K_azimuth"] / p["D_azimuth"] * az

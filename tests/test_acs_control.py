@@ -197,3 +197,26 @@ def test_fmu_validates_and_simulates(acs_fmu_dir, name):
         assert not r["paddles_deployed"][0] and r["paddles_deployed"][-1]
     else:
         assert not r["tracking"][0] and r["tracking"][-1]
+
+
+def test_precession_tapers_off_with_the_momentum_error():
+    from components import acs_control as ac
+    c = ac.AcsControl({"k_momentum": 1e-12})
+    hd = c.p["Iy"] * c.p["spin_rate"]
+    s = (0.6, 0.5, 0.6)
+    full = c._momentum_torque((0.0, hd, 0.0), s, 0.0)
+    half = c._momentum_torque((1.5 * c.p["precession_taper"], hd, 0.0), s, 0.0)
+    off = c._momentum_torque((2.0 * c.p["precession_taper"], hd, 0.0), s, 0.0)
+    g = c.p["k_precession"] * 0.5 * hd
+    assert abs(full[0] + g * 0.6) < 1e-12 and abs(full[2] + g * 0.6) < 1e-12
+    assert abs(half[2] + 0.5 * g * 0.6) < 1e-10
+    assert abs(off[2]) < 1e-10
+
+
+def test_fine_modes_use_their_own_precession_gain():
+    from components import acs_control as ac
+    B, s, w = (2e-5, 1e-5, -3e-5), (0.3, 0.2, 0.93), (0.0, 0.0, 0.0)
+    wr = 0.13 * ac.PARAMETER_DEFAULTS["spin_rate"] / 2e-5
+    a = ac.AcsControl({"k_precession_fine": 1e-3}).command(ac.ORBIT_DAY, True, True, w, B, s, wr)[0]
+    b = ac.AcsControl({"k_precession_fine": 2e-3, "k_precession": 7e-3}).command(ac.ORBIT_DAY, True, True, w, B, s, wr)[0]
+    assert all(abs(2 * x - y) < 1e-9 for x, y in zip(a, b))

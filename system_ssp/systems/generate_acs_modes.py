@@ -33,7 +33,9 @@ Parameter files:
 - acs_modes_initial_state.ssv  tumbling start: 2 deg/s about each body axis, identity attitude;
 - acs_modes_shortened.ssv   scenario for tests: mode delays scaled down (RMD 300 s etc.),
   5 s step-compatible, coils 1 A.m2, small paddle/tracker times: the whole nominal sequence and
-  two day/night alternations in 3 orbits (stop time 16800 s, step 5 s);
+  two day/night alternations (stop time 18000 s, step 5 s): Detumble/Spinup by 2620 s (dawn),
+  Reorient falls back to Spinup at the first dusk (6125 s, Spinup col 5, tables), completes in
+  the second daylight, Orbit Day at 9430 s, then Orbit Night/Day at 11705/13780/17280 s;
 - acs_modes_sun_facing.ssv  scenario for the long run with the seed's delays: RMD = 6000 s
   exceeds the 5577 s period and Reorient falls back to Spinup at every night (Spinup col 5),
   so the deployment needs an eclipse-free orbit: see examples/acs_modes_long_run.py.
@@ -72,7 +74,7 @@ SHORTENED = {**{f"modes.{k}": v for k, v in SHORT_DELAYS.items()},
              "control.reorient_duration": SHORT_DELAYS["RMD"],
              **{f"coils.max_dipole[{i}]": 1.0 for i in (1, 2, 3)},
              "paddles.deployment_time": 20.0, "optical.acquisition_time": 10.0, "optical.loss_time": 7.0}
-SHORT_STEP, SHORT_STOP = 5.0, 16800.0
+SHORT_STEP, SHORT_STOP = 5.0, 18000.0
 GROUND = {**SHORTENED, "signals.command_start": 12000.0, "signals.command_end": 12030.0}
 
 SYSTEM = {
