@@ -81,6 +81,8 @@ uT at 420 km, torques of order 0.2 A.m2 x 30 uT = 6 uN.m):
 """
 import math
 
+from .parameters import finite_parameters
+
 WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
 
 PARAMETER_DEFAULTS = {
@@ -105,15 +107,8 @@ B_MIN = 1.0e-9  # T: below it the field is taken as absent (no coil command)
 
 
 def check_parameters(params=None):
-    p = dict(PARAMETER_DEFAULTS)
-    for k, v in (params or {}).items():
-        if k not in p:
-            raise ValueError(f"unknown parameter {k!r}")
-        p[k] = v
+    p = finite_parameters(PARAMETER_DEFAULTS, params)
     for k, v in p.items():
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"parameter {k} = {v!r} must be a finite number")
-        v = p[k] = float(v)
         if k in NONNEGATIVE:
             if v < 0 or (k == "reorient_hold_elevation" and v >= 1.0):
                 raise ValueError(f"parameter {k} = {v!r} must be in [0, {'1)' if k.startswith('reorient_hold') else 'inf)'}")

@@ -65,6 +65,8 @@ import math
 import re
 from dataclasses import dataclass, field
 
+from .parameters import finite_parameters
+
 WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
 STARTUP = -1  # pseudo-mode before the first decision ("Control Mode: Startup")
 MODE_NAMES = ("Wait", "Detumble", "Spinup", "Reorient", "Deploy Wheel", "Acquire", "Deploy Paddles",
@@ -341,16 +343,8 @@ def literal_rules():
 # ---- checks -------------------------------------------------------------------------------
 def check_parameters(params=None):
     """Defaults completed with `params`; ValueError naming a bad parameter and its range."""
-    p = dict(PARAMETER_DEFAULTS)
-    for k, v in (params or {}).items():
-        if k not in p:
-            raise ValueError(f"unknown parameter {k!r}")
-        p[k] = v
-    for k in p:
-        v = p[k]
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"parameter {k} = {v!r} must be a finite number")
-        p[k] = v = float(v)
+    p = finite_parameters(PARAMETER_DEFAULTS, params)
+    for k, v in p.items():
         if k in DELAYS:
             if v < 0:
                 raise ValueError(f"parameter {k} = {v!r} s must be in [0, inf)")

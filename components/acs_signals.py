@@ -17,20 +17,15 @@ Definitions (all in B; H_B = J omega is the body's momentum, h_w the wheels' rel
 """
 import math
 
+from .parameters import finite_parameters
+
 PARAMETER_DEFAULTS = {"Iy": 0.13, "spin_rate": math.radians(5.0), "command_start": -1.0, "command_end": -1.0}
 
 
 def check_parameters(params=None):
-    p = dict(PARAMETER_DEFAULTS)
-    for k, v in (params or {}).items():
-        if k not in p:
-            raise ValueError(f"unknown parameter {k!r}")
-        p[k] = v
+    p = finite_parameters(PARAMETER_DEFAULTS, params)
     for k, v in p.items():
-        if isinstance(v, bool) or not isinstance(v, (int, float)) or not math.isfinite(v):
-            raise ValueError(f"parameter {k} = {v!r} must be a finite number")
-        p[k] = float(v)
-        if k in ("Iy", "spin_rate") and p[k] <= 0:
+        if k in ("Iy", "spin_rate") and v <= 0:
             raise ValueError(f"parameter {k} = {v!r} must be in (0, inf)")
     return p
 
