@@ -5,8 +5,8 @@ import zipfile
 
 import fmpy
 import pytest
-from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
+from fmu_instances import instantiate
 
 EXPECTED = {"RigidBody", "DetumbleController", "SlewController", "RcsThrusters"}
 
@@ -76,14 +76,7 @@ def test_each_fmu_simulates_alone(fmu_paths):
 
 
 def _instance(path, tmp_path, name):
-    md = fmpy.read_model_description(str(path))
-    unzip = fmpy.extract(str(path), unzipdir=str(tmp_path / name))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName=name)
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    vrs = {v.name: v.valueReference for v in md.modelVariables}
-    return fmu, vrs
+    return instantiate(path, tmp_path, name)
 
 
 def test_get_and_set_state_restores_hidden_state(fmu_paths, tmp_path):

@@ -7,11 +7,11 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from components import attitude, magnetic_field as mf, magnetorquer, momentum_wheel, time_utils
 from components.rigid_body import RigidBody, box_inertia
+from fmu_instances import instantiate
 
 ROOT = Path(__file__).resolve().parents[1]
 WRAPPERS = {"MagneticField": "neighbor_magnetic_field.py", "TorqueCoils": "neighbor_torque_coils.py",
@@ -381,13 +381,7 @@ def test_fmus_simulate_alone(ma_fmus):
 
 
 def _instance(path, tmp_path, name):
-    md = fmpy.read_model_description(str(path))
-    unzip = fmpy.extract(str(path), unzipdir=str(tmp_path / name))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName=name)
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    return fmu, {v.name: v.valueReference for v in md.modelVariables}
+    return instantiate(path, tmp_path, name)
 
 
 def test_wheel_and_body_fmus_cosimulate_and_restore_state(ma_fmus, tmp_path):

@@ -7,10 +7,10 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 
 from components import circular_orbit, eclipse, sun, time_utils
+from fmu_instances import instantiate
 
 ROOT = Path(__file__).resolve().parents[1]
 WRAPPERS = {"SunEphemeris": "neighbor_sun_ephemeris.py", "EarthShadow": "neighbor_earth_shadow.py",
@@ -330,15 +330,7 @@ def test_fmus_simulate_alone_and_report_the_communication_point(se_fmus):
 
 
 def _instance(path, tmp_path, name):
-    md = fmpy.read_model_description(str(path))
-    unzip = fmpy.extract(str(path), unzipdir=str(tmp_path / name))
-    fmu = FMU2Slave(guid=md.guid, unzipDirectory=unzip, modelIdentifier=md.coSimulation.modelIdentifier,
-                    instanceName=name)
-    fmu.instantiate()
-    fmu.setupExperiment(startTime=0.0)
-    fmu.enterInitializationMode()
-    fmu.exitInitializationMode()
-    return fmu, {v.name: v.valueReference for v in md.modelVariables}
+    return instantiate(path, tmp_path, name, initialize=True)
 
 
 def test_fmu_state_restores_time(se_fmus, tmp_path):
