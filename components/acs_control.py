@@ -81,7 +81,7 @@ uT at 420 km, torques of order 0.2 A.m2 x 30 uT = 6 uN.m):
 """
 import math
 
-from .parameters import finite_parameters
+from .checks import finite_parameters
 
 WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
 

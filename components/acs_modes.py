@@ -65,7 +65,7 @@ import math
 import re
 from dataclasses import dataclass, field
 
-from .parameters import finite_parameters
+from .checks import finite_parameters
 
 WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
 STARTUP = -1  # pseudo-mode before the first decision ("Control Mode: Startup")

@@ -17,7 +17,7 @@ Definitions (all in B; H_B = J omega is the body's momentum, h_w the wheels' rel
 """
 import math
 
-from .parameters import finite_parameters
+from .checks import finite_parameters
 
 PARAMETER_DEFAULTS = {"Iy": 0.13, "spin_rate": math.radians(5.0), "command_start": -1.0, "command_end": -1.0}
 

@@ -25,27 +25,12 @@ Everything works on tuples of floats (plain float arithmetic beats numpy on 3-ve
 import math
 
 from . import attitude
-
-
-def _finite3(v, what):
-    try:
-        t = tuple(float(x) for x in v)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what} must be 3 numbers, got {v!r}") from None
-    if len(t) != 3 or not all(math.isfinite(x) for x in t):
-        raise ValueError(f"{what} {list(t)} must be 3 finite numbers")
-    return t
+from .checks import finite_vector
 
 
 def unit_quaternion(q, what="q_BN"):
     """q (4 finite numbers, scalar last) normalized; ValueError naming `what` otherwise."""
-    try:
-        t = tuple(float(x) for x in q)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what} must be 4 numbers, got {q!r}") from None
-    if len(t) != 4 or not all(math.isfinite(x) for x in t):
-        raise ValueError(f"{what} {list(t)} must be 4 finite numbers (scalar last)")
-    return attitude.normalized(t, what)
+    return attitude.normalized(finite_vector(q, 4, what, "scalar last"), what)
 
 
 def from_quaternion(q, short=False):
@@ -68,7 +53,7 @@ def to_quaternion(sigma):
     """Unit scalar-last quaternion of sigma: q_1:3 = 2 sigma/(1 + s2), q4 = (1 - s2)/(1 + s2).
 
     The short set gives q4 >= 0, its shadow set the opposite quaternion (same attitude)."""
-    s1, s2, s3 = _finite3(sigma, "sigma_BN")
+    s1, s2, s3 = finite_vector(sigma, 3, "sigma_BN")
     ss = s1 * s1 + s2 * s2 + s3 * s3
     d = 1.0 + ss
     return (2.0 * s1 / d, 2.0 * s2 / d, 2.0 * s3 / d, (1.0 - ss) / d)
@@ -76,7 +61,7 @@ def to_quaternion(sigma):
 
 def shadow(sigma):
     """Shadow set sigma_s = -sigma / |sigma|^2 (same attitude; the zero MRP has none)."""
-    s1, s2, s3 = _finite3(sigma, "sigma_BN")
+    s1, s2, s3 = finite_vector(sigma, 3, "sigma_BN")
     ss = s1 * s1 + s2 * s2 + s3 * s3
     if ss == 0.0:
         raise ValueError("sigma_BN = [0, 0, 0] (zero rotation) has no shadow set (it would be infinite)")
@@ -85,7 +70,7 @@ def shadow(sigma):
 
 def short(sigma):
     """The short set of sigma: sigma itself if |sigma| <= 1, else its shadow set."""
-    s1, s2, s3 = _finite3(sigma, "sigma_BN")
+    s1, s2, s3 = finite_vector(sigma, 3, "sigma_BN")
     ss = s1 * s1 + s2 * s2 + s3 * s3
     if ss > 1.0:
         return (-s1 / ss, -s2 / ss, -s3 / ss)
@@ -95,7 +80,7 @@ def short(sigma):
 def to_dcm(sigma):
     """[BN(sigma)] = I + (8 [s~]^2 - 4 (1 - s2) [s~]) / (1 + s2)^2 (Schaub and Junkins), as a
     3x3 nested tuple mapping N-frame components to B-frame components (= A(q))."""
-    s1, s2, s3 = _finite3(sigma, "sigma_BN")
+    s1, s2, s3 = finite_vector(sigma, 3, "sigma_BN")
     ss = s1 * s1 + s2 * s2 + s3 * s3
     d = 1.0 + ss
     k8 = 8.0 / (d * d)

@@ -25,15 +25,9 @@ import math
 import numpy as np
 
 from . import attitude
+from .checks import finite_vector
 
 TWO_PI = 2.0 * math.pi
-
-
-def _finite_vector(v, n, what):
-    v = tuple(float(x) for x in v)
-    if len(v) != n or not all(math.isfinite(x) for x in v):
-        raise ValueError(f"{what} {list(v)} must be {n} finite numbers")
-    return v
 
 
 def check_sigma(name, value, unit):
@@ -127,11 +121,11 @@ class HorizonSensor(_VectorSensor):
         super().__init__(sigma, seed)
 
     def true_nadir(self, r_BN_N, q_BN):
-        r = _finite_vector(r_BN_N, 3, "r_BN_N")
+        r = finite_vector(r_BN_N, 3, "r_BN_N")
         n = attitude.norm(r)
         if n == 0.0:
             return None
-        q = attitude.normalized(_finite_vector(q_BN, 4, "q_BN"), "q_BN")
+        q = attitude.normalized(finite_vector(q_BN, 4, "q_BN"), "q_BN")
         return rotate_vector(attitude.attitude_matrix(q), (-r[0] / n, -r[1] / n, -r[2] / n))
 
     def measure(self, r_BN_N, q_BN):
@@ -148,7 +142,7 @@ class SunSensor(_VectorSensor):
 
     def __init__(self, boresight_B=(1.0, 0.0, 0.0), half_fov=math.radians(60.0), sigma=math.radians(0.5) / 3.0,
                  seed=0):
-        b = _finite_vector(boresight_B, 3, "boresight_B")
+        b = finite_vector(boresight_B, 3, "boresight_B")
         if attitude.norm(b) == 0.0:
             raise ValueError("boresight_B must be a non-zero vector")
         self.boresight = unit_vector(b, "boresight_B")
@@ -160,13 +154,13 @@ class SunSensor(_VectorSensor):
         super().__init__(sigma, seed)
 
     def true_sun(self, r_SN_N, r_BN_N, q_BN):
-        s = _finite_vector(r_SN_N, 3, "r_SN_N")
-        r = _finite_vector(r_BN_N, 3, "r_BN_N")
+        s = finite_vector(r_SN_N, 3, "r_SN_N")
+        r = finite_vector(r_BN_N, 3, "r_BN_N")
         d = (s[0] - r[0], s[1] - r[1], s[2] - r[2])
         n = attitude.norm(d)
         if n == 0.0:
             return None
-        q = attitude.normalized(_finite_vector(q_BN, 4, "q_BN"), "q_BN")
+        q = attitude.normalized(finite_vector(q_BN, 4, "q_BN"), "q_BN")
         return rotate_vector(attitude.attitude_matrix(q), (d[0] / n, d[1] / n, d[2] / n))
 
     def in_fov(self, sun_B):
@@ -184,7 +178,7 @@ class Gyro(_Seeded):
     """3-axis rate gyro (thesis 3.3.1, Bosch BMG160 [44]): omega + bias + white noise."""
 
     def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0):
-        self.bias = _finite_vector(bias, 3, "bias")
+        self.bias = finite_vector(bias, 3, "bias")
         self.sigma = check_sigma("sigma", sigma, "rad/s")
         super().__init__(seed)
 
@@ -192,7 +186,7 @@ class Gyro(_Seeded):
         return tuple(float(x) for x in self.rng.standard_normal(3))
 
     def measure(self, omega_BN_B):
-        w = _finite_vector(omega_BN_B, 3, "omega_BN_B")
+        w = finite_vector(omega_BN_B, 3, "omega_BN_B")
         b, n, s = self.bias, self.sample, self.sigma
         return (w[0] + b[0] + s * n[0], w[1] + b[1] + s * n[1], w[2] + b[2] + s * n[2])
 
@@ -218,7 +212,7 @@ class GpsReceiver(_Seeded):
 
     def measure(self, r_BN_N):
         """(r_meas_N, valid): zeros when the receiver is unavailable."""
-        r = _finite_vector(r_BN_N, 3, "r_BN_N")
+        r = finite_vector(r_BN_N, 3, "r_BN_N")
         if not self.available:
             return (0.0, 0.0, 0.0), False
         n, s = self.sample, self.sigma

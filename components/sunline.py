@@ -17,6 +17,7 @@ as a point, with no light-time or aberration correction.
 import math
 
 from . import attitude, mrp
+from .checks import finite_vector
 
 ATTITUDE_INPUTS = ("mrp", "quaternion")
 # Positions closer than this fraction of their larger magnitude count as coinciding: the
@@ -24,23 +25,13 @@ ATTITUDE_INPUTS = ("mrp", "quaternion")
 REL_TOL = 1e-10
 
 
-def _position(r, what):
-    try:
-        t = tuple(float(x) for x in r)
-    except (TypeError, ValueError):
-        raise ValueError(f"{what} must be 3 numbers (m), got {r!r}") from None
-    if len(t) != 3 or not all(math.isfinite(x) for x in t):
-        raise ValueError(f"{what} {list(t)} must be 3 finite numbers (m)")
-    return t
-
-
 def sun_vector_N(r_SN_N, r_BN_N):
     """(unit heading d_N from the spacecraft to the Sun, distance |r_SN_N - r_BN_N| in m).
 
     ValueError, naming both positions, when they coincide: |r_SN_N - r_BN_N| <= REL_TOL times
     the larger of |r_SN_N|, |r_BN_N| (or exactly zero)."""
-    rs = _position(r_SN_N, "Sun position r_SN_N")
-    rb = _position(r_BN_N, "spacecraft position r_BN_N")
+    rs = finite_vector(r_SN_N, 3, "Sun position r_SN_N", "m")
+    rb = finite_vector(r_BN_N, 3, "spacecraft position r_BN_N", "m")
     d = (rs[0] - rb[0], rs[1] - rb[1], rs[2] - rb[2])
     dist = math.sqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2])
     scale = max(math.sqrt(attitude.dot(rs, rs)), math.sqrt(attitude.dot(rb, rb)))

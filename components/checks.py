@@ -1,4 +1,4 @@
-"""Parameter sets of the models that take a dict of named numbers (the ACS models)."""
+"""Input and parameter checks shared by the models: finite vectors and parameter sets."""
 import math
 
 
@@ -17,3 +17,15 @@ def finite_parameters(defaults, params=None):
             raise ValueError(f"parameter {k} = {v!r} must be a finite number")
         p[k] = float(v)
     return p
+
+
+def finite_vector(v, n, what, note=None):
+    """v as a tuple of n finite floats; ValueError naming `what` (and `note`, e.g. its unit)."""
+    suffix = f" ({note})" if note else ""
+    try:
+        t = tuple(float(x) for x in v)
+    except (TypeError, ValueError):
+        raise ValueError(f"{what} must be {n} numbers{suffix}, got {v!r}") from None
+    if len(t) != n or not all(math.isfinite(x) for x in t):
+        raise ValueError(f"{what} {list(t)} must be {n} finite numbers{suffix}")
+    return t
