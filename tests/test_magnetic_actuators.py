@@ -7,11 +7,10 @@ from pathlib import Path
 import fmpy
 import numpy as np
 import pytest
-from fmpy.validation import validate_fmu
 
 from components import attitude, magnetic_field as mf, magnetorquer, momentum_wheel, time_utils
 from components.rigid_body import RigidBody, box_inertia
-from fmu_instances import instantiate
+from fmu_helpers import check_declarations, instantiate
 
 ROOT = Path(__file__).resolve().parents[1]
 WRAPPERS = {"MagneticField": "neighbor_magnetic_field.py", "TorqueCoils": "neighbor_torque_coils.py",
@@ -317,16 +316,8 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
     CMD = [f"dipole_cmd_B[{i}]" for i in (1, 2, 3)] + ["enabled"]
     BB = [f"B_B[{i}]" for i in (1, 2, 3)]
     for name, path in ma_fmus.items():
-        assert validate_fmu(str(path)) == [], name
+        deps = check_declarations(path)
         md = fmpy.read_model_description(str(path))
-        units = {u.name for u in md.unitDefinitions}
-        for v in md.modelVariables:
-            assert v.description, (name, v.name)
-            if v.type == "Real":
-                assert v.unit in units, (name, v.name)
-        assert md.coSimulation.canGetAndSetFMUstate
-        deps = {u.variable.name: sorted(d.name for d in u.dependencies) for u in md.outputs}
-        assert {u.variable.name for u in md.initialUnknowns} == set(deps)
         if name == "MagneticField":
             assert all(deps[f"B_N[{i}]"] == sorted(R) for i in (1, 2, 3))
             assert all(deps[f"B_B[{i}]"] == sorted(R + Q) for i in (1, 2, 3))
