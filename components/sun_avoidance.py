@@ -181,6 +181,18 @@ def min_sun_angle(P_start, e, phi, S):
     return best
 
 
+def _cone_segment(q, a, b, boresight, phi):
+    """Axis in B (at attitude q) and angle >= 0 of a rotation by phi about a x b (in N; about
+    any axis perpendicular to the boresight when a and b are parallel), for the segments
+    between a boresight direction and the keep-out cone."""
+    c = attitude.cross(a, b)
+    e_N = _unit(c, "axis") if attitude.norm(c) > 1e-9 else perpendicular(boresight)
+    e_B = mat_vec(attitude.attitude_matrix(q), e_N)
+    if phi < 0:
+        e_B, phi = tuple(-x for x in e_B), -phi
+    return e_B, phi
+
+
 def eigenaxis(q_from, q_to):
     """Short-way eigenaxis rotation from q_from to q_to: (axis in B, angle in [0, pi]) with
     q_to = q(axis, angle) (x) q_from (up to sign). Axis (1, 0, 0) for a zero angle."""
@@ -334,21 +346,11 @@ class SunAvoidanceGuidance:
         S, P_i, P_f = self.S, self.P_i, self.P_f
         eps_d = self.epsilon + self.margin
         # Segment 1: in the plane of P_i and S, toward S, onto the eps_d cone.
-        c = attitude.cross(P_i, S)
-        e1_N = _unit(c, "axis") if attitude.norm(c) > 1e-9 else perpendicular(P_i)
-        phi1 = self.theta_i - eps_d
-        e1_B = mat_vec(attitude.attitude_matrix(self.q0), e1_N)
-        if phi1 < 0:
-            e1_B, phi1 = tuple(-x for x in e1_B), -phi1
+        e1_B, phi1 = _cone_segment(self.q0, P_i, S, P_i, self.theta_i - eps_d)
         q1 = attitude.circle_cross(attitude.from_axis_angle(e1_B, phi1), self.q0)
         P1 = boresight_N(q1, self.P)
         # Segment 3 (built backwards from q_f): from the eps_d cone, away from S, to P_f.
-        c = attitude.cross(S, P_f)
-        e3_N = _unit(c, "axis") if attitude.norm(c) > 1e-9 else perpendicular(P_f)
-        phi3 = self.theta_f - eps_d
-        e3_B = mat_vec(attitude.attitude_matrix(self.q_f), e3_N)
-        if phi3 < 0:
-            e3_B, phi3 = tuple(-x for x in e3_B), -phi3
+        e3_B, phi3 = _cone_segment(self.q_f, S, P_f, P_f, self.theta_f - eps_d)
         q2 = attitude.circle_cross(attitude.from_axis_angle(e3_B, -phi3), self.q_f)
         P2 = boresight_N(q2, self.P)
         candidates = []
