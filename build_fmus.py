@@ -95,7 +95,8 @@ def _digest(paths):
 
 
 def _component_files():
-    return [p for p in COMPONENTS.rglob("*.py") if "__pycache__" not in p.parts]
+    """Everything bundled from components/ (code and package data such as space-weather tables)."""
+    return [p for p in COMPONENTS.rglob("*") if p.is_file() and "__pycache__" not in p.parts]
 
 
 def wrapper_scripts():

@@ -20,6 +20,23 @@ def built():
 
 
 @pytest.fixture(scope="session")
+def build_one(tmp_path_factory):
+    """build_one("neighbor_orbit.py") -> path of that one wrapper's FMU, built once per session
+    into a private folder (for FMU tests that need no other FMU and no SSP)."""
+    import build_fmus
+
+    cache = {}
+
+    def build(script_name):
+        if script_name not in cache:
+            dest = tmp_path_factory.mktemp(Path(script_name).stem)
+            cache[script_name] = build_fmus.build_fmu(build_fmus.FMU_SOURCES / script_name, dest)
+        return cache[script_name]
+
+    return build
+
+
+@pytest.fixture(scope="session")
 def fmu_paths(built):
     return built[0]
 
