@@ -72,6 +72,34 @@ nc:StopCondition: a Boolean output; the run stops at the first communication poi
 is true. Arguments of simulate()/run() override the annotation. Other tools (libcosim) ignore
 unknown annotation types; the content is schema-valid (ssc:Annotation allows any element).
 
+Mode-dependent communication steps (nc:Schedule)
+------------------------------------------------
+A mission spends years coasting and minutes in 15 ms attitude manoeuvres in one run, so a
+system may declare its steps per mode inside nc:Master:
+
+    <nc:Schedule>
+      <nc:Mode name="attitude" stepSize="0.015" recordEvery="20">
+        <nc:When component="mission" connector="mode" values="4"/>
+        <nc:When component="mission" connector="phase" values="2 3 4"/>
+      </nc:Mode>
+      <nc:Mode name="coast" stepSize="3600" active="mission host orbit power data"/>
+      <nc:NextEvent component="mission" connector="next_event_time"/>
+    </nc:Schedule>
+
+After initialization and after every macro step the master takes the first nc:Mode whose
+nc:When conditions all hold (an Integer, Enumeration or Boolean output in `values`; a mode
+without conditions matches always and must be last). The next step is the mode's stepSize,
+shortened to end exactly on the earliest nc:NextEvent time ahead (Real outputs by which FMUs
+announce timers: a daily wake-up, the end of a grace period) and on the stop time. `active`
+lists the components stepped in that mode (default: all); the others are suspended: not
+stepped, outputs held, inputs not set, and their next doStep starts at the then-current time
+(FMI 2.0 does not require contiguous communication points; every component must declare
+canHandleVariableCommunicationStepSize). Gauss-Seidel only; no step multiples. Rows are
+recorded every `recordEvery` steps of a mode, at each mode change, at a stop and at the end.
+`Result.modes` gives steps and simulated time per mode; `profile=True` adds `Result.profile`
+(wall seconds per component for set + doStep + get, and the master's own share).
+`run(..., schedule=False)` ignores the schedule and runs with the fixed step.
+
 Result
 ------
 `.data` numpy structured array ('time', then 'component.variable' fields: float64 / int64 /

@@ -70,6 +70,8 @@ class Result:
         self.algorithm = algorithm
         self.order = order
         self.messages = messages
+        self.modes = None  # scheduled runs: {mode: {"steps", "simulated_time"}}
+        self.profile = None  # profile=True on a scheduled run: wall seconds per component and master
 
     @property
     def names(self):
@@ -602,13 +604,16 @@ class System:
     # ---- running ------------------------------------------------------------------------
     def run(self, stop_time=None, step_size=None, start_time=None, parameters=None, parameter_sets=None,
             outputs=None, algorithm=None, order=None, step_multiples=None, stop_when=None, output_file=None,
-            progress=False, record_every=1):
-        """Run one simulation with fresh FMU instances; see `system_ssp.simulate` for arguments."""
+            progress=False, record_every=1, schedule=True, profile=False):
+        """Run one simulation with fresh FMU instances; see `system_ssp.simulate` for arguments.
+        schedule=False runs a system that has an nc:Schedule with the fixed step instead."""
         from .run import Run
 
         wall0 = time.perf_counter()
         plan = self._plan(stop_time, step_size, start_time, parameters, parameter_sets, outputs, algorithm,
                           order, step_multiples, stop_when, record_every)
+        plan["profile"] = bool(profile)
+        plan["schedule"] = self._plan_schedule(plan) if (schedule and self.desc.master.schedule) else None
         result = Run(self, plan).execute(progress)
         result.wall_time = time.perf_counter() - wall0
         if output_file is not None:
@@ -707,6 +712,44 @@ class System:
         return dict(start=start, stop=stop, h=h, n_steps=n_steps, algorithm=algo, order=order_idx, mult=mult,
                     stops=stops, record=rec, params=params, record_every=int(record_every))
 
+    def _plan_schedule(self, plan):
+        """Resolve the SSD's nc:Schedule against the loaded FMUs (names, types, causality)."""
+        sched = self.desc.master.schedule
+        if plan["algorithm"] != "gauss-seidel":
+            raise SSPError(f"{sched.origin}: nc:Schedule runs with gauss-seidel only, not {plan['algorithm']!r}")
+        if any(k != 1 for k in plan["mult"]):
+            raise SSPError(f"{sched.origin}: nc:Schedule sets its own steps; step multiples cannot be combined "
+                           "with it")
+        names = [c.name for c in self.comps]
+
+        def output(comp, conn, types, what, origin):
+            if comp not in self.by_name:
+                raise SSPError(f"{origin}: {what} names unknown component {comp!r}{_near(comp, names)}")
+            c = self.by_name[comp]
+            if conn not in c.vars:
+                raise SSPError(f"{origin}: {what} names unknown variable {comp}.{conn}{_near(conn, list(c.vars))}")
+            v = c.vars[conn]
+            if v.causality != "output" or v.type not in types:
+                raise SSPError(f"{origin}: {what} {comp}.{conn} must be an output of type "
+                               f"{' or '.join(types)} (it is a {v.causality} {v.type})")
+            return c.index, conn, _KIND[v.type]
+
+        modes = []
+        for m in sched.modes:
+            if m.active is None:
+                active = [True] * len(self.comps)
+            else:
+                unknown = [a for a in m.active if a not in self.by_name]
+                if unknown:
+                    raise SSPError(f"{m.origin}: nc:Mode {m.name!r} active lists unknown component(s) "
+                                   + ", ".join(f"{u!r}{_near(u, names)}" for u in unknown))
+                active = [c.name in m.active for c in self.comps]
+            conds = [output(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}", m.origin)[:2]
+                     + (vals,) for c, v, vals in m.conditions]
+            modes.append(dict(name=m.name, h=m.step_size, active=active, every=m.record_every, conds=conds))
+        events = [output(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events]
+        return dict(modes=modes, events=events, origin=sched.origin)
+
     # ---- cleanup ------------------------------------------------------------------------
     def close(self):
         if getattr(self, "_tmp", None) is not None:
@@ -774,10 +817,10 @@ def _toposort(n, edges):
 
 def simulate(path, stop_time=None, step_size=None, start_time=None, parameters=None, parameter_sets=None,
              outputs=None, algorithm=None, order=None, step_multiples=None, stop_when=None, output_file=None,
-             progress=False, validate=True, record_every=1):
+             progress=False, validate=True, record_every=1, schedule=True, profile=False):
     """Load and run an SSP system; returns a `Result`. See the package docstring."""
     with System(path, validate=validate) as system:
         return system.run(stop_time=stop_time, step_size=step_size, start_time=start_time, parameters=parameters,
                           parameter_sets=parameter_sets, outputs=outputs, algorithm=algorithm, order=order,
                           step_multiples=step_multiples, stop_when=stop_when, output_file=output_file,
-                          progress=progress, record_every=record_every)
+                          progress=progress, record_every=record_every, schedule=schedule, profile=profile)

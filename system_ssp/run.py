@@ -128,6 +128,8 @@ class Run:
             self._instantiate()
             self._prepare()
             self._initialize()
+            if self.plan.get("schedule"):
+                return self._loop_scheduled(progress)
             return self._loop(progress)
         except _Failed as f:
             raise self._error(f.ci, f.call, status=f.status) from None
@@ -454,6 +456,165 @@ class Run:
                       start_time=start, step_size=h, algorithm=p["algorithm"],
                       order=[self.system.comps[i].name for i in order],
                       messages={inst.name: list(inst.messages) for inst in self.instances if inst.messages})
+
+    def _loop_scheduled(self, progress):
+        """Gauss-Seidel with mode-dependent communication steps (nc:Schedule).
+
+        After initialization and after every macro step the master reads the schedule's
+        condition signals and takes the first nc:Mode whose conditions all hold. The next macro
+        step is that mode's stepSize, shortened so that it ends exactly on the earliest
+        nc:NextEvent time ahead (an FMU announcing e.g. a timer expiry) and on the stop time.
+        Only the mode's active components are stepped (set inputs, doStep, get outputs); the
+        others are suspended: not stepped, outputs held. A suspended component's next doStep
+        starts at the current time, so its own clock skips the suspended span (FMI 2.0 does not
+        require contiguous communication points; every FMU here declares
+        canHandleVariableCommunicationStepSize). Rows are recorded every `recordEvery` macro
+        steps of a mode, at every mode change, at a stop condition and at the end."""
+        import time as _time
+
+        p = self.plan
+        sch = p["schedule"]
+        start, stop = p["start"], p["stop"]
+        n = len(self.instances)
+        comps = self.system.comps
+        for ci in range(n):
+            if comps[ci].md.coSimulation is not None and not comps[ci].md.coSimulation.canHandleVariableCommunicationStepSize:
+                raise SimulationError(f"{sch['origin']}: component {comps[ci].name!r} cannot handle a variable "
+                                      "communication step size, which nc:Schedule needs")
+        # condition and event reads, straight through the FMI functions like stop conditions
+        def reader(ci, var, kind):
+            vr = (ctypes.c_uint * 1)(comps[ci].vars[var].valueReference)
+            buf = (_CT[kind] * 1)()
+            return (self.instances[ci].fn[_GET[kind]], self.instances[ci].fmu.component, vr, buf, ci,
+                    f"{comps[ci].name}.{var}")
+
+        modes = []
+        for m in sch["modes"]:
+            conds = [(reader(ci, var, _KIND[comps[ci].vars[var].type]), vals) for ci, var, vals in m["conds"]]
+            order = [ci for ci in p["order"] if m["active"][ci]]
+            modes.append((m["name"], m["h"], order, m["every"], conds))
+        events = [reader(ci, var, "Real") for ci, var in sch["events"]]
+
+        def read(op):
+            fn, c, vr, buf, ci, name = op
+            s = fn(c, vr, 1, buf)
+            if s > 1:
+                raise _Failed(ci, name, s)
+            return buf[0]
+
+        def pick():
+            for mode in modes:
+                if all(int(read(op)) in vals for op, vals in mode[4]):
+                    return mode
+            raise SimulationError(f"{sch['origin']}: no nc:Mode matches at t={self.t:g} s ("
+                                  + ", ".join(f"{op[5]}={int(read(op))}" for mode in modes for op, _ in mode[4])
+                                  + "); end the schedule with an unconditional nc:Mode")
+
+        recs, stop_ops = self.recs, self.stop_ops
+        rows, times = [], []
+
+        def record(t):
+            r = np.empty(self.ncols, dtype=np.float64)
+            for fn, c, vr, m, buf, view, a, b, ci, name in recs:
+                s = fn(c, vr, m, buf)
+                if s > 1:
+                    raise _Failed(ci, name, s)
+                r[a:b] = view
+            rows.append(r)
+            times.append(t)
+
+        def check_stop():
+            for fn, c, vr, m, buf, ci, names in stop_ops:
+                s = fn(c, vr, m, buf)
+                if s > 1:
+                    raise _Failed(ci, "fmi2GetBoolean", s)
+                for j in range(m):
+                    if buf[j]:
+                        return names[j]
+            return None
+
+        profile = p.get("profile")
+        spent = [0.0] * n
+        mode_time = {m[0]: 0.0 for m in modes}
+        mode_steps = {m[0]: 0 for m in modes}
+        perf = _time.perf_counter
+        wall0 = perf()
+        t = start
+        self.t = t
+        record(t)
+        fired = check_stop() if stop_ops else None
+        mode = pick()
+        steps = 0
+        since_record = 0
+        tol = 1e-9 * max(1.0, abs(stop))
+        step_fns = self.step_fns
+        get, set_ = self._get, self._set
+        has_ft = self.has_ft
+        bar = None
+        if progress:
+            try:
+                from tqdm import tqdm
+                bar = tqdm(total=stop - start, file=sys.stderr, unit="s", leave=False, mininterval=0.5)
+            except ImportError:
+                bar = None
+        try:
+            while fired is None and t < stop - tol:
+                name, h, order, every, _ = mode
+                for op in events:
+                    te = read(op)
+                    if te > t + tol and te - t < h:
+                        h = te - t
+                if stop - t < h + tol:
+                    h = stop - t
+                for ci in order:
+                    if profile:
+                        w0 = perf()
+                    set_(ci)
+                    fn, c = step_fns[ci]
+                    s = fn(c, t, h, 1)
+                    if s > 1:
+                        raise _Failed(ci, "fmi2DoStep", s)
+                    get(ci)
+                    if profile:
+                        spent[ci] += perf() - w0
+                for ci in order:
+                    set_(ci)
+                    if has_ft[ci]:
+                        get(ci)
+                t = t + h if stop - (t + h) > tol else stop
+                self.t = t
+                steps += 1
+                since_record += 1
+                mode_time[name] += h
+                mode_steps[name] += 1
+                if stop_ops:
+                    fired = check_stop()
+                nxt = pick()
+                if since_record >= every or nxt is not mode or fired is not None or t >= stop:
+                    record(t)
+                    since_record = 0
+                mode = nxt
+                if bar is not None:
+                    bar.update(t - start - bar.n)
+        finally:
+            if bar is not None:
+                bar.close()
+        if times[-1] != t:
+            record(t)
+        total = perf() - wall0
+        reason = f"stop condition {fired} at t={t:g} s" if fired is not None else "reached stop time"
+        data = self._result_array(np.array(times), np.array(rows).reshape(len(rows), self.ncols))
+        final = self._final()
+        from .master import Result
+        res = Result(data=data, stop_time=t, stop_reason=reason, steps=steps, final=final, wall_time=0.0,
+                     start_time=start, step_size=None, algorithm="gauss-seidel",
+                     order=[comps[i].name for i in p["order"]],
+                     messages={inst.name: list(inst.messages) for inst in self.instances if inst.messages})
+        res.modes = {m: {"steps": mode_steps[m], "simulated_time": mode_time[m]} for m in mode_steps}
+        if profile:
+            res.profile = {"components": {comps[ci].name: spent[ci] for ci in range(n)},
+                           "loop": total, "master": total - sum(spent)}
+        return res
 
     def _result_array(self, times, rec):
         col_of = {name: j for j, name in enumerate(self.rec_names)}

@@ -111,6 +111,27 @@ class MasterSettings:
     order: list = None
     step_multiples: dict = field(default_factory=dict)
     stop_conditions: list = field(default_factory=list)
+    schedule: "Schedule" = None
+    origin: str = ""
+
+
+@dataclass
+class ScheduleMode:
+    """One entry of nc:Schedule: when its conditions hold, step with `step_size` and step only
+    the `active` components (None = all)."""
+    name: str
+    step_size: float
+    active: list = None
+    record_every: int = 1
+    conditions: list = field(default_factory=list)  # [(component, connector, frozenset of ints)]
+    origin: str = ""
+
+
+@dataclass
+class Schedule:
+    """nc:Schedule: mode-dependent communication steps (see system_ssp/__init__.py)."""
+    modes: list = field(default_factory=list)
+    events: list = field(default_factory=list)  # [(component, connector)] of Real outputs
     origin: str = ""
 
 
@@ -421,9 +442,74 @@ def parse_master_annotation(el, namer, settings):
                 if not comp or not conn:
                     raise SSPError(f"{corigin}: nc:StopCondition needs component=\"name\" and connector=\"name\"")
                 settings.stop_conditions.append(f"{comp}.{conn}")
+            elif child.tag == _q("nc", "Schedule"):
+                settings.schedule = _parse_schedule(child, namer)
             else:
                 raise SSPError(f"{corigin}: unknown element {child.tag} in nc:Master "
-                               "(expected nc:Order, nc:StepMultiple, nc:StopCondition)")
+                               "(expected nc:Order, nc:StepMultiple, nc:StopCondition, nc:Schedule)")
+
+
+def _parse_schedule(el, namer):
+    """nc:Schedule: nc:Mode entries (each with nc:When conditions) and nc:NextEvent signals."""
+    def where(e):
+        return f"{namer(e.getroottree().docinfo.URL)}:{e.sourceline}"
+
+    sched = Schedule(origin=where(el))
+    names = set()
+    for child in el:
+        if not isinstance(child.tag, str):
+            continue
+        o = where(child)
+        if child.tag == _q("nc", "NextEvent"):
+            comp, conn = child.get("component"), child.get("connector")
+            if not comp or not conn:
+                raise SSPError(f"{o}: nc:NextEvent needs component=\"name\" and connector=\"name\"")
+            sched.events.append((comp, conn))
+            continue
+        if child.tag != _q("nc", "Mode"):
+            raise SSPError(f"{o}: unknown element {child.tag} in nc:Schedule (expected nc:Mode, nc:NextEvent)")
+        unknown = set(child.attrib) - {"name", "stepSize", "active", "recordEvery"}
+        if unknown:
+            raise SSPError(f"{o}: unknown attribute(s) on nc:Mode: {', '.join(sorted(unknown))}")
+        name = child.get("name")
+        if not name or name in names:
+            raise SSPError(f"{o}: nc:Mode needs a unique name=\"...\", got {name!r}")
+        names.add(name)
+        h = _float_attr(child, "stepSize", o)
+        if h is None or not (h > 0 and math.isfinite(h)):
+            raise SSPError(f"{o}: nc:Mode {name!r} stepSize must be a positive number, got {child.get('stepSize')!r}")
+        try:
+            every = int(child.get("recordEvery", "1"))
+        except ValueError:
+            every = 0
+        if every < 1:
+            raise SSPError(f"{o}: nc:Mode {name!r} recordEvery must be an integer >= 1, got {child.get('recordEvery')!r}")
+        active = child.get("active")
+        mode = ScheduleMode(name=name, step_size=h, active=None if active is None else active.split(),
+                            record_every=every, origin=o)
+        for w in child:
+            if not isinstance(w.tag, str):
+                continue
+            wo = where(w)
+            if w.tag != _q("nc", "When"):
+                raise SSPError(f"{wo}: unknown element {w.tag} in nc:Mode (expected nc:When)")
+            comp, conn, values = w.get("component"), w.get("connector"), w.get("values")
+            try:
+                vals = frozenset(int(v) for v in (values or "").split())
+            except ValueError:
+                vals = frozenset()
+            if not comp or not conn or not vals:
+                raise SSPError(f"{wo}: nc:When needs component=\"name\", connector=\"name\" and "
+                               "values=\"integers\" (Booleans: 0 or 1)")
+            mode.conditions.append((comp, conn, vals))
+        sched.modes.append(mode)
+    if not sched.modes:
+        raise SSPError(f"{sched.origin}: nc:Schedule needs at least one nc:Mode")
+    for m in sched.modes[:-1]:
+        if not m.conditions:
+            raise SSPError(f"{m.origin}: nc:Mode {m.name!r} has no nc:When, so it always matches; only the "
+                           "last mode may be unconditional (modes are tried in order)")
+    return sched
 
 
 def parse_ssd(ssd_path, namer, validate=True):

@@ -9,7 +9,8 @@ import zipfile
 HERE = Path(__file__).resolve().parent
 REPO = HERE.parent.parent
 PY = sys.executable
-SCRIPTS = {"gain": "mf_gain.py", "integrator": "mf_integrator.py", "threshold": "mf_threshold.py"}
+SCRIPTS = {"gain": "mf_gain.py", "integrator": "mf_integrator.py", "threshold": "mf_threshold.py",
+           "timer": "mf_timer.py"}
 
 _BUILD_SCRIPT = r"""
 import json, sys

@@ -1,0 +1,92 @@
+"""Mode-dependent communication steps (nc:Schedule) on small fixture FMUs."""
+from pathlib import Path
+import sys
+
+import numpy as np
+import pytest
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+from master_fixtures import helpers as h  # noqa: E402
+
+import system_ssp  # noqa: E402
+from system_ssp import SSPError  # noqa: E402
+
+USES = {"integ.fmu": "integrator", "gain.fmu": "gain", "timer.fmu": "timer"}
+X0 = ('<ssd:ParameterBinding><ssd:ParameterValues><ssv:ParameterSet version="1.0" name="p"><ssv:Parameters>'
+      '<ssv:Parameter name="x0"><ssv:Real value="1"/></ssv:Parameter></ssv:Parameters></ssv:ParameterSet>'
+      '</ssd:ParameterValues></ssd:ParameterBinding>')
+SCHEDULE = """<nc:Schedule>
+  <nc:Mode name="before" stepSize="0.1"><nc:When component="timer" connector="expired" values="0"/></nc:Mode>
+  <nc:Mode name="after" stepSize="0.25" active="integ timer" recordEvery="{every}"/>
+  <nc:NextEvent component="timer" connector="next_event_time"/>
+</nc:Schedule>"""
+
+
+@pytest.fixture(scope="session")
+def fmus(tmp_path_factory):
+    return h.build_fixture_fmus(tmp_path_factory.mktemp("master_fmus"))
+
+
+def scheduled_system(folder, fmus, schedule=SCHEDULE.format(every=1), expiry=0.35):
+    """integ.x -> gain.u -> gain.y -> integ.u (x' = x), and a timer that expires at `expiry`."""
+    ann = ('<ssd:Annotations><ssc:Annotation type="org.neighbor-cosim.master">'
+           f'<nc:Master xmlns:nc="https://neighbor-cosim.org/ssp/master" stepSize="0.1">{schedule}</nc:Master>'
+           '</ssc:Annotation></ssd:Annotations>')
+    timer_bind = ('<ssd:ParameterBinding><ssd:ParameterValues><ssv:ParameterSet version="1.0" name="t">'
+                  f'<ssv:Parameters><ssv:Parameter name="expiry"><ssv:Real value="{expiry}"/></ssv:Parameter>'
+                  '</ssv:Parameters></ssv:ParameterSet></ssd:ParameterValues></ssd:ParameterBinding>')
+    el = (h.component("integ", "integ.fmu", bindings=X0) + h.component("gain", "gain.fmu")
+          + h.component("timer", "timer.fmu", bindings=timer_bind))
+    co = h.connection("integ.x", "gain.u") + h.connection("gain.y", "integ.u")
+    return h.write_system(folder, fmus, USES, h.ssd_text(el, co, system_extra=ann,
+                                                         experiment='<ssd:DefaultExperiment stopTime="1"/>'))
+
+
+def test_steps_follow_the_mode_and_land_on_events(fmus, tmp_path):
+    r = system_ssp.simulate(scheduled_system(tmp_path, fmus), profile=True)
+    # 0.1 steps until the timer's announced expiry at 0.35 (last one shortened to 0.05), then
+    # 0.25 steps, the last one shortened to end at the stop time.
+    np.testing.assert_allclose(r.data["time"], [0, 0.1, 0.2, 0.3, 0.35, 0.6, 0.85, 1.0], atol=1e-12)
+    assert r.steps == 7 and r.stop_time == 1.0
+    assert r.modes["before"]["steps"] == 4 and r.modes["after"]["steps"] == 3
+    assert r.modes["after"]["simulated_time"] == pytest.approx(0.65)
+    assert r.final["timer.steps"] == 7 and r.final["timer.last_step"] == pytest.approx(0.15)
+    # gain is suspended after the expiry: its output holds x(0.35), so x grows linearly from there
+    x35 = 1.1 * 1.1 * 1.1 * 1.05
+    assert r.data["integ.x"][4] == pytest.approx(x35, rel=1e-12)
+    assert r.final["integ.x"] == pytest.approx(x35 + 0.65 * x35, rel=1e-12)
+    assert r.final["gain.y"] == pytest.approx(x35, rel=1e-12)
+    assert set(r.profile["components"]) == {"integ", "gain", "timer"} and r.profile["master"] >= 0.0
+
+
+def test_record_every_and_fixed_step_fallback(fmus, tmp_path):
+    ssd = scheduled_system(tmp_path, fmus, schedule=SCHEDULE.format(every=2))
+    r = system_ssp.simulate(ssd)
+    # in "after": 0.6 skipped (every 2nd step), 0.85 recorded, 1.0 recorded as the end
+    np.testing.assert_allclose(r.data["time"], [0, 0.1, 0.2, 0.3, 0.35, 0.85, 1.0], atol=1e-12)
+    fixed = system_ssp.simulate(ssd, schedule=False)
+    assert fixed.steps == 10 and fixed.modes is None
+    assert fixed.final["integ.x"] == pytest.approx(1.1 ** 10)
+
+
+@pytest.mark.parametrize("schedule, pattern", [
+    ('<nc:Schedule><nc:Mode name="a" stepSize="0.1"/><nc:Mode name="b" stepSize="1"/></nc:Schedule>',
+     "only the last mode may be unconditional"),
+    ('<nc:Schedule><nc:Mode name="a" stepSize="0"/></nc:Schedule>', "stepSize must be a positive number"),
+    ('<nc:Schedule><nc:Mode name="a" stepSize="1" active="integ nosuch"/></nc:Schedule>',
+     "active lists unknown component"),
+    ('<nc:Schedule><nc:Mode name="a" stepSize="1"><nc:When component="integ" connector="x" values="1"/>'
+     '</nc:Mode><nc:Mode name="b" stepSize="1"/></nc:Schedule>', "must be an output of type Integer"),
+    ('<nc:Schedule><nc:Mode name="a" stepSize="1"/><nc:NextEvent component="timer" connector="expired"/>'
+     '</nc:Schedule>', "must be an output of type Real"),
+    ('<nc:Schedule><nc:Mode name="a" stepSize="1"><nc:When component="timer" connector="expired" values="1"/>'
+     '</nc:Mode></nc:Schedule>', "no nc:Mode matches"),
+])
+def test_bad_schedules(fmus, tmp_path, schedule, pattern):
+    with pytest.raises(SSPError, match=pattern):
+        system_ssp.simulate(scheduled_system(tmp_path, fmus, schedule=schedule))
+
+
+def test_schedule_needs_gauss_seidel(fmus, tmp_path):
+    with pytest.raises(SSPError, match="gauss-seidel only"):
+        system_ssp.simulate(scheduled_system(tmp_path, fmus), algorithm="jacobi")
