@@ -202,7 +202,9 @@ def write_ssd(name, spec, directory=HERE):
     """Write <directory>/<name>.ssd from a spec (see SYSTEMS): components as (instance, FMU
     model identifier, [parameter files in parameters/, without .ssv]), connections as
     (source, output, destination, input, n) with n > 0 for structured names out[1]..out[n] or
-    n = 0 for a scalar, optional "stop" Boolean outputs, "order", "stop_time", "step_size".
+    n = 0 for a scalar, optional "stop" Boolean outputs, "order", "stop_time", "step_size", and
+    "schedule": {"modes": [(name, step, active components or None, recordEvery,
+    [(component, connector, [values])])], "events": [(component, connector)]} for an nc:Schedule.
     libcosim applies only a component's first ParameterBinding: put the one that matters first."""
     all_units = {}
     comp_vars = {}
@@ -246,6 +248,8 @@ def write_ssd(name, spec, directory=HERE):
             f'        <nc:Master xmlns:nc="{MASTER_NS}" stepSize="{dt!r}" algorithm="gauss-seidel">',
             *([f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>'] if spec.get("order") else [])]
     out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec.get("stop", [])]
+    if spec.get("schedule"):
+        out += _schedule_xml(name, spec["schedule"], comp_vars)
     out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
     out.append("  <ssd:Units>")
     for uname in sorted(all_units):
@@ -266,6 +270,39 @@ def write_ssd(name, spec, directory=HERE):
             "  </ssd:DefaultExperiment>"]
     out += ["</ssd:SystemStructureDescription>", ""]
     (directory / f"{name}.ssd").write_text("\n".join(out))
+
+
+def _schedule_xml(name, schedule, comp_vars):
+    """nc:Schedule lines, checked against the FMUs' variables."""
+    def check(comp, var, types):
+        v = comp_vars.get(comp, {}).get(var)
+        if v is None or v.causality != "output" or v.type not in types:
+            raise SystemExit(f"{name}: schedule signal {comp}.{var} must be an output of type {' or '.join(types)}")
+
+    out = ["          <nc:Schedule>"]
+    for mode, step, active, every, when in schedule["modes"]:
+        for comp in active or []:
+            if comp not in comp_vars:
+                raise SystemExit(f"{name}: schedule mode {mode} lists unknown component {comp}")
+        attrs = f'name="{mode}" stepSize="{step!r}"'
+        if active is not None:
+            attrs += f' active="{" ".join(active)}"'
+        if every != 1:
+            attrs += f' recordEvery="{every}"'
+        if not when:
+            out.append(f"            <nc:Mode {attrs}/>")
+            continue
+        out.append(f"            <nc:Mode {attrs}>")
+        for comp, var, values in when:
+            check(comp, var, ("Integer", "Enumeration", "Boolean"))
+            out.append(f'              <nc:When component="{comp}" connector="{var}" '
+                       f'values="{" ".join(str(int(v)) for v in values)}"/>')
+        out.append("            </nc:Mode>")
+    for comp, var in schedule.get("events", []):
+        check(comp, var, ("Real",))
+        out.append(f'            <nc:NextEvent component="{comp}" connector="{var}"/>')
+    out.append("          </nc:Schedule>")
+    return out
 
 
 def main():
