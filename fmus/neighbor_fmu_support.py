@@ -197,3 +197,67 @@ class NeighborSlave(Fmi2Slave):
         self._model = None
         if state["model"] is not None:
             self.model.set_state(state["model"])
+
+
+# ---- atmosphere parameters shared by the Atmosphere, Orbit and OrbitAveraged FMUs ------------
+def atmosphere_parameters(slave):
+    """Declare the shared atmosphere parameters on a NeighborSlave (same names, units and
+    meaning on every FMU that computes a density); `atmosphere_model(slave.values, ...)`
+    builds the model from their values."""
+    slave.parameter("density_model", "jacchia_roberts", None,
+                    "Atmosphere density model: exponential (Vallado Table 8-4), harris_priester (Montenbruck "
+                    "and Gill), msis (NRLMSIS 2.1) or jacchia_roberts (Jacchia 1970 / Roberts, as FreeFlyer)", str)
+    slave.parameter("space_weather_file", "", None,
+                    "CSSI space-weather file (CelesTrak SpaceWx format 1.2) for msis and jacchia_roberts; empty = "
+                    "the bundled copy of 2026-08-22 (observed from 2000, predictions to 2041-10, last entry held "
+                    "after that)", str)
+    slave.parameter("use_constant_space_weather", False, None,
+                    "When true, msis and jacchia_roberts use the constant f107, f107a and ap below instead of "
+                    "the space-weather file", bool)
+    slave.parameter("f107", 150.0, "1",
+                    "Constant daily solar flux F10.7 in solar flux units (1 sfu = 1e-22 W/m2/Hz), 50..400; used "
+                    "when use_constant_space_weather")
+    slave.parameter("f107a", 150.0, "1",
+                    "Constant 81-day mean solar flux F10.7 in solar flux units (1 sfu = 1e-22 W/m2/Hz), 50..400; "
+                    "used when use_constant_space_weather")
+    slave.parameter("ap", 15.0, "1",
+                    "Constant geomagnetic index Ap (daily and 3-hourly), 0..400; used when "
+                    "use_constant_space_weather")
+    slave.parameter("hp_exponent", 0.0, "1",
+                    "Harris-Priester cosine exponent n, 2..6 (2 low inclination, 6 polar); 0 = from the orbit "
+                    "inclination (linear, 2 at 0 deg to 6 at 90 deg), or 4 where the FMU has no orbit")
+
+
+_ATMOSPHERE_CACHE = {}
+
+
+def atmosphere_model(values, inclination=None):
+    """The components.atmosphere density model for the parameter values declared by
+    `atmosphere_parameters` (a mapping name -> value, e.g. slave.values). `inclination` (rad)
+    sets the Harris-Priester exponent when hp_exponent is 0. ValueError naming the parameter
+    for a bad value. A space-weather file is parsed once per path and process."""
+    from components import atmosphere, space_weather
+
+    name = values["density_model"]
+    if name not in atmosphere.MODELS:
+        raise ValueError(f"density_model = {name!r} is unknown; choose one of {', '.join(atmosphere.MODELS)}")
+    n = float(values["hp_exponent"])
+    if n != 0.0 and not (2.0 <= n <= 6.0):
+        raise ValueError(f"hp_exponent = {n!r} must be 0 (from the inclination) or in [2, 6]")
+    sw = None
+    if name in ("msis", "jacchia_roberts"):
+        if values["use_constant_space_weather"]:
+            sw = space_weather.ConstantSpaceWeather(values["f107"], values["f107a"], values["ap"])
+        else:
+            path = values["space_weather_file"]
+            key = os.path.abspath(path) if path else ""
+            if key and not os.path.isfile(key):
+                raise ValueError(f"space_weather_file = {path!r} does not exist")
+            if key not in _ATMOSPHERE_CACHE:
+                try:
+                    _ATMOSPHERE_CACHE[key] = space_weather.SpaceWeather.from_file(path or None)
+                except ValueError as exc:
+                    raise ValueError(f"space_weather_file = {path!r}: {exc}") from None
+            sw = _ATMOSPHERE_CACHE[key]
+    return atmosphere.make_density_model(name, space_weather=sw, inclination=inclination,
+                                         hp_exponent=None if n == 0.0 else n)
