@@ -29,11 +29,17 @@ def _parser():
     r.add_argument("--no-progress", action="store_true")
     r.add_argument("--print-final", action="store_true", help="print all final values")
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
+    r.add_argument("--no-schedule", action="store_true",
+                   help="ignore the system's nc:Schedule and run with the fixed step")
+    r.add_argument("--profile", action="store_true",
+                   help="with an nc:Schedule: print wall time per component and for the master itself")
     i = sub.add_parser("info", help="describe a system")
     i.add_argument("path")
     i.add_argument("--no-validate", action="store_true")
     sub.add_parser("thesis", add_help=False,
                    help="run the NEIGHBOR thesis validation cases and compare with the published numbers")
+    sub.add_parser("deorbit-study", add_help=False,
+                   help="run the thesis de-orbit lifetime study (3 scenarios, with and without the burn)")
     return ap
 
 
@@ -60,11 +66,14 @@ def _parse_multiples(items):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] == ["thesis"]:
-        from . import thesis
+    if argv[:1] in (["thesis"], ["deorbit-study"]):
+        if argv[0] == "thesis":
+            from . import thesis as command
+        else:
+            from . import deorbit_study as command
 
         try:
-            return thesis.main(argv[1:])
+            return command.main(argv[1:])
         except SSPError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
@@ -81,7 +90,7 @@ def main(argv=None):
                 parameters=_parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
                 algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
                 stop_when=args.stop_when, output_file=args.output, progress=not args.no_progress,
-                record_every=args.record_every)
+                record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile)
     except SSPError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
@@ -92,8 +101,17 @@ def main(argv=None):
         print(f"error: unexpected {type(exc).__name__}: {exc}", file=sys.stderr)
         return 3
     print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
-    print(f"steps:       {result.steps} (h = {result.step_size:g} s, {result.algorithm}, order "
-          f"{' '.join(result.order)})")
+    h = f"h = {result.step_size:g} s" if result.step_size is not None else "steps per nc:Schedule mode"
+    print(f"steps:       {result.steps} ({h}, {result.algorithm}, order {' '.join(result.order)})")
+    if result.modes:
+        for name, m in result.modes.items():
+            print(f"  mode {name}: {m['steps']} steps, {m['simulated_time']:g} s simulated")
+    if result.profile:
+        prof = result.profile
+        print(f"wall time by component (set + doStep + get), of {prof['loop']:.3f} s in the step loop:")
+        for name, sec in sorted(prof["components"].items(), key=lambda kv: -kv[1]):
+            print(f"  {name:<16} {sec:8.3f} s")
+        print(f"  {'(master)':<16} {prof['master']:8.3f} s")
     print(f"wall time:   {result.wall_time:.3f} s")
     if args.output:
         print(f"results:     {args.output}")
