@@ -1,0 +1,44 @@
+"""FMU `TorqueSelector` (instance `selector`): passes the torque command of the enabled
+attitude controller (detumble, slew or tracking) to the RCS thrusters.
+
+Wraps components.command_selector.select_command. Direct feedthrough; no state.
+"""
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import command_selector  # noqa: E402 (after use_bundled_components)
+
+
+class _Stateless:
+    def get_state(self):
+        return None
+
+    def set_state(self, state):
+        pass
+
+
+class TorqueSelector(NeighborSlave):
+    description = ("Selects the torque command of the one enabled attitude controller (detumble, slew, "
+                   "de-orbit tracking) for the RCS thrusters; two enabled at once is an error")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        deps = []
+        for name in command_selector.CONTROLLERS:
+            self.input_array(f"torque_cmd_{name}_B", [0.0] * 3, "N.m", f"Torque command of the {name} controller")
+            self.input(f"{name}_enable", False, None, f"The {name} controller is the active one", bool)
+            deps += [f"torque_cmd_{name}_B[{i}]" for i in (1, 2, 3)] + [f"{name}_enable"]
+        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(self._select), "N.m",
+                          "Torque command of the enabled controller (zero when none is enabled)", depends_on=deps)
+
+    def build_model(self):
+        return _Stateless()
+
+    def _select(self):
+        names = command_selector.CONTROLLERS
+        return command_selector.select_command({n: self.vector(f"torque_cmd_{n}_B", 3) for n in names},
+                                               {n: self.values[f"{n}_enable"] for n in names})
+
+    def do_step(self, current_time, step_size):
+        return True
