@@ -1,0 +1,51 @@
+"""FMU `Power` (instance `power`): NEIGHBOR's battery (one LG HG2 cell, 10.8 Wh = 38880 J)
+drained by the components the mission manager switches on.
+
+Wraps components.power.PowerSystem (see its docstring for the load powers, Table 5 vs Table 6
+vs Appendix I, and the exact integration). Inputs: one Boolean per load (held over a step)
+and `solar_power` (W, default 0: NEIGHBOR has no panels; a host may charge it). `load_power`
+depends directly on the Booleans; energy, state_of_charge, energy_used and empty are states.
+"""
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import power  # noqa: E402 (after use_bundled_components)
+
+
+class Power(NeighborSlave):
+    description = ("NEIGHBOR power supply: LG HG2 Li-ion cell (3.0 Ah, 3.6 V, 38880 J) drained by the switched "
+                   "loads of thesis Table 5 (Appendix I duty model); stored energy exact over any step")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("capacity", power.CELL_CAPACITY, "J",
+                       "Battery capacity, > 0 (default 3.0 Ah x 3.6 V = 10.8 Wh = 38880 J)")
+        self.parameter("initial_state_of_charge", 1.0, "1",
+                       "Initial stored energy as a fraction of capacity, in [0, 1]")
+        for name in power.LOADS:
+            self.parameter(f"power_{name}", power.DEFAULT_LOAD_POWER[name], "W",
+                           f"Power drawn by: {power.LOAD_DESCRIPTIONS[name]} (>= 0)")
+        for name in power.LOADS:
+            self.input(name, False, None, f"On/off: {power.LOAD_DESCRIPTIONS[name]}", bool)
+        self.input("solar_power", 0.0, "W", "Charging power from a host (>= 0; default 0, NEIGHBOR has no panels)")
+        m = lambda: self.model  # noqa: E731
+        self.output("energy", lambda: m().energy, "J", "Stored battery energy, in [0, capacity]")
+        self.output("state_of_charge", lambda: m().state_of_charge, "1", "Stored energy / capacity")
+        self.output("load_power", lambda: m().load_power(self._switches()), "W",
+                    "Total power of the loads switched on", depends_on=list(power.LOADS))
+        self.output("energy_used", lambda: m().energy_used, "J",
+                    "Cumulative energy delivered to the loads since the start")
+        self.output("empty", lambda: m().empty, None, "True when the battery is empty (energy 0)", bool)
+
+    def _switches(self):
+        return {name: self.values[name] for name in power.LOADS}
+
+    def build_model(self):
+        v = self.values
+        return power.PowerSystem(v["capacity"], v["initial_state_of_charge"],
+                                 {name: v[f"power_{name}"] for name in power.LOADS})
+
+    def do_step(self, current_time, step_size):
+        self.model.step(self._switches(), step_size, self.values["solar_power"])
+        return True
