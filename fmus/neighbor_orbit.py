@@ -1,0 +1,95 @@
+"""FMU `Orbit` (instance `orbit`): Cowell orbit propagation with EGM96 zonal gravity, drag and thrust.
+
+Wraps components.orbit.CowellOrbit (gravity point mass + J2..J6, drag per thesis Eq. 1 with the
+velocity relative to the rotating atmosphere, thrust F_B rotated to N with q_BN or along -v when
+`retrograde`). Integrated across each communication step with adaptive DOP853 (minutes in coast,
+0.5 s in burns: do_step(t, h) lands exactly on t + h). Inputs are held over a step, and every
+output is a state output (no direct feedthrough). Same connectors as the orbit-averaged
+`OrbitAveraged` FMU, so a system swaps one for the other by replacing one component.
+
+The model keeps simulation time (s since `epoch`) from setup_experiment's start time; the initial
+elements are the osculating elements at that time. `reentered` latches once the geodetic altitude
+falls below reentry_altitude; the model then holds its state (the system's stop signal).
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave, atmosphere_model, atmosphere_parameters, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import orbit, orbit_elements, time_utils  # noqa: E402 (after use_bundled_components)
+
+R_EQ = orbit_elements.R_EQ
+
+
+class Orbit(NeighborSlave):
+    description = ("Cowell orbit propagator (NEIGHBOR thesis Sec. 2.5, Eq. 1): EGM96 J2..J6 gravity, drag "
+                   "with a selectable atmosphere, body-frame or retrograde thrust; adaptive DOP853 across each "
+                   "communication step")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
+                       "Scenario epoch, ISO 8601 UTC; simulation time is seconds since it", str)
+        self.parameter("sma0", R_EQ + 420e3, "m",
+                       "Initial semi-major axis (thesis Table 3: 6798.1363 km); perigee must be above reentry_altitude")
+        self.parameter("ecc0", 0.0, "1", "Initial eccentricity, in [0, 1)")
+        self.parameter("inc0", math.radians(51.6), "rad", "Initial inclination, in [0, pi]")
+        self.parameter("raan0", 0.0, "rad", "Initial right ascension of the ascending node")
+        self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
+        self.parameter("ta0", 0.0, "rad",
+                       "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
+        self.parameter("Cd", 2.2, "1", "Drag coefficient (> 0; thesis Table 2: 2.2)")
+        self.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
+        self.parameter("reentry_altitude", 250e3, "m",
+                       "Geodetic altitude of re-entry (thesis: 250 km); an initial perigee altitude "
+                       "sma0 (1 - ecc0) - 6378136.3 m below it is an error")
+        atmosphere_parameters(self)
+        self.parameter("mu", orbit_elements.MU_EARTH, "m3/s2",
+                       "Earth's gravitational parameter (thesis: 398600.4415 km3/s2), > 0")
+        self.parameter("zonal_degree", 6, None,
+                       "Zonal gravity terms: 0 = point mass only, 2 = J2, ..., 6 = J2..J6 (EGM96)", int)
+        self.parameter("drag", True, None, "Atmospheric drag on (false: gravity and thrust only)", bool)
+
+        self.input_array("F_thrust_B", [0.0, 0.0, 0.0], "N",
+                         "Thrust force in the body frame B, held over a step (rotated to N with q_BN)")
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         "Attitude quaternion of B relative to N, scalar last (A(q) maps N to B)")
+        self.input("retrograde", False, None,
+                   "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
+                   "ignoring q_BN", bool)
+        self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
+
+        out = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731
+        vec = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731
+        self.output_array("r_BN_N", 3, vec("r_BN_N"), "m", "Spacecraft position relative to Earth's centre in N")
+        self.output_array("v_BN_N", 3, vec("v_BN_N"), "m/s", "Spacecraft velocity relative to N, in N")
+        self.output("altitude", out("altitude"), "m", "Geodetic altitude above the WGS-84 ellipsoid")
+        self.output("altitude_spherical", out("altitude_spherical"), "m", "|r| - 6378136.3 m")
+        self.output("latitude", out("latitude"), "rad", "Geodetic latitude (WGS-84)")
+        self.output("longitude", out("longitude"), "rad", "East longitude (GMST Earth-fixed frame), in (-pi, pi]")
+        self.output("sma", out("sma"), "m", "Osculating semi-major axis")
+        self.output("ecc", out("ecc"), "1", "Osculating eccentricity")
+        self.output("perigee_altitude", out("perigee_altitude"), "m", "Osculating a (1 - e) - 6378136.3 m")
+        self.output("apogee_altitude", out("apogee_altitude"), "m", "Osculating a (1 + e) - 6378136.3 m")
+        self.output("density", out("density"), "kg/m3", "Atmospheric density at the current position and time (0 when drag is false)")
+        self.output("reentered", out("reentered"), None,
+                    "Latched true once the geodetic altitude is below reentry_altitude; the model then holds "
+                    "its state", bool)
+
+    def build_model(self):
+        v = self.values
+        if not (0.0 <= v["inc0"] <= math.pi):
+            raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [0, pi]")
+        density = atmosphere_model(v, inclination=v["inc0"]) if v["drag"] else None
+        return orbit.CowellOrbit(
+            epoch=v["epoch"], sma0=v["sma0"], ecc0=v["ecc0"], inc0=v["inc0"], raan0=v["raan0"], argp0=v["argp0"],
+            ta0=v["ta0"], Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],
+            density_model=density, drag=v["drag"], zonal_degree=v["zonal_degree"], mu=v["mu"], t0=self.start_time)
+
+    def do_step(self, current_time, step_size):
+        m = self.model
+        m.set_inputs(self.vector("F_thrust_B", 3), self.vector("q_BN", 4), self.values["retrograde"],
+                     self.values["mass"])
+        m.advance_to(current_time + step_size)
+        return True
