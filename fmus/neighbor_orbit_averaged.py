@@ -1,0 +1,112 @@
+"""FMU `OrbitAveraged` (instance `orbit`): orbit-averaged lifetime propagator (mean elements).
+
+Wraps components.orbit_averaged.OrbitAveraged: mean a, e cos(argp), e sin(argp), i, RAAN and
+argp + M under orbit-averaged drag (Gauss equations, quadrature over the eccentric longitude,
+density from the selected atmosphere model at each node's 3D position), J2 secular drift, and
+thrust through the Gauss equations at the current position (short burns). RK4 with steps of at
+most one day ending on UTC midnights, at most 1 km of semi-major-axis change, 10 s while
+thrusting; do_step(t, h) lands exactly on t + h for any h.
+
+Same inputs and outputs as the Cowell `Orbit` FMU, so a system swaps one for the other by
+replacing one component. Differences in meaning: `sma`, `ecc`, `perigee_altitude` and
+`apogee_altitude` are mean (not osculating) values; r_BN_N / v_BN_N are the two-body state of
+the mean elements; `reentered` latches once the mean perigee altitude a (1 - e) - 6378136.3 m is
+below reentry_altitude, at the crossing time found within the internal step, after which the
+model holds its state. Every output is a state output (no direct feedthrough); inputs are held
+over a step. The initial Keplerian elements are taken as mean elements.
+"""
+import math
+
+from neighbor_fmu_support import NeighborSlave, atmosphere_model, atmosphere_parameters, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import orbit_averaged, orbit_elements, time_utils  # noqa: E402 (after use_bundled_components)
+
+R_EQ = orbit_elements.R_EQ
+
+
+class OrbitAveraged(NeighborSlave):
+    description = ("Orbit-averaged lifetime propagator: mean elements under orbit-averaged drag (Gauss "
+                   "equations, selectable atmosphere), J2 secular drift and thrust; decades in seconds")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
+                       "Scenario epoch, ISO 8601 UTC; simulation time is seconds since it", str)
+        self.parameter("sma0", R_EQ + 420e3, "m",
+                       "Initial mean semi-major axis (thesis Table 3: 6798.1363 km); perigee must be above "
+                       "reentry_altitude")
+        self.parameter("ecc0", 0.0, "1", "Initial mean eccentricity, in [0, 1)")
+        self.parameter("inc0", math.radians(51.6), "rad",
+                       "Initial inclination, in [1e-4, pi - 1e-4] (the element set is singular for equatorial orbits)")
+        self.parameter("raan0", 0.0, "rad", "Initial right ascension of the ascending node")
+        self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
+        self.parameter("ta0", 0.0, "rad",
+                       "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
+        self.parameter("Cd", 2.2, "1", "Drag coefficient (>= 0, <= 10; thesis Table 2: 2.2)")
+        self.parameter("area", 0.02, "m2", "Drag area facing the flow (>= 0; thesis Table 2: 0.02 m2)")
+        self.parameter("reentry_altitude", 250e3, "m",
+                       "Re-entry altitude (thesis: 250 km), compared with the mean perigee altitude; an initial "
+                       "perigee altitude sma0 (1 - ecc0) - 6378136.3 m below it is an error")
+        atmosphere_parameters(self)
+        self.parameter("mu", orbit_elements.MU_EARTH, "m3/s2",
+                       "Earth's gravitational parameter (thesis: 398600.4415 km3/s2), > 0")
+        self.parameter("drag", True, None, "Atmospheric drag on (false: J2 and thrust only, density output 0)",
+                       bool)
+        self.parameter("j2", orbit_averaged.J2, "1",
+                       "J2 of the secular drift of RAAN, argp and M (EGM96 1.0826e-3), in [0, 0.01]; 0 = none")
+        self.parameter("quadrature_nodes", 24, None,
+                       "Nodes of the orbit-average quadrature (trapezoidal in eccentric longitude), 8..512", int)
+        self.parameter("max_step", 86400.0, "s", "Largest internal integration step (> 0); steps also end on "
+                       "UTC midnights")
+        self.parameter("max_da_step", 1000.0, "m", "Largest change of the semi-major axis in one internal step (> 0)")
+        self.parameter("thrust_step", 10.0, "s", "Largest internal step while the thrust is on (> 0)")
+
+        self.input_array("F_thrust_B", [0.0, 0.0, 0.0], "N",
+                         "Thrust force in the body frame B, held over a step (rotated to N with q_BN)")
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         "Attitude quaternion of B relative to N, scalar last (A(q) maps N to B)")
+        self.input("retrograde", False, None,
+                   "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
+                   "ignoring q_BN", bool)
+        self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
+
+        m = lambda: self.model  # noqa: E731
+        self.output_array("r_BN_N", 3, lambda: m().state_vectors()[0], "m",
+                          "Spacecraft position relative to Earth's centre in N (two-body, from the mean elements)")
+        self.output_array("v_BN_N", 3, lambda: m().state_vectors()[1], "m/s",
+                          "Spacecraft velocity relative to N, in N (two-body, from the mean elements)")
+        self.output("altitude", lambda: m().geodetic()[2], "m", "Geodetic altitude above the WGS-84 ellipsoid")
+        self.output("altitude_spherical", lambda: math.sqrt(sum(x * x for x in m().state_vectors()[0])) - R_EQ,
+                    "m", "|r| - 6378136.3 m")
+        self.output("latitude", lambda: m().geodetic()[0], "rad", "Geodetic latitude (WGS-84)")
+        self.output("longitude", lambda: m().geodetic()[1], "rad",
+                    "East longitude (GMST Earth-fixed frame), in (-pi, pi]")
+        self.output("sma", lambda: m().sma, "m", "Mean semi-major axis")
+        self.output("ecc", lambda: m().ecc, "1", "Mean eccentricity")
+        self.output("perigee_altitude", lambda: m().perigee_altitude, "m", "Mean a (1 - e) - 6378136.3 m")
+        self.output("apogee_altitude", lambda: m().apogee_altitude, "m", "Mean a (1 + e) - 6378136.3 m")
+        self.output("density", lambda: m().density(), "kg/m3",
+                    "Atmospheric density at the current position and time (0 when drag is false)")
+        self.output("reentered", lambda: m().reentered, None,
+                    "Latched true once the mean perigee altitude is below reentry_altitude; the model then "
+                    "holds its state", bool)
+
+    def build_model(self):
+        v = self.values
+        inc = v["inc0"]
+        if not (0.0 <= inc <= math.pi):
+            raise ValueError(f"inc0 = {inc!r} rad must be in [1e-4, pi - 1e-4]")
+        density = atmosphere_model(v, inclination=inc) if v["drag"] else None
+        return orbit_averaged.OrbitAveraged(
+            density, epoch=v["epoch"], sma0=v["sma0"], ecc0=v["ecc0"], inc0=inc, raan0=v["raan0"], argp0=v["argp0"],
+            ta0=v["ta0"], Cd=v["Cd"], area=v["area"], reentry_altitude=v["reentry_altitude"], mu=v["mu"],
+            j2=v["j2"], quadrature_nodes=v["quadrature_nodes"], max_step=v["max_step"],
+            max_da_step=v["max_da_step"], thrust_step=v["thrust_step"], t0=self.start_time)
+
+    def do_step(self, current_time, step_size):
+        v = self.values
+        self.model.advance_to(current_time + step_size, self.vector("F_thrust_B", 3), self.vector("q_BN", 4),
+                              v["retrograde"], v["mass"])
+        return True
