@@ -1,0 +1,54 @@
+"""FMU `GroundStation` (instance `ground`): contact geometry between the UIUC ground station and
+the spacecraft, and the ground's final de-orbit confirmation.
+
+Wraps components.ground_station.GroundStation (WGS-84 station, Earth rotation by GMST). Every
+output depends directly on the input r_BN_N (and on the time the model keeps: the start time at
+initialization, t + h after do_step(t, h)).
+"""
+
+from neighbor_fmu_support import NeighborSlave, use_bundled_components
+
+use_bundled_components(__file__)
+
+from components import ground_station as gs, time_utils  # noqa: E402 (after use_bundled_components)
+
+R = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
+
+
+class GroundStation(NeighborSlave):
+    description = ("Ground station at UIUC (40.1020 N, 88.2272 W): elevation, azimuth, range and visibility of "
+                   "the spacecraft, and the ground's final de-orbit confirmation during contacts")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
+                       "Scenario epoch (simulation time 0), ISO 8601 UTC 'YYYY-MM-DDThh:mm:ss[.fff]Z'", str)
+        self.parameter("latitude", gs.UIUC_LATITUDE, "rad", "Station geodetic latitude (WGS-84); default 40.1020 deg N")
+        self.parameter("longitude", gs.UIUC_LONGITUDE, "rad", "Station east longitude; default -88.2272 deg (W)")
+        self.parameter("altitude", gs.UIUC_HEIGHT, "m", "Station height above the WGS-84 ellipsoid, in [-500, 10000]")
+        self.parameter("elevation_mask", 0.0, "rad",
+                       "Minimum elevation for contact, in [-pi/2, pi/2); default 0: the horizon, as the thesis' "
+                       "FreeFlyer station without a mask")
+        self.parameter("confirm_after", 0.0, "s",
+                       "Operators confirm the de-orbit at contacts from this time on (ground_command)")
+        self.input_array("r_BN_N", [gs.geodesy.WGS84_A + 420e3, 0.0, 0.0], "m",
+                         "Spacecraft position relative to Earth's centre in N")
+        look = lambda: self.model.look(self.vector("r_BN_N", 3))  # noqa: E731
+        self.output("visible", lambda: look()[0] >= self.model.elevation_mask, None,
+                    "Spacecraft in contact: elevation >= elevation_mask", bool, depends_on=R)
+        self.output("elevation", lambda: look()[0], "rad", "Elevation of the spacecraft above the station's "
+                    "horizon (ellipsoid normal)", depends_on=R)
+        self.output("azimuth", lambda: look()[1], "rad", "Azimuth of the spacecraft from north toward east, "
+                    "in [0, 2 pi)", depends_on=R)
+        self.output("range", lambda: look()[2], "m", "Distance from the station to the spacecraft", depends_on=R)
+        self.output("ground_command", lambda: self.model.ground_command(self.vector("r_BN_N", 3)), None,
+                    "Ground's final de-orbit confirmation: visible and time >= confirm_after", bool, depends_on=R)
+
+    def build_model(self):
+        v = self.values
+        return gs.GroundStation(v["latitude"], v["longitude"], v["altitude"], v["elevation_mask"],
+                                v["confirm_after"], v["epoch"], self.start_time)
+
+    def do_step(self, current_time, step_size):
+        self.model.advance_to(current_time + step_size)
+        return True
