@@ -299,3 +299,56 @@ def test_fmu_through_fmpy_matches_component(fmu_path, tmp_path):
         fmu.freeInstance()
     with pytest.raises(Exception):
         fmpy.simulate_fmu(str(fmu_path), stop_time=10.0, start_values={"sma0": R_EQ + 200e3})
+
+
+def test_fmu_connectors_equal_the_cowell_orbit_fmu(fmu_path, build_one):
+    """Both FMUs have exactly the same inputs and outputs (names, types, units), so a system
+    swaps them by replacing one component."""
+    cowell = fmpy.read_model_description(str(build_one("neighbor_orbit.py")))
+    mine = fmpy.read_model_description(str(fmu_path))
+
+    def connectors(md):
+        return {v.name: (v.causality, v.type, v.unit) for v in md.modelVariables if v.causality in ("input", "output")}
+
+    assert connectors(mine) == connectors(cowell)
+    params = lambda md: {v.name: (v.type, v.unit) for v in md.modelVariables if v.causality == "parameter"}  # noqa: E731
+    shared = SHARED_PARAMETERS | {"drag", "hp_exponent"}
+    assert {k: v for k, v in params(mine).items() if k in shared} == {k: v for k, v in params(cowell).items()
+                                                                       if k in shared}
+
+
+# ---- cross-check with the Cowell model -----------------------------------------------------------
+def _orbit_mean(model, t_start, value, period, n=48):
+    vals = []
+    for k in range(n):
+        model.advance_to(t_start + k * period / n)
+        vals.append(value(model))
+    return float(np.mean(vals))
+
+
+@pytest.mark.parametrize("zonal_degree, tolerance", [(0, 0.005), (6, 0.05)])
+def test_mean_decay_agrees_with_cowell(zonal_degree, tolerance):
+    """350 km circular, exponential density, 30 days: the decay of the orbit-mean semi-major
+    axis of the Cowell model (components.orbit, osculating a averaged over one orbit at the
+    start and the end) and of the averaged model started from the same mean a.
+
+    Point mass only (zonal_degree 0, j2 0): within 0.5 % (measured 0.1 %). With J2..J6 in
+    Cowell and J2 here: within 5 % (measured 2.6 %: the averaged model rebuilds the orbit by
+    two-body formulae, so its mean geodetic altitude is 0.8 km above the Cowell orbit's at the
+    same mean a, the first-order J2 short-period offset of the radius, and the density there
+    is 1.5 % lower; J3..J6 add their own long-period eccentricity)."""
+    from components import orbit
+
+    dens = atmosphere.make_density_model("exponential")
+    a0, days = R_EQ + 350e3, 30.0
+    period = orbit_elements.period(a0)
+    c = orbit.CowellOrbit(sma0=a0, density_model=dens, zonal_degree=zonal_degree)
+    sma = lambda mdl: mdl.outputs()["sma"]  # noqa: E731
+    s0 = _orbit_mean(c, 0.0, sma, period)
+    c.advance_to(days * 86400.0)
+    s1 = _orbit_mean(c, days * 86400.0, sma, period)
+    av = oa.OrbitAveraged(dens, sma0=s0, j2=J2 if zonal_degree else 0.0)
+    av.advance_to(days * 86400.0)
+    a1 = _orbit_mean(av, days * 86400.0, lambda mdl: mdl.sma, period)
+    assert s1 - s0 < -3000.0  # a few km in a month at 350 km
+    assert (a1 - s0) == pytest.approx(s1 - s0, rel=tolerance)
