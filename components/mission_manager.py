@@ -19,7 +19,10 @@ Modes (`mode`):
                     3 slew to the burn attitude (until slew_done), 4 burn with the attitude held
                     by the tracking controller (until budget_spent) -> MONITORING
   6 MONITORING      microprocessor quiescent; during ground contacts GPS + UHF on to beacon the
-                    position (and downlink stored data) until the battery is empty or re-entry
+                    position (and downlink stored data) until the battery is empty or re-entry.
+                    beacon_interval (default 0: every contact, as Appendix I) lets operators
+                    choose the beacon frequency (section 3.6): a contact is used only if it
+                    starts at least beacon_interval after the start of the last one used
   7 END             battery empty (state_of_charge <= battery_empty_soc) or re-entered
                     (`end_reason` 1 or 2); everything off. Either condition ends the mission
                     from any mode: without power nothing runs, after re-entry nothing is left.
@@ -83,6 +86,7 @@ PARAMETER_DEFAULTS = {
     "initial_mode": IDLE,
     "initial_phase": ATTITUDE_DETERMINATION,
     "listen_while_awaiting": False,
+    "beacon_interval": 0.0,
 }
 INPUT_DEFAULTS = {
     "heartbeat": True, "ground_contact": False, "ground_command": False, "detumble_done": False,
@@ -104,7 +108,7 @@ def check_parameters(params):
                          f"{sorted(PARAMETER_DEFAULTS)}")
     p = dict(PARAMETER_DEFAULTS, **params)
     for name in ("grace_period", "wake_period", "wake_duration", "wake_offset", "attitude_determination_duration",
-                 "battery_empty_soc"):
+                 "battery_empty_soc", "beacon_interval"):
         try:
             p[name] = float(p[name])
         except (TypeError, ValueError):
@@ -122,6 +126,8 @@ def check_parameters(params):
         raise ValueError(f"wake_offset = {p['wake_offset']!r} s must be in [0, wake_period = {p['wake_period']!r} s)")
     if p["attitude_determination_duration"] < 0:
         raise ValueError(f"attitude_determination_duration = {p['attitude_determination_duration']!r} s must be >= 0")
+    if p["beacon_interval"] < 0:
+        raise ValueError(f"beacon_interval = {p['beacon_interval']!r} s must be >= 0 (0: beacon in every contact)")
     if not 0 <= p["battery_empty_soc"] < 1:
         raise ValueError(f"battery_empty_soc = {p['battery_empty_soc']!r} must be in [0, 1)")
     if p["initial_mode"] not in (IDLE, GRACE, AWAITING, CONTACT, DEORBIT, MONITORING):
@@ -161,7 +167,9 @@ class MissionManager:
         self.awake, self.wake_end, self.next_wake_k = False, NO_EVENT, 0
         self.grace_end = self.att_det_end = NO_EVENT
         self.confirmed = False  # ground_command latched during the current final contact
-        self.in_contact = False  # monitoring: the contact flag sampled at the last step start
+        self.in_contact = False  # monitoring: beaconing in the contact sampled at the last step start
+        self.contact_seen = False  # monitoring: ground_contact at the last step start
+        self.last_beacon = None  # monitoring: start of the last contact used for a beacon
         self.heartbeat_lost_at = NO_EVENT  # time of the check that found the heartbeat missing
         self.phase_published = t0  # end of the step that first output the current phase
         mode = self.p["initial_mode"]
@@ -255,9 +263,22 @@ class MissionManager:
                 self._enter_phase(BURN, t)
             elif started and self.phase == BURN and x["budget_spent"]:
                 self._enter(MONITORING, t)
-                self.in_contact = x["ground_contact"]
+                self.contact_seen = False
+                self._monitor_contact(t, x["ground_contact"])
         elif mode == MONITORING:
-            self.in_contact = x["ground_contact"]
+            self._monitor_contact(t, x["ground_contact"])
+
+    def _monitor_contact(self, t, contact):
+        """Beacon in this contact? Decided when it starts, from beacon_interval."""
+        if contact and not self.contact_seen:
+            interval = self.p["beacon_interval"]
+            self.in_contact = (self.last_beacon is None or interval <= 0.0
+                               or t - self.last_beacon >= interval - time_tol(t))
+            if self.in_contact:
+                self.last_beacon = t
+        elif not contact:
+            self.in_contact = False
+        self.contact_seen = contact
 
     def _next_event(self):
         """(time, kind) of the next timed event, or (NO_EVENT, None)."""
@@ -353,7 +374,8 @@ class MissionManager:
 
     # ---- state -----------------------------------------------------------------------------
     _STATE = ("t", "mode", "phase", "end_reason", "mode_entry", "phase_entry", "awake", "wake_end", "next_wake_k",
-              "grace_end", "att_det_end", "confirmed", "in_contact", "heartbeat_lost_at", "phase_published")
+              "grace_end", "att_det_end", "confirmed", "in_contact", "contact_seen", "last_beacon", "heartbeat_lost_at",
+              "phase_published")
 
     def get_state(self):
         return {k: getattr(self, k) for k in self._STATE}

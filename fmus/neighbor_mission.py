@@ -30,6 +30,8 @@ PARAMETERS = (
     ("initial_phase", None, int, f"De-orbit phase at the start time when initial_mode = 5, 1..4 ({mm.PHASE_TABLE})"),
     ("listen_while_awaiting", None, bool, "UHF receiver on while awaiting the final contact (thesis text); false: "
                                           "radio on only during the contact (Appendix I)"),
+    ("beacon_interval", "s", float, "Monitoring: beacon (GPS + UHF) only in a contact starting at least this long "
+                                    "after the last contact used (>= 0; 0: every contact, Appendix I)"),
 )
 INPUTS = (
     ("heartbeat", None, bool, "Host spacecraft heartbeat present (HostSpacecraft.heartbeat)"),

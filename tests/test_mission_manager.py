@@ -269,6 +269,26 @@ def test_end_state_reasons():
     assert (m.mode, m.end_reason) == (mm.END, mm.END_BATTERY)
 
 
+def test_beacon_interval_skips_contacts():
+    """beacon_interval = 1 day: only the first contact starting a day or more after the last
+    beacon is used; 0 (Appendix I) beacons in every contact."""
+    def beacons(interval):
+        m = mm.MissionManager({"initial_mode": mm.MONITORING, "beacon_interval": interval})
+        used, t = [], 0.0
+        # contacts of 600 s starting every 6 h (4 a day) for 3 days, 60 s steps
+        while t < 3 * DAY:
+            contact = (t % (6 * 3600.0)) < 600.0
+            m.step(t, 60.0, {"ground_contact": contact})
+            if m.powered()["gps_receiver"] and (not used or t - used[-1] > 700.0):
+                used.append(t)
+            t += 60.0
+        return used
+    assert beacons(0.0) == [6 * 3600.0 * k for k in range(12)]
+    assert beacons(DAY) == [0.0, DAY, 2 * DAY]
+    with pytest.raises(ValueError, match="beacon_interval"):
+        mm.MissionManager({"beacon_interval": -1.0})
+
+
 def test_state_round_trip():
     env = nominal_env()
     m, _, _ = run(env, 6 * DAY + 3200.0, 600.0, params={"grace_period": GRACE})
