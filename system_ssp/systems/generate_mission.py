@@ -161,9 +161,10 @@ def main():
               "Host heartbeat: lost 5 years after deployment (Appendix I: 1825 days of idle)",
               {"heartbeat_loss_time": IDLE_DAYS * DAY, "heartbeat_return_times": ""})
     write_ssv(params / "mission_manager.ssv", "mission_manager",
-              "Operating modes (Section 3.4): 30-day grace period, 5 s daily wake, 10 min attitude determination",
+              "Operating modes (Section 3.4): 30-day grace period, 5 s daily wake, 10 min attitude determination; "
+              "in monitoring one GPS beacon contact a day (operators choose the frequency, Section 3.6)",
               {"grace_period": GRACE_DAYS * DAY, "wake_period": DAY, "wake_duration": 5.0,
-               "attitude_determination_duration": 600.0})
+               "attitude_determination_duration": 600.0, "beacon_interval": DAY})
     h420 = takeover_altitudes["420km"]
     write_ssv(params / "mission_orbit.ssv", "mission_orbit",
               f"Host orbit at deployment ({MISSION_EPOCH}, 51.6 deg; {h420:.2f} km decays to 420 km by "
