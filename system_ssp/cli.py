@@ -40,6 +40,8 @@ def _parser():
                    help="run the NEIGHBOR thesis validation cases and compare with the published numbers")
     sub.add_parser("deorbit-study", add_help=False,
                    help="run the thesis de-orbit lifetime study (3 scenarios, with and without the burn)")
+    sub.add_parser("mission", add_help=False,
+                   help="run the NEIGHBOR mission from deployment to re-entry and write its figures")
     return ap
 
 
@@ -66,9 +68,11 @@ def _parse_multiples(items):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] in (["thesis"], ["deorbit-study"]):
+    if argv[:1] in (["thesis"], ["deorbit-study"], ["mission"]):
         if argv[0] == "thesis":
             from . import thesis as command
+        elif argv[0] == "mission":
+            from . import mission as command
         else:
             from . import deorbit_study as command
 

@@ -1,0 +1,187 @@
+"""The thesis' de-orbit lifetime study (Section 3.2, Figures 11-13), run through the master.
+
+    python -m system_ssp deorbit-study [--model averaged|cowell] [--density jacchia_roberts]
+                                       [--out results/deorbit_study] [--scenarios 420km,475km,525km]
+
+For each thesis scenario (420 -> 350 km, 475 -> 350 km, 525 -> 300 km perigee; 12 kg, Cd 2.2,
+0.02 m^2, i 51.6 deg, start 2023-01-01) the packed system runs twice: with the NEIGHBOR burn
+(retrograde from t = 0 until the Eq. 2-3 propellant is spent) and without (host alone). A run
+ends at re-entry (orbit.reentered: 250 km). Lifetimes count from the start of the burn, as the
+thesis' "de-orbit times" do.
+
+Systems: `deorbit_lifetime` (OrbitAveraged, the default: the 97-year case takes seconds) or
+`deorbit` (Cowell; about a minute of wall time per simulated year with Jacchia-Roberts, so the
+century-long no-burn cases take long: pick scenarios with --scenarios or cap with --max-years).
+Writes into --out: summary.json, table.md (also printed), <scenario>[_no_burn].csv time series,
+and altitude_<scenario>.png (semi-major-axis altitude a - R_eq vs time, like the thesis' plots of
+"NEIGHBOR.A - Earth.Radius", with perigee altitude shaded).
+"""
+import argparse
+import json
+import math
+import os
+from pathlib import Path
+import sys
+
+from components import propulsion
+
+from .errors import SSPError
+from .master import System, write_csv_atomic
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
+PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
+YEAR = 365.25 * 86400.0
+KM = 1000.0
+SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
+# Section 3.2: (initial altitude km, target perigee km, delta-V m/s, propellant kg, burn min,
+# lifetime without / with NEIGHBOR in years)
+THESIS = {"420km": dict(h0=420.0, target=350.0, delta_v=19.84, propellant=0.564, burn_min=38.74,
+                        life_no_burn=4.38, life_burn=2.20, figure=11),
+          "475km": dict(h0=475.0, target=350.0, delta_v=35.18, propellant=0.982, burn_min=67.42,
+                        life_no_burn=25.04, life_burn=3.44, figure=12),
+          "525km": dict(h0=525.0, target=300.0, delta_v=63.21, propellant=1.707, burn_min=117.20,
+                        life_no_burn=97.41, life_burn=3.19, figure=13)}
+RECORD = ["orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",
+          "orbit.reentered", "atmosphere.density", "propulsion.mass", "propulsion.propellant_used",
+          "propulsion.burn_time", "propulsion.burning"]
+
+
+def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_dir=DEFAULT_SSP_DIR, out=None,
+              max_years=150.0, space_weather_file="", progress=False):
+    """Run the study; returns {run name: summary dict}. Writes files into `out` if given."""
+    if model not in SYSTEMS:
+        raise SSPError(f"unknown model {model!r} (expected one of: {', '.join(SYSTEMS)})")
+    scenarios = list(scenarios or THESIS)
+    unknown = [s for s in scenarios if s not in THESIS]
+    if unknown:
+        raise SSPError(f"unknown scenario(s) {', '.join(unknown)} (expected: {', '.join(THESIS)})")
+    if not (isinstance(max_years, (int, float)) and max_years > 0 and math.isfinite(max_years)):
+        raise SSPError(f"max_years must be a positive number, got {max_years!r}")
+    ssp = Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"
+    if not ssp.is_file():
+        raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
+    overrides = {"orbit.density_model": density, "atmosphere.density_model": density,
+                 "orbit.space_weather_file": space_weather_file, "atmosphere.space_weather_file": space_weather_file}
+    out = Path(out) if out is not None else None
+    if out is not None:
+        out.mkdir(parents=True, exist_ok=True)
+    summary = {}
+    with System(ssp) as system:
+        for name in scenarios:
+            for burn in (True, False):
+                run = name + ("" if burn else "_no_burn")
+                ssv = PARAMETERS / f"deorbit_{run}.ssv"
+                r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
+                               outputs=RECORD, progress=progress)
+                reentered = bool(r.final["orbit.reentered"])
+                ref = THESIS[name]
+                s = {"scenario": name, "burn": burn, "model": model, "density_model": density,
+                     "reentered": reentered, "lifetime_years": r.stop_time / YEAR,
+                     "thesis_lifetime_years": ref["life_burn" if burn else "life_no_burn"],
+                     "steps": r.steps, "wall_time_s": r.wall_time,
+                     "propellant_used_kg": r.final["propulsion.propellant_used"],
+                     "burn_time_min": r.final["propulsion.burn_time"] / 60.0}
+                if burn:
+                    lib = propulsion.deorbit_scenario(ref["h0"] * KM, ref["target"] * KM)
+                    s.update(delta_v_m_s=lib["delta_v"], propellant_kg=lib["propellant"],
+                             burn_time_library_min=lib["burn_time"] / 60.0,
+                             thesis_delta_v_m_s=ref["delta_v"], thesis_propellant_kg=ref["propellant"],
+                             thesis_burn_min=ref["burn_min"])
+                    i_end = int((r.data["propulsion.burning"]).nonzero()[0].max()) + 1 if r.data["propulsion.burning"].any() else 0
+                    s["perigee_after_burn_km"] = float(r.data["orbit.perigee_altitude"][i_end]) / KM
+                summary[run] = s
+                if out is not None:
+                    write_csv_atomic(r.data, out / f"{run}.csv")
+    if out is not None:
+        _write_atomic(out / "summary.json", json.dumps(summary, indent=1))
+        _write_atomic(out / "table.md", table(summary))
+        plot(summary, out)
+    return summary
+
+
+def _write_atomic(path, text):
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def table(summary):
+    lines = ["| scenario | dV m/s (thesis) | propellant kg (thesis) | burn min (thesis) | lifetime no burn y (thesis) "
+             "| lifetime with burn y (thesis) | model |",
+             "|---|---|---|---|---|---|---|"]
+    for name in THESIS:
+        b, n = summary.get(name), summary.get(name + "_no_burn")
+        if b is None or n is None:
+            continue
+
+        def life(s):
+            mark = "" if s["reentered"] else "> "
+            return f"{mark}{s['lifetime_years']:.2f} ({s['thesis_lifetime_years']:.2f})"
+
+        lines.append(f"| {name} | {b['delta_v_m_s']:.2f} ({b['thesis_delta_v_m_s']:.2f}) | "
+                     f"{b['propellant_used_kg']:.3f} ({b['thesis_propellant_kg']:.3f}) | "
+                     f"{b['burn_time_min']:.2f} ({b['thesis_burn_min']:.2f}) | {life(n)} | {life(b)} | "
+                     f"{b['model']}, {b['density_model']} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(summary, out):
+    """altitude_<scenario>.png: a - R_eq (km) vs years since the burn, with and without NEIGHBOR."""
+    import numpy as np
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    r_eq = propulsion.EARTH_RADIUS_EQ
+    for name, ref in THESIS.items():
+        if name not in summary:
+            continue
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        for run, label, color in ((name + "_no_burn", "without NEIGHBOR", "tab:red"), (name, "with NEIGHBOR", "tab:blue")):
+            data = np.genfromtxt(out / f"{run}.csv", delimiter=",", names=True, deletechars="")
+            years = data["time"] / YEAR
+            ax.plot(years, (data["orbit.sma"] - r_eq) / KM, color=color,
+                    label=f"{label}: {summary[run]['lifetime_years']:.2f} y (thesis {summary[run]['thesis_lifetime_years']:.2f} y)")
+            ax.fill_between(years, data["orbit.perigee_altitude"] / KM, (data["orbit.sma"] - r_eq) / KM, color=color,
+                            alpha=0.15, linewidth=0)
+        ax.axhline(250.0, color="k", linestyle=":", linewidth=1, label="re-entry, 250 km")
+        s = summary[name]
+        ax.set_title(f"Orbital lifetime from {ref['h0']:g} km (thesis Fig. {ref['figure']}); {s['model']} orbit, "
+                     f"{s['density_model']}")
+        ax.set_xlabel("years since the start of the burn")
+        ax.set_ylabel("a - R_eq (km); shaded down to perigee")
+        ax.legend(loc="upper right", fontsize=8)
+        ax.grid(alpha=0.3)
+        fig.tight_layout()
+        tmp = out / f".altitude_{name}.png"
+        fig.savefig(tmp, dpi=110, format="png")
+        plt.close(fig)
+        os.replace(tmp, out / f"altitude_{name}.png")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m system_ssp deorbit-study", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--model", choices=list(SYSTEMS), default="averaged")
+    ap.add_argument("--density", default="jacchia_roberts",
+                    help="exponential | harris_priester | msis | jacchia_roberts (default)")
+    ap.add_argument("--space-weather", default="", metavar="FILE",
+                    help="CSSI space-weather file (default: the bundled copy)")
+    ap.add_argument("--scenarios", default=",".join(THESIS), help="comma-separated, e.g. 420km,475km")
+    ap.add_argument("--max-years", type=float, default=150.0)
+    ap.add_argument("--out", default="results/deorbit_study")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--progress", action="store_true")
+    args = ap.parse_args(argv)
+    summary = run_study(args.model, args.density, [s for s in args.scenarios.split(",") if s], args.ssp_dir,
+                        args.out, args.max_years, args.space_weather, args.progress)
+    print(table(summary), end="")
+    total = sum(s["wall_time_s"] for s in summary.values())
+    print(f"wall time: {total:.1f} s for {len(summary)} runs; results in {args.out}")
+    ok = all(s["reentered"] for s in summary.values())
+    return 0 if ok else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

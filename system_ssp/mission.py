@@ -1,0 +1,280 @@
+"""The NEIGHBOR mission from deployment to re-entry, run through the master, with the thesis'
+figures and a summary beside the published numbers.
+
+    python -m system_ssp mission [--scenario 420km] [--orbit cowell|averaged] [--out results/mission]
+
+Runs build/ssp/neighbor_mission.ssp (Cowell orbit) or neighbor_mission_lifetime.ssp (orbit-
+averaged) with the scenario's parameter set (system_ssp/systems/parameters/
+neighbor_mission_<scenario>.ssv), and writes into --out:
+- timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode);
+- summary.json     every computed figure beside the thesis' (also printed as a table);
+- altitude.png (Fig. 11), detumble.png (Fig. 20-22), slew.png (Fig. 27-29), tracking.png
+  (Fig. 43-44), battery.png (Fig. 46), data.png (Fig. 47).
+`--profile` adds the wall time per component and of the master to the summary.
+"""
+import argparse
+import json
+import os
+from pathlib import Path
+import sys
+
+import numpy as np
+
+from .errors import SSPError
+from .master import System, write_csv_atomic
+
+ROOT = Path(__file__).resolve().parents[1]
+DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
+PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
+SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
+SCENARIOS = ("420km", "475km", "525km")
+DAY = 86400.0
+YEAR = 365.25 * DAY
+R_EQ = 6378136.3
+WH = 3600.0
+DEORBIT, MONITORING, END = 5, 6, 7
+AD, DETUMBLE, SLEW, BURN = 1, 2, 3, 4
+# Thesis figures for the 420 km scenario (sections 3.2, 3.3.9, 3.5, 3.6)
+THESIS = {"soc_after_burn_percent": 79.65, "energy_used_Wh": 2.2, "energy_left_Wh": 8.6,
+          "battery_empty_days_after_burn": 14.0, "max_storage_MB": 0.1, "contacts_to_downlink": 2,
+          "tracking_propellant_g": 4.75, "detumble_propellant_g": 2.36, "slew_propellant_g": 4.51,
+          "total_propellant_kg": 0.587, "burn_time_min": 38.74, "lifetime_with_burn_years": 2.20,
+          "detumble_time_s": 9.97, "slew_time_s": 24.84}
+RECORD = (["mission.mode", "mission.phase", "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
+           "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
+           "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
+           "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
+           "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked"]
+          + [f"dynamics.omega_BN_B[{i}]" for i in (1, 2, 3)] + [f"dynamics.euler123[{i}]" for i in (1, 2, 3)]
+          + [f"dynamics.q_BN[{i}]" for i in (1, 2, 3, 4)])
+
+
+def run_mission(scenario="420km", orbit="cowell", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
+                parameters=None, profile=False, progress=False):
+    """Run the mission; returns (summary dict, Result). Writes the results folder if `out`."""
+    if orbit not in SYSTEMS:
+        raise SSPError(f"unknown orbit model {orbit!r} (expected one of: {', '.join(SYSTEMS)})")
+    if scenario not in SCENARIOS:
+        raise SSPError(f"unknown scenario {scenario!r} (expected one of: {', '.join(SCENARIOS)})")
+    ssp = Path(ssp_dir) / f"{SYSTEMS[orbit]}.ssp"
+    if not ssp.is_file():
+        raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
+    ssv = PARAMETERS / f"neighbor_mission_{scenario}.ssv"
+    with System(ssp) as system:
+        r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
+                       outputs=RECORD, profile=profile, progress=progress)
+    s = summarize(r, scenario, orbit)
+    if out is not None:
+        out = Path(out)
+        out.mkdir(parents=True, exist_ok=True)
+        write_csv_atomic(r.data, out / "timeseries.csv")
+        _write_atomic(out / "summary.json", json.dumps(s, indent=1))
+        plot(r.data, s, out)
+    return s, r
+
+
+def _write_atomic(path, text):
+    tmp = path.with_name(path.name + ".tmp")
+    tmp.write_text(text)
+    os.replace(tmp, path)
+
+
+def _first(mask):
+    idx = np.flatnonzero(mask)
+    return int(idx[0]) if idx.size else None
+
+
+def summarize(r, scenario, orbit):
+    d = r.data
+    t = d["time"]
+    mode, phase = d["mission.mode"], d["mission.phase"]
+    s = {"scenario": scenario, "orbit": orbit, "stop_reason": r.stop_reason, "steps": r.steps,
+         "wall_time_s": r.wall_time, "simulated_years": r.stop_time / YEAR, "modes": r.modes,
+         "reentered": bool(r.final["orbit.reentered"])}
+    if r.profile:
+        s["profile_s"] = r.profile
+
+    def phase_start(p):
+        i = _first((mode == DEORBIT) & (phase == p))
+        return None if i is None else (i, float(t[i]))
+
+    i_deorbit = _first(mode == DEORBIT)
+    i_mon = _first(mode == MONITORING)
+    if i_deorbit is None or i_mon is None:
+        s["error"] = "the de-orbit did not complete (no monitoring mode reached)"
+        return s
+    t0 = float(t[i_deorbit])
+    starts = {p: phase_start(p) for p in (AD, DETUMBLE, SLEW, BURN)}
+    t_mon = float(t[i_mon])
+    s["deorbit_start_days"] = t0 / DAY
+    s["altitude_at_deorbit_km"] = float(d["orbit.sma"][i_deorbit] - R_EQ) / 1e3
+    s["attitude_determination_s"] = starts[DETUMBLE][1] - starts[AD][1]
+    s["detumble_time_s"] = starts[SLEW][1] - starts[DETUMBLE][1]
+    s["slew_time_s"] = starts[BURN][1] - starts[SLEW][1]
+    s["burn_time_min"] = (t_mon - starts[BURN][1]) / 60.0
+    rcs = d["thrusters.propellant_mass"]
+    s["detumble_propellant_g"] = 1e3 * float(rcs[starts[SLEW][0]] - rcs[starts[DETUMBLE][0]])
+    s["slew_propellant_g"] = 1e3 * float(rcs[starts[BURN][0]] - rcs[starts[SLEW][0]])
+    s["tracking_propellant_g"] = 1e3 * float(rcs[i_mon] - rcs[starts[BURN][0]])
+    s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
+    s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
+    soc, energy = d["power.state_of_charge"], d["power.energy"]
+    s["soc_after_burn_percent"] = 100.0 * float(soc[i_mon])
+    s["energy_used_Wh"] = float(energy[0] - energy[i_mon]) / WH
+    s["energy_left_Wh"] = float(energy[i_mon]) / WH
+    i_empty = _first((t > t_mon) & (soc <= 0.0))
+    s["battery_empty_days_after_burn"] = None if i_empty is None else (float(t[i_empty]) - t_mon) / DAY
+    store = d["data.storage_used"]
+    s["max_storage_MB"] = float(store.max()) / 1e6
+    s["bytes_lost"] = float(d["data.bytes_lost"][-1])
+    # contacts after the burn until the store is empty: rising edges of ground.visible
+    vis = d["ground.visible"].astype(bool)
+    after = t >= t_mon
+    rises = np.flatnonzero(after[1:] & vis[1:] & ~vis[:-1]) + 1
+    i_clear = _first(after & (store <= 0.5))
+    s["contacts_to_downlink"] = None if i_clear is None else int(np.sum(rises <= i_clear))
+    s["lifetime_with_burn_years"] = (r.stop_time - starts[BURN][1]) / YEAR if s["reentered"] else None
+    s["thesis"] = THESIS if scenario == "420km" else {}
+    return s
+
+
+def table(s):
+    rows = [("de-orbit starts (days after deployment)", s.get("deorbit_start_days"), None, "{:.2f}"),
+            ("altitude at de-orbit start (km)", s.get("altitude_at_deorbit_km"), None, "{:.1f}"),
+            ("attitude determination (s)", s.get("attitude_determination_s"), 600.0, "{:.1f}"),
+            ("detumble time (s)", s.get("detumble_time_s"), "detumble_time_s", "{:.2f}"),
+            ("slew time (s)", s.get("slew_time_s"), "slew_time_s", "{:.2f}"),
+            ("burn time (min)", s.get("burn_time_min"), "burn_time_min", "{:.2f}"),
+            ("detumble propellant (g)", s.get("detumble_propellant_g"), "detumble_propellant_g", "{:.3f}"),
+            ("slew propellant (g)", s.get("slew_propellant_g"), "slew_propellant_g", "{:.3f}"),
+            ("tracking propellant during the burn (g)", s.get("tracking_propellant_g"), "tracking_propellant_g",
+             "{:.3f}"),
+            ("total propellant (kg)", s.get("total_propellant_kg"), "total_propellant_kg", "{:.4f}"),
+            ("battery after the de-orbit maneuver (%)", s.get("soc_after_burn_percent"), "soc_after_burn_percent",
+             "{:.2f}"),
+            ("energy used to the end of the burn (Wh)", s.get("energy_used_Wh"), "energy_used_Wh", "{:.3f}"),
+            ("energy left after the burn (Wh)", s.get("energy_left_Wh"), "energy_left_Wh", "{:.3f}"),
+            ("battery empty after the burn (days)", s.get("battery_empty_days_after_burn"),
+             "battery_empty_days_after_burn", "{:.2f}"),
+            ("largest data storage (MB)", s.get("max_storage_MB"), "max_storage_MB", "{:.4f}"),
+            ("contacts after the burn to downlink", s.get("contacts_to_downlink"), "contacts_to_downlink", "{}"),
+            ("re-entry after the burn (years)", s.get("lifetime_with_burn_years"), "lifetime_with_burn_years",
+             "{:.2f}")]
+    thesis = s.get("thesis", {})
+    lines = ["| quantity | this run | thesis |", "|---|---|---|"]
+    for label, value, ref, fmt in rows:
+        ours = "-" if value is None else fmt.format(value)
+        theirs = ref if isinstance(ref, float) else thesis.get(ref) if ref else None
+        lines.append(f"| {label} | {ours} | {'-' if theirs is None else theirs} |")
+    return "\n".join(lines) + "\n"
+
+
+def plot(d, s, out):
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    t = d["time"]
+    mode, phase = d["mission.mode"], d["mission.phase"]
+
+    def save(fig, name):
+        fig.tight_layout()
+        tmp = out / f".{name}"
+        fig.savefig(tmp, dpi=110, format="png")
+        plt.close(fig)
+        os.replace(tmp, out / name)
+
+    fig, ax = plt.subplots(figsize=(8, 4.5))
+    ax.plot(t / YEAR, (d["orbit.sma"] - R_EQ) / 1e3, label="a - R_eq")
+    ax.plot(t / YEAR, d["orbit.perigee_altitude"] / 1e3, linewidth=0.8, label="perigee altitude")
+    if "deorbit_start_days" in s:
+        ax.axvline(s["deorbit_start_days"] * DAY / YEAR, color="k", linestyle="--", linewidth=1, label="de-orbit")
+    ax.axhline(250.0, color="k", linestyle=":", linewidth=1, label="re-entry, 250 km")
+    ax.set_xlabel("years since deployment")
+    ax.set_ylabel("altitude (km)")
+    ax.set_title(f"NEIGHBOR mission, {s['scenario']} scenario ({s['orbit']} orbit), cf. thesis Fig. 11")
+    ax.legend(fontsize=8)
+    ax.grid(alpha=0.3)
+    save(fig, "altitude.png")
+
+    for name, p, title in (("detumble.png", DETUMBLE, "Detumble (cf. Fig. 20-22)"),
+                           ("slew.png", SLEW, "Slew to the burn attitude (cf. Fig. 27-29)"),
+                           ("tracking.png", BURN, "Burn-attitude tracking (cf. Fig. 43-44)")):
+        sel = (mode == DEORBIT) & (phase == p)
+        if not sel.any():
+            continue
+        tt = t[sel] - t[sel][0]
+        fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        for i in (1, 2, 3):
+            axes[0].plot(tt, np.degrees(d[f"dynamics.omega_BN_B[{i}]"][sel]), label=f"omega_{'xyz'[i - 1]}")
+        axes[0].set_ylabel("rate (deg/s)")
+        if p == SLEW:
+            for i in (1, 2, 3, 4):
+                axes[1].plot(tt, d[f"dynamics.q_BN[{i}]"][sel], label=f"q{i}")
+            axes[1].set_ylabel("quaternion")
+        else:
+            for i in (1, 2, 3):
+                axes[1].plot(tt, np.degrees(d[f"dynamics.euler123[{i}]"][sel]), label=f"1-2-3 angle {i}")
+            axes[1].set_ylabel("angle (deg)")
+        if p == BURN:
+            ax2 = axes[1].twinx()
+            ax2.plot(tt, np.degrees(d["tracking.attitude_error"][sel]), color="k", linewidth=0.7)
+            ax2.set_ylabel("tracking error (deg)")
+        axes[1].set_xlabel("time in phase (s)")
+        for a in axes:
+            a.legend(fontsize=7, loc="upper right")
+            a.grid(alpha=0.3)
+        axes[0].set_title(title)
+        save(fig, name)
+
+    # battery and data from the end of the grace period to a few days after the burn
+    i3 = _first(mode >= 3)
+    if i3 is not None:
+        t_end = (s.get("deorbit_start_days", 0) * DAY) + 3 * DAY
+        sel = (t >= t[i3] - 3600.0) & (t <= t_end)
+        th = (t[sel] - t[i3]) / 3600.0
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        ax.plot(th, 100.0 * d["power.state_of_charge"][sel])
+        ax.set_xlabel("hours since the end of the grace period")
+        ax.set_ylabel("battery state of charge (%)")
+        ax.set_title("Battery through the final contact, de-orbit and first contacts (cf. Fig. 46)")
+        ax.grid(alpha=0.3)
+        save(fig, "battery.png")
+        fig, ax = plt.subplots(figsize=(8, 4.5))
+        ax.plot(th, d["data.storage_used"][sel] / 1e6, label="storage used")
+        ax.fill_between(th, 0, d["ground.visible"][sel].astype(float) * max(d["data.storage_used"].max() / 1e6, 1e-3),
+                        step="post", alpha=0.2, color="tab:green", label="ground contact")
+        ax.set_xlabel("hours since the end of the grace period")
+        ax.set_ylabel("data stored (MB)")
+        ax.set_title("Data storage and downlink (cf. Fig. 47)")
+        ax.legend(fontsize=8)
+        ax.grid(alpha=0.3)
+        save(fig, "data.png")
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="python -m system_ssp mission", description=__doc__.split("\n\n")[0])
+    ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
+    ap.add_argument("--orbit", choices=list(SYSTEMS), default="cowell")
+    ap.add_argument("--out", default="results/mission")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--max-years", type=float, default=40.0)
+    ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--progress", action="store_true")
+    args = ap.parse_args(argv)
+    s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years, profile=args.profile,
+                       progress=args.progress)
+    print(table(s), end="")
+    print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
+    if r.profile:
+        prof = r.profile
+        for name, sec in sorted(prof["components"].items(), key=lambda kv: -kv[1]):
+            print(f"  {name:<12} {sec:8.2f} s")
+        print(f"  {'(master)':<12} {prof['master']:8.2f} s")
+    print(f"results in {args.out}")
+    return 0 if "error" not in s else 1
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,112 @@
+"""Write the de-orbit systems (.ssd) and their parameter files (.ssv).
+
+    python build_fmus.py && python system_ssp/systems/generate_deorbit.py
+
+Two systems with the same wiring, differing in one component (the fidelity swap of issue 3):
+- `deorbit`:          orbit = Orbit (Cowell: J2..J6 zonal gravity, drag at every integrator
+                      stage, adaptive DOP853 inside each communication step);
+- `deorbit_lifetime`: orbit = OrbitAveraged (mean elements, orbit-averaged drag, J2 secular
+                      drift), fast enough for century-long lifetimes.
+Both: propulsion (the main de-orbit thrusters, burning from t = 0 until the scenario's
+propellant budget is spent, thrust along -v through orbit.retrograde since no attitude is
+simulated) and atmosphere (the standalone density FMU on orbit.r_BN_N, so density is a
+recorded signal). The run stops at orbit.reentered (geodetic altitude, or mean perigee for the
+averaged model, below 250 km: the thesis' re-entry point).
+
+Steps (nc:Schedule): 0.5 s while propulsion.burning (the thesis' manoeuvre step, Section 3.2),
+otherwise 1 h (Cowell) or 1 day (averaged). The orbit FMUs integrate adaptively inside a step,
+so the coast step only sets how often outputs are sampled and re-entry is tested.
+
+Parameter files (component-level, the first binding of each component):
+- deorbit_orbit.ssv       epoch 2023-01-01, Table 3 elements for 420 km, Cd 2.2, 0.02 m^2 (Table 2),
+                          Jacchia-Roberts driven by the bundled CSSI space-weather file;
+- deorbit_propulsion.ssv  4 x 25 mN, Isp 42 s, g0 9.81, 12 kg, the 420 km propellant budget.
+Scenario files (names component.variable), one per thesis case, with and without the burn:
+- deorbit_420km.ssv, deorbit_420km_no_burn.ssv, deorbit_475km..., deorbit_525km...:
+  initial semi-major axis R_eq + h0 and, with the burn, the propellant of Eq. 2-3 for the
+  scenario's target perigee (350, 350, 300 km). Without the burn, burn_enable stays false
+  (the host alone, 12 kg).
+"""
+import math
+import sys
+from pathlib import Path
+
+HERE = Path(__file__).resolve().parent
+sys.path.insert(0, str(HERE))
+sys.path.insert(0, str(HERE.parents[1]))
+
+from generate import write_ssd, write_ssv  # noqa: E402
+
+from components import propulsion, time_utils  # noqa: E402
+
+R_EQ = propulsion.EARTH_RADIUS_EQ
+KM = 1000.0
+# (initial altitude, target perigee altitude) in km, thesis Section 3.2
+SCENARIOS = {"420km": (420.0, 350.0), "475km": (475.0, 350.0), "525km": (525.0, 300.0)}
+ORBIT = {"epoch": time_utils.DEFAULT_EPOCH, "sma0": R_EQ + 420.0 * KM, "ecc0": 0.0, "inc0": math.radians(51.6),
+         "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": 2.2, "area": 0.02, "reentry_altitude": 250.0 * KM,
+         "density_model": "jacchia_roberts", "space_weather_file": "", "use_constant_space_weather": False}
+BURN_STEP = 0.5  # s, thesis Section 3.2
+COAST_STEP = {"deorbit": 3600.0, "deorbit_lifetime": 86400.0}
+STOP_TIME = 150.0 * 365.25 * 86400.0  # longer than the 97-year case
+
+
+def scenario(h0_km, target_km, burn):
+    params = {"orbit.sma0": R_EQ + h0_km * KM, "propulsion.burn_enable": burn}
+    if burn:
+        params["propulsion.propellant_budget"] = propulsion.deorbit_scenario(h0_km * KM, target_km * KM)["propellant"]
+    return params
+
+
+def system(orbit_fmu, coast_step):
+    return {
+        "description": f"NEIGHBOR de-orbit: {orbit_fmu} orbit, main de-orbit thrusters (retrograde burn to the "
+                       "propellant budget), atmosphere density; stops at re-entry (250 km)",
+        "components": [("propulsion", "Propulsion", ["deorbit_propulsion"]),
+                       ("orbit", orbit_fmu, ["deorbit_orbit"]),
+                       ("atmosphere", "Atmosphere", ["deorbit_atmosphere"])],
+        "connections": [("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
+                        ("propulsion", "mass", "orbit", "mass", 0),
+                        ("orbit", "r_BN_N", "atmosphere", "r_BN_N", 3)],
+        "order": ["propulsion", "orbit", "atmosphere"],
+        "stop": [("orbit", "reentered")],
+        "stop_time": STOP_TIME,
+        "step_size": coast_step,
+        "schedule": {"modes": [("burn", BURN_STEP, None, 60, [("propulsion", "burning", [1])]),
+                               ("coast", coast_step, None, 1, [])]},
+    }
+
+
+def main():
+    params = HERE / "parameters"
+    orbit = dict(ORBIT, retrograde=True)
+    write_ssv(params / "deorbit_orbit.ssv", "deorbit_orbit",
+              "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
+              "space weather); retrograde thrust since no attitude is simulated", orbit)
+    write_ssv(params / "deorbit_atmosphere.ssv", "deorbit_atmosphere",
+              "Density signal: the same model and space weather as the orbit",
+              {k: ORBIT[k] for k in ("epoch", "density_model", "space_weather_file", "use_constant_space_weather")})
+    dv = propulsion.deorbit_scenario(420.0 * KM, 350.0 * KM)
+    write_ssv(params / "deorbit_propulsion.ssv", "deorbit_propulsion",
+              "Main de-orbit thrusters (4 x 25 mN, Isp 42 s, g0 9.81; thesis Section 3.2, Appendix A), 12 kg, "
+              "the 420 km -> 350 km propellant budget (Eq. 2-3)",
+              {"thrust_per_thruster": propulsion.THRUST_PER_THRUSTER, "n_thrusters": propulsion.N_THRUSTERS,
+               "isp": propulsion.ISP, "g0": propulsion.G0, "mass0": propulsion.MASS0,
+               "propellant_budget": dv["propellant"]})
+    for name, (h0, target) in SCENARIOS.items():
+        write_ssv(params / f"deorbit_{name}.ssv", f"deorbit_{name}",
+                  f"Thesis scenario {h0:g} km -> {target:g} km perigee, with the NEIGHBOR burn", scenario(h0, target, True))
+        write_ssv(params / f"deorbit_{name}_no_burn.ssv", f"deorbit_{name}_no_burn",
+                  f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, 12 kg)", scenario(h0, target, False))
+    # deorbit_lifetime_*.ssv are the same scenario files under the lifetime system's name
+    for name in SCENARIOS:
+        for suffix in ("", "_no_burn"):
+            src = params / f"deorbit_{name}{suffix}.ssv"
+            (params / f"deorbit_lifetime_{name}{suffix}.ssv").write_text(src.read_text())
+    write_ssd("deorbit", system("Orbit", COAST_STEP["deorbit"]))
+    write_ssd("deorbit_lifetime", system("OrbitAveraged", COAST_STEP["deorbit_lifetime"]))
+    print(f"wrote deorbit.ssd, deorbit_lifetime.ssd and their parameter sets in {HERE}")
+
+
+if __name__ == "__main__":
+    main()
