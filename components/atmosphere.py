@@ -262,3 +262,46 @@ class MsisModel(DensityModel):
                                np.array([h / 1e3]), np.array([f107]), np.array([f107a]), np.array(aps),
                                version=2.1)
         return float(out[0, 0])  # Variable.MASS_DENSITY, kg/m^3
+
+
+# ---- a density model on the simulation clock (what the Atmosphere FMU wraps) -------------------
+class AtmosphereAtEpoch:
+    """A density model evaluated at simulation time t (s since `epoch`, ISO 8601 UTC).
+
+    State: the time t only (the model itself is fixed by its parameters)."""
+
+    def __init__(self, model, epoch, t0=0.0):
+        from . import time_utils
+
+        self.model = model
+        self.epoch = time_utils.parse_epoch(epoch, "epoch")
+        self._jd_epoch = time_utils.julian_date(self.epoch)
+        self.t = time_utils.check_time(t0, "start time")
+        sw = getattr(model, "space_weather", None)
+        if sw is not None:  # an epoch before the space-weather data is an error now, not mid-run
+            try:
+                sw._row(self.jd())
+            except ValueError as exc:
+                raise ValueError(f"epoch = {epoch!r}: {exc}") from None
+
+    def jd(self, t=None):
+        return self._jd_epoch + (self.t if t is None else float(t)) / 86400.0
+
+    def density(self, r_N):
+        """kg/m^3 at the N position r_N (m) at the current time."""
+        return self.model.density(r_N, self.jd())
+
+    def altitude(self, r_N):
+        """Geodetic altitude (m, WGS-84) of r_N at the current time."""
+        return geodesy.geodetic_from_inertial(tuple(_as_position(r_N)), self.jd())[2]
+
+    def advance_to(self, t):
+        from . import time_utils
+
+        self.t = time_utils.check_time(t, "time")
+
+    def get_state(self):
+        return {"t": self.t}
+
+    def set_state(self, state):
+        self.advance_to(state["t"])

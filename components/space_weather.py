@@ -139,8 +139,10 @@ class _IndexSource:
         return float(self._row(jd_utc)[self._cols(kind)[0]])
 
     def f107_previous_day(self, jd_utc, kind="observed"):
-        """F10.7 (sfu) of the day before the day of jd_utc (what NRLMSIS takes)."""
-        return float(self._row(jd_utc)[self._cols(kind)[1]])
+        """F10.7 (sfu) of the day before the day of jd_utc (what NRLMSIS takes); after the last
+        entry, the last entry's F10.7 (held)."""
+        row = self._row(jd_utc)
+        return float(row[self._cols(kind)[0 if self.past_end(jd_utc) else 1]])
 
     def f107a(self, jd_utc, kind="observed"):
         """81-day centred mean of F10.7 (sfu) at the day of jd_utc."""
