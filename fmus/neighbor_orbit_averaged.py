@@ -56,7 +56,7 @@ class OrbitAveraged(NeighborSlave):
                        bool)
         self.parameter("j2", orbit_averaged.J2, "1",
                        "J2 of the secular drift of RAAN, argp and M (EGM96 1.0826e-3), in [0, 0.01]; 0 = none")
-        self.parameter("quadrature_nodes", 24, None,
+        self.parameter("quadrature_nodes", 16, None,
                        "Nodes of the orbit-average quadrature (trapezoidal in eccentric longitude), 8..512", int)
         self.parameter("max_step", 86400.0, "s", "Largest internal integration step (> 0); steps also end on "
                        "UTC midnights")
