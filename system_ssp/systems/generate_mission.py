@@ -140,6 +140,15 @@ def system(orbit_fmu):
         "components": comps,
         "connections": conns,
         "stop": [("orbit", "reentered")],
+        # Gauss-Seidel order. The mission manager decides at a step's start from its inputs
+        # there; components stepped after it see that decision for the step (the controllers,
+        # the burn). Power and data integrate the loads and recording over the step, so they
+        # step before it and see the states held at the step's start; a timed event the manager
+        # reaches at the step's end (a wake-up) applies from then on, not to the step before.
+        # The rest follow the feedthrough edges (propulsion -> orbit, orbit -> ground,
+        # controllers -> selector -> thrusters -> dynamics).
+        "order": ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking",
+                  "selector", "thrusters", "dynamics"],
         "stop_time": 40.0 * 365.25 * DAY,
         "step_size": 3600.0,
         "schedule": {"modes": [
