@@ -47,20 +47,29 @@ def enu_axes(lat, lon):
     return (-so, co, 0.0), (-sl * co, -sl * so, cl), (cl * co, cl * so, sl)
 
 
+# A spacecraft below elevation_mask - 20 deg needs at least 448 s to reach the mask: the shortest
+# rise from -20 deg to 0 deg over 3 days of a 420 km, 51.6 deg circular orbit at 2 s resolution
+# (five RAANs), 450 s for a 300 km orbit. A master stepping at most 240 s while near_contact is
+# false therefore cannot miss the start of a contact in such orbits.
+APPROACH_MARGIN = math.radians(20.0)
+
+
 class GroundStation(time_utils.Clock):
     def __init__(self, latitude=UIUC_LATITUDE, longitude=UIUC_LONGITUDE, height=UIUC_HEIGHT, elevation_mask=0.0,
-                 confirm_after=0.0, epoch=time_utils.DEFAULT_EPOCH, t0=0.0):
+                 confirm_after=0.0, epoch=time_utils.DEFAULT_EPOCH, t0=0.0, approach_margin=APPROACH_MARGIN):
         checks = (("latitude", latitude, -math.pi / 2, math.pi / 2, "[-pi/2, pi/2] rad"),
                   ("longitude", longitude, -2 * math.pi, 2 * math.pi, "[-2 pi, 2 pi] rad"),
                   ("height", height, -500.0, 10000.0, "[-500, 10000] m"),
                   ("elevation_mask", elevation_mask, -math.pi / 2, math.pi / 2, "[-pi/2, pi/2) rad"),
-                  ("confirm_after", confirm_after, -math.inf, math.inf, "finite s"))
+                  ("confirm_after", confirm_after, -math.inf, math.inf, "finite s"),
+                  ("approach_margin", approach_margin, 0.0, math.pi, "[0, pi] rad"))
         for name, value, lo, hi, text in checks:
             value = float(value)
             if not (math.isfinite(value) and lo <= value <= hi) or (name == "elevation_mask" and value == hi):
                 raise ValueError(f"{name} = {value!r} must be in {text}")
         self.latitude, self.longitude, self.height = float(latitude), float(longitude), float(height)
         self.elevation_mask, self.confirm_after = float(elevation_mask), float(confirm_after)
+        self.approach_margin = float(approach_margin)
         self.jd0 = time_utils.julian_date(epoch)  # ValueError naming "epoch" if it does not parse
         self.r_site_E = earth_fixed_from_geodetic(self.latitude, self.longitude, self.height)
         self.axes = enu_axes(self.latitude, self.longitude)
@@ -91,6 +100,11 @@ class GroundStation(time_utils.Clock):
 
     def visible(self, r_N, t=None):
         return self.look(r_N, t)[0] >= self.elevation_mask
+
+    def near_contact(self, r_N, t=None):
+        """Elevation above elevation_mask - approach_margin: a contact may begin soon. A master
+        can step coarsely while this is false (see APPROACH_MARGIN)."""
+        return self.look(r_N, t)[0] > self.elevation_mask - self.approach_margin
 
     def ground_command(self, r_N, t=None):
         t = self.t if t is None else float(t)

@@ -31,6 +31,9 @@ class GroundStation(NeighborSlave):
                        "FreeFlyer station without a mask")
         self.parameter("confirm_after", 0.0, "s",
                        "Operators confirm the de-orbit at contacts from this time on (ground_command)")
+        self.parameter("approach_margin", gs.APPROACH_MARGIN, "rad",
+                       "near_contact is true above elevation_mask - approach_margin, in [0, pi]; default 20 deg "
+                       "(a 300-420 km orbit needs at least 448 s from there to the mask)")
         self.input_array("r_BN_N", [gs.geodesy.WGS84_A + 420e3, 0.0, 0.0], "m",
                          "Spacecraft position relative to Earth's centre in N")
         look = lambda: self.model.look(self.vector("r_BN_N", 3))  # noqa: E731
@@ -41,13 +44,15 @@ class GroundStation(NeighborSlave):
         self.output("azimuth", lambda: look()[1], "rad", "Azimuth of the spacecraft from north toward east, "
                     "in [0, 2 pi)", depends_on=R)
         self.output("range", lambda: look()[2], "m", "Distance from the station to the spacecraft", depends_on=R)
+        self.output("near_contact", lambda: self.model.near_contact(self.vector("r_BN_N", 3)), None,
+                    "A contact may begin soon: elevation > elevation_mask - approach_margin", bool, depends_on=R)
         self.output("ground_command", lambda: self.model.ground_command(self.vector("r_BN_N", 3)), None,
                     "Ground's final de-orbit confirmation: visible and time >= confirm_after", bool, depends_on=R)
 
     def build_model(self):
         v = self.values
         return gs.GroundStation(v["latitude"], v["longitude"], v["altitude"], v["elevation_mask"],
-                                v["confirm_after"], v["epoch"], self.start_time)
+                                v["confirm_after"], v["epoch"], self.start_time, v["approach_margin"])
 
     def do_step(self, current_time, step_size):
         self.model.advance_to(current_time + step_size)

@@ -94,7 +94,9 @@ announce timers: a daily wake-up, the end of a grace period) and on the stop tim
 lists the components stepped in that mode (default: all); the others are suspended: not
 stepped, outputs held, inputs not set, and their next doStep starts at the then-current time
 (FMI 2.0 does not require contiguous communication points; every component must declare
-canHandleVariableCommunicationStepSize). Gauss-Seidel only; no step multiples. Rows are
+canHandleVariableCommunicationStepSize). `every="comp:k ..."` steps a slow component only every
+k-th step of the mode, ahead of the master by k stepSize with its inputs held (like step
+multiples); otherwise each component's communication points are contiguous. Gauss-Seidel only; no step multiples. Rows are
 recorded every `recordEvery` steps of a mode, at each mode change, at a stop and at the end.
 `Result.modes` gives steps and simulated time per mode; `profile=True` adds `Result.profile`
 (wall seconds per component for set + doStep + get, and the master's own share).

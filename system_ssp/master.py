@@ -746,7 +746,17 @@ class System:
                 active = [c.name in m.active for c in self.comps]
             conds = [output(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}", m.origin)[:2]
                      + (vals,) for c, v, vals in m.conditions]
-            modes.append(dict(name=m.name, h=m.step_size, active=active, every=m.record_every, conds=conds))
+            mult = [1] * len(self.comps)
+            for comp, k in m.every.items():
+                if comp not in self.by_name:
+                    raise SSPError(f"{m.origin}: nc:Mode {m.name!r} every names unknown component "
+                                   f"{comp!r}{_near(comp, names)}")
+                if not active[self.by_name[comp].index]:
+                    raise SSPError(f"{m.origin}: nc:Mode {m.name!r} every names {comp!r}, which is not active "
+                                   "in that mode")
+                mult[self.by_name[comp].index] = k
+            modes.append(dict(name=m.name, h=m.step_size, active=active, every=m.record_every, conds=conds,
+                              mult=mult))
         events = [output(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events]
         return dict(modes=modes, events=events, origin=sched.origin)
 

@@ -462,14 +462,26 @@ class Run:
 
         After initialization and after every macro step the master reads the schedule's
         condition signals and takes the first nc:Mode whose conditions all hold. The next macro
-        step is that mode's stepSize, shortened so that it ends exactly on the earliest
-        nc:NextEvent time ahead (an FMU announcing e.g. a timer expiry) and on the stop time.
-        Only the mode's active components are stepped (set inputs, doStep, get outputs); the
-        others are suspended: not stepped, outputs held. A suspended component's next doStep
-        starts at the current time, so its own clock skips the suspended span (FMI 2.0 does not
-        require contiguous communication points; every FMU here declares
-        canHandleVariableCommunicationStepSize). Rows are recorded every `recordEvery` macro
-        steps of a mode, at every mode change, at a stop condition and at the end."""
+        step [t, t + h] is that mode's stepSize, shortened so that it ends exactly on the
+        earliest nc:NextEvent time ahead (an FMU announcing e.g. a timer expiry) and on the stop
+        time. Each component keeps its own time t_c:
+        - active, every = 1: stepped from t_c to t + h (t_c = t, or a little before when it
+          ran ahead in an earlier mode; communication points stay contiguous);
+        - active, every = k > 1 (nc:Mode every="comp:k"): stepped when due (t_c <= t) from t_c
+          to t + k stepSize, i.e. ahead of the master with its inputs held from t (like fixed-
+          step multiples); until the master reaches t_c it is not stepped again;
+        - not active in the mode: suspended, not stepped, outputs held, inputs not set. When it
+          becomes active again its clock jumps to the current time: its next doStep starts
+          there, and the suspended span is skipped, not integrated (FMI 2.0 does not require
+          contiguous communication points; every component must declare
+          canHandleVariableCommunicationStepSize).
+        After the steps, direct-feedthrough components whose outputs the schedule or a stop
+        condition watches, or that feed a component stepping before them, get their inputs again
+        and their outputs are read (so conditions, stop signals and the next steps see values at
+        t + h); the rest is brought up to date on recorded rows (every active component), and
+        inputs are always set right before a doStep. Rows are
+        recorded every `recordEvery` macro steps of a mode, at every mode change, at a stop
+        condition and at the end."""
         import time as _time
 
         p = self.plan
@@ -481,18 +493,42 @@ class Run:
             if comps[ci].md.coSimulation is not None and not comps[ci].md.coSimulation.canHandleVariableCommunicationStepSize:
                 raise SimulationError(f"{sch['origin']}: component {comps[ci].name!r} cannot handle a variable "
                                       "communication step size, which nc:Schedule needs")
-        # condition and event reads, straight through the FMI functions like stop conditions
-        def reader(ci, var, kind):
+
+        def reader(ci, var, kind):  # straight through the FMI functions, like stop conditions
             vr = (ctypes.c_uint * 1)(comps[ci].vars[var].valueReference)
             buf = (_CT[kind] * 1)()
             return (self.instances[ci].fn[_GET[kind]], self.instances[ci].fmu.component, vr, buf, ci,
                     f"{comps[ci].name}.{var}")
 
+        consumers = [set() for _ in range(n)]
+        producers = [set() for _ in range(n)]
+        for lk in self.system.links:
+            consumers[lk.src].add(lk.dst)
+            producers[lk.dst].add(lk.src)
+        watched = {ci for ci, _ in p["stops"]} | {ci for ci, _ in sch["events"]}
+        watched |= {ci for m in sch["modes"] for ci, _, _ in m["conds"]}
+
+        def refreshed(order):
+            """Feedthrough components whose outputs must be brought to t + h after the steps:
+            those watched by the schedule or a stop condition, those read by a component that
+            steps before them, and (transitively) their feedthrough producers. The others are
+            read fresh in the next step pass anyway."""
+            pos = {ci: k for k, ci in enumerate(order)}
+            need = {ci for ci in order if self.has_ft[ci]
+                    and (ci in watched or any(cj in pos and pos[cj] < pos[ci] for cj in consumers[ci]))}
+            grow = list(need)
+            while grow:
+                for cj in producers[grow.pop()]:
+                    if cj in pos and self.has_ft[cj] and cj not in need:
+                        need.add(cj)
+                        grow.append(cj)
+            return [ci for ci in order if ci in need]
+
         modes = []
         for m in sch["modes"]:
             conds = [(reader(ci, var, _KIND[comps[ci].vars[var].type]), vals) for ci, var, vals in m["conds"]]
             order = [ci for ci in p["order"] if m["active"][ci]]
-            modes.append((m["name"], m["h"], order, m["every"], conds))
+            modes.append((m["name"], m["h"], order, m["every"], conds, m["mult"], refreshed(order)))
         events = [reader(ci, var, "Real") for ci, var in sch["events"]]
 
         def read(op):
@@ -512,8 +548,18 @@ class Run:
 
         recs, stop_ops = self.recs, self.stop_ops
         rows, times = [], []
+        set_, get = self._set, self._get
+
+        has_ft = self.has_ft
 
         def record(t):
+            # every active component's inputs and feedthrough outputs as they stand at t (the
+            # step loop refreshes only what the next steps need); rows are also recorded at each
+            # mode change, so a component suspended by the change holds its outputs at t
+            for ci in active_order:
+                set_(ci)
+                if has_ft[ci]:
+                    get(ci)
             r = np.empty(self.ncols, dtype=np.float64)
             for fn, c, vr, m, buf, view, a, b, ci, name in recs:
                 s = fn(c, vr, m, buf)
@@ -541,15 +587,16 @@ class Run:
         wall0 = perf()
         t = start
         self.t = t
+        tc = [start] * n  # each component's own time
+        mode = pick()
+        active_order = mode[2]
+        suspended = [ci not in active_order for ci in range(n)]
         record(t)
         fired = check_stop() if stop_ops else None
-        mode = pick()
         steps = 0
         since_record = 0
         tol = 1e-9 * max(1.0, abs(stop))
         step_fns = self.step_fns
-        get, set_ = self._get, self._set
-        has_ft = self.has_ft
         bar = None
         if progress:
             try:
@@ -559,29 +606,40 @@ class Run:
                 bar = None
         try:
             while fired is None and t < stop - tol:
-                name, h, order, every, _ = mode
+                name, h_mode, order, every, _, mult, ft_order = mode
+                active_order = order
+                h = h_mode
                 for op in events:
                     te = read(op)
                     if te > t + tol and te - t < h:
                         h = te - t
                 if stop - t < h + tol:
                     h = stop - t
+                t1 = t + h if stop - (t + h) > tol else stop
                 for ci in order:
+                    if suspended[ci]:
+                        tc[ci] = t  # back from suspension: the clock jumps to now
+                        suspended[ci] = False
+                    t_c = tc[ci]
+                    if t_c > t + tol:
+                        continue  # ahead of the master (stepped with a multiple)
+                    k = mult[ci]
+                    end = t1 if k == 1 else min(t + k * h_mode, stop)
                     if profile:
                         w0 = perf()
                     set_(ci)
                     fn, c = step_fns[ci]
-                    s = fn(c, t, h, 1)
+                    s = fn(c, t_c, end - t_c, 1)
                     if s > 1:
                         raise _Failed(ci, "fmi2DoStep", s)
                     get(ci)
+                    tc[ci] = end
                     if profile:
                         spent[ci] += perf() - w0
-                for ci in order:
+                for ci in ft_order:
                     set_(ci)
-                    if has_ft[ci]:
-                        get(ci)
-                t = t + h if stop - (t + h) > tol else stop
+                    get(ci)
+                t = t1
                 self.t = t
                 steps += 1
                 since_record += 1
@@ -590,6 +648,11 @@ class Run:
                 if stop_ops:
                     fired = check_stop()
                 nxt = pick()
+                if nxt is not mode:
+                    active_now = set(nxt[2])
+                    for ci in range(n):
+                        if ci not in active_now:
+                            suspended[ci] = True
                 if since_record >= every or nxt is not mode or fired is not None or t >= stop:
                     record(t)
                     since_record = 0
@@ -601,6 +664,8 @@ class Run:
                 bar.close()
         if times[-1] != t:
             record(t)
+        for ci in mode[2]:
+            set_(ci)
         total = perf() - wall0
         reason = f"stop condition {fired} at t={t:g} s" if fired is not None else "reached stop time"
         data = self._result_array(np.array(times), np.array(rows).reshape(len(rows), self.ncols))

@@ -123,6 +123,7 @@ class ScheduleMode:
     step_size: float
     active: list = None
     record_every: int = 1
+    every: dict = field(default_factory=dict)  # component -> k: stepped every k-th step of the mode
     conditions: list = field(default_factory=list)  # [(component, connector, frozenset of ints)]
     origin: str = ""
 
@@ -468,7 +469,7 @@ def _parse_schedule(el, namer):
             continue
         if child.tag != _q("nc", "Mode"):
             raise SSPError(f"{o}: unknown element {child.tag} in nc:Schedule (expected nc:Mode, nc:NextEvent)")
-        unknown = set(child.attrib) - {"name", "stepSize", "active", "recordEvery"}
+        unknown = set(child.attrib) - {"name", "stepSize", "active", "recordEvery", "every"}
         if unknown:
             raise SSPError(f"{o}: unknown attribute(s) on nc:Mode: {', '.join(sorted(unknown))}")
         name = child.get("name")
@@ -485,8 +486,19 @@ def _parse_schedule(el, namer):
         if every < 1:
             raise SSPError(f"{o}: nc:Mode {name!r} recordEvery must be an integer >= 1, got {child.get('recordEvery')!r}")
         active = child.get("active")
+        multiples = {}
+        for item in (child.get("every") or "").split():
+            comp, _, k = item.partition(":")
+            try:
+                k = int(k)
+            except ValueError:
+                k = 0
+            if not comp or k < 1:
+                raise SSPError(f"{o}: nc:Mode {name!r} every=\"{child.get('every')}\": expected "
+                               "\"component:k ...\" with integers k >= 1")
+            multiples[comp] = k
         mode = ScheduleMode(name=name, step_size=h, active=None if active is None else active.split(),
-                            record_every=every, origin=o)
+                            record_every=every, every=multiples, origin=o)
         for w in child:
             if not isinstance(w.tag, str):
                 continue

@@ -161,7 +161,7 @@ def test_ground_station_fmu(build_one, tmp_path):
     path = build_one("neighbor_ground.py")
     deps = check_declarations(path)
     r = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
-    assert deps == {name: r for name in ("visible", "elevation", "azimuth", "range", "ground_command")}
+    assert deps == {name: r for name in ("visible", "elevation", "azimuth", "range", "near_contact", "ground_command")}
     fmu, vr = instantiate(path, tmp_path, "ground", start_time=0.0)
     fmu.setReal([vr["confirm_after"]], [50.0])
     fmu.enterInitializationMode()
@@ -183,3 +183,29 @@ def test_ground_station_fmu(build_one, tmp_path):
         fmu.doStep(t, 100.0 - t if t == 0.0 else 10.0)
     fmu.terminate()
     fmu.freeInstance()
+
+
+def test_near_contact_gives_warning_before_every_contact():
+    """near_contact (elevation above mask - 20 deg) turns true at least 240 s before each
+    contact of a 420 km, 51.6 deg orbit over a day (the coarse step a master may take outside)."""
+    from components import orbit_elements as oe
+
+    station = gsm.GroundStation(epoch="2023-01-01T00:00:00Z")
+    r0, v0 = oe.kepler_to_cartesian(oe.R_EQ + 420e3, 0.0, math.radians(51.6), 0.0, 0.0, 0.0)
+    ts = np.arange(0.0, 86400.0, 4.0)
+    near, vis = [], []
+    for t in ts:
+        r = oe.kepler_propagate(r0, v0, t)[0]
+        near.append(station.near_contact(r, t))
+        vis.append(station.visible(r, t))
+    near, vis = np.array(near), np.array(vis)
+    rises = np.flatnonzero(vis[1:] & ~vis[:-1]) + 1
+    assert len(rises) >= 4
+    for i in rises:
+        j = i
+        while j > 0 and near[j - 1]:
+            j -= 1
+        assert ts[i] - ts[j] >= 240.0
+    assert (near | ~vis).all()  # visible implies near
+    with pytest.raises(ValueError, match="approach_margin"):
+        gsm.GroundStation(approach_margin=-0.1)

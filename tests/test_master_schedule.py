@@ -90,3 +90,29 @@ def test_bad_schedules(fmus, tmp_path, schedule, pattern):
 def test_schedule_needs_gauss_seidel(fmus, tmp_path):
     with pytest.raises(SSPError, match="gauss-seidel only"):
         system_ssp.simulate(scheduled_system(tmp_path, fmus), algorithm="jacobi")
+
+
+def test_every_k_steps_ahead_with_contiguous_points(fmus, tmp_path):
+    schedule = SCHEDULE.format(every=1).replace('active="integ timer"', 'active="integ timer" every="integ:2"')
+    r = system_ssp.simulate(scheduled_system(tmp_path, fmus, schedule=schedule))
+    # after 0.35 integ steps 0.35 -> 0.85 (2 x 0.25 ahead), skips the master step at 0.6, then
+    # 0.85 -> 1.0 (cut at the stop time); the timer steps every macro step
+    assert r.final["integ.steps"] == 4 + 2 and r.final["timer.steps"] == 7
+    x35 = 1.1 * 1.1 * 1.1 * 1.05
+    assert r.final["integ.x"] == pytest.approx(x35 * 1.65, rel=1e-12)
+    i06 = int(np.argmin(abs(r.data["time"] - 0.6)))
+    assert r.data["integ.x"][i06] == pytest.approx(x35 * 1.5, rel=1e-12)  # already at its own t = 0.85
+    bad = SCHEDULE.format(every=1).replace('active="integ timer"', 'active="integ timer" every="gain:2"')
+    with pytest.raises(SSPError, match="not active in that mode"):
+        system_ssp.simulate(scheduled_system(tmp_path / "bad", fmus, schedule=bad))
+
+
+def test_component_suspended_from_the_start_joins_at_the_current_time(fmus, tmp_path):
+    """A component inactive in the first mode starts its clock when it is first stepped."""
+    schedule = ('<nc:Schedule><nc:Mode name="late" stepSize="0.25"><nc:When component="timer" connector="expired" '
+                'values="1"/></nc:Mode><nc:Mode name="early" stepSize="0.1" active="timer gain"/>'
+                '<nc:NextEvent component="timer" connector="next_event_time"/></nc:Schedule>')
+    r = system_ssp.simulate(scheduled_system(tmp_path, fmus, schedule=schedule, expiry=0.5))
+    # integ is suspended until 0.5 (x = x0 = 1), then steps 0.5 -> 0.75 -> 1.0 with u = gain.y:
+    # x = 1 + 0.25 * 1 = 1.25, then 1.25 + 0.25 * 1.25 (not a 0.5 s step from t = 0)
+    assert r.final["integ.steps"] == 2 and r.final["integ.x"] == pytest.approx(1.5625, rel=1e-12)

@@ -204,7 +204,8 @@ def write_ssd(name, spec, directory=HERE):
     (source, output, destination, input, n) with n > 0 for structured names out[1]..out[n] or
     n = 0 for a scalar, optional "stop" Boolean outputs, "order", "stop_time", "step_size", and
     "schedule": {"modes": [(name, step, active components or None, recordEvery,
-    [(component, connector, [values])])], "events": [(component, connector)]} for an nc:Schedule.
+    [(component, connector, [values])][, {component: k}])], "events": [(component, connector)]} for an
+    nc:Schedule (the optional dict: components stepped every k-th step of the mode).
     libcosim applies only a component's first ParameterBinding: put the one that matters first."""
     all_units = {}
     comp_vars = {}
@@ -280,8 +281,9 @@ def _schedule_xml(name, schedule, comp_vars):
             raise SystemExit(f"{name}: schedule signal {comp}.{var} must be an output of type {' or '.join(types)}")
 
     out = ["          <nc:Schedule>"]
-    for mode, step, active, every, when in schedule["modes"]:
-        for comp in active or []:
+    for mode, step, active, every, when, *multiples in schedule["modes"]:
+        multiples = multiples[0] if multiples else {}
+        for comp in list(active or []) + list(multiples):
             if comp not in comp_vars:
                 raise SystemExit(f"{name}: schedule mode {mode} lists unknown component {comp}")
         attrs = f'name="{mode}" stepSize="{step!r}"'
@@ -289,6 +291,8 @@ def _schedule_xml(name, schedule, comp_vars):
             attrs += f' active="{" ".join(active)}"'
         if every != 1:
             attrs += f' recordEvery="{every}"'
+        if multiples:
+            attrs += f' every="{" ".join(f"{c}:{k}" for c, k in multiples.items())}"'
         if not when:
             out.append(f"            <nc:Mode {attrs}/>")
             continue

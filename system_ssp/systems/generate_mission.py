@@ -14,12 +14,14 @@ re-entry. Components (instance: FMU):
 
 Mode-dependent steps (nc:Schedule, first match wins), events landed exactly on
 mission.next_event_time and host.next_event_time:
-  maneuver       mode 5, phases 2-4 (detumble, slew, burn): 15 ms, every component
+  detumble, slew, burn   mode 5, phases 2, 3, 4: 15 ms, the attitude loop with the phase's own
+                 controller (the other two suspended); orbit, ground, host, power and data every
+                 33rd step (0.495 s), in the burn also the manager and the propulsion
   determination  mode 5, phase 1 (10 min of attitude determination): 1 s, no attitude loop
   contact        mode 4 (final-confirmation contact): 1 s;   awaiting  mode 3: 10 s
-  monitoring     mode 6 (GPS beacon during contacts): 20 s
+  monitoring     mode 6 (GPS beacon during contacts): 20 s, without host and propulsion
   decay          mode 7 (battery empty: only the orbit left until re-entry): 1 day
-  idle           modes 1-2 (idle, grace period): 1 h, only host, mission, power and orbit
+  idle           modes 1-2 (idle, grace period): 6 h, only host, mission, power and orbit
 The attitude loop (dynamics, controllers, thrusters) is suspended until the detumble starts, so
 the host's tumble at takeover is the rigid body's initial state (10 deg/s per axis, Eq. 7).
 
@@ -59,6 +61,17 @@ W0_TAKEOVER = [math.radians(10.0)] * 3  # Eq. 7
 
 ATTITUDE = ["dynamics", "detumble", "slew", "tracking", "selector", "thrusters"]
 BUS = ["host", "mission", "orbit", "ground", "propulsion", "power", "data"]
+MONITOR = ["mission", "orbit", "ground", "power", "data"]  # after the burn: no host, no thrust
+# During the 15 ms attitude phases the orbit, ground station, host, power and data step every
+# 33rd step (0.495 s, about the thesis' 0.5 s burn step), ahead with inputs held.
+SLOW_EVERY = 33
+SLOW = {c: SLOW_EVERY for c in ("host", "orbit", "ground", "power", "data")}
+ALL = ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking", "selector",
+       "thrusters", "dynamics"]
+
+
+def ALL_BUT(*names):
+    return [c for c in ALL if c not in names]
 
 
 def deployment_altitude(target_km, density="jacchia_roberts"):
@@ -147,18 +160,23 @@ def system(orbit_fmu):
         # reaches at the step's end (a wake-up) applies from then on, not to the step before.
         # The rest follow the feedthrough edges (propulsion -> orbit, orbit -> ground,
         # controllers -> selector -> thrusters -> dynamics).
-        "order": ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking",
-                  "selector", "thrusters", "dynamics"],
+        "order": ALL,
         "stop_time": 40.0 * 365.25 * DAY,
         "step_size": 3600.0,
         "schedule": {"modes": [
-            ("maneuver", 0.015, None, 20, [("mission", "mode", [5]), ("mission", "phase", [2, 3, 4])]),
+            ("detumble", 0.015, ALL_BUT("slew", "tracking"), 20,
+             [("mission", "mode", [5]), ("mission", "phase", [2])], SLOW),
+            ("slew", 0.015, ALL_BUT("detumble", "tracking"), 20,
+             [("mission", "mode", [5]), ("mission", "phase", [3])], SLOW),
+            ("burn", 0.015, ALL_BUT("detumble", "slew"), 20,
+             [("mission", "mode", [5]), ("mission", "phase", [4])],
+             dict(SLOW, mission=SLOW_EVERY, propulsion=SLOW_EVERY)),
             ("determination", 1.0, BUS, 10, [("mission", "mode", [5])]),
             ("contact", 1.0, BUS, 10, [("mission", "mode", [4])]),
             ("awaiting", 10.0, BUS, 6, [("mission", "mode", [3])]),
-            ("monitoring", 20.0, BUS, 9, [("mission", "mode", [6])]),
+            ("monitoring", 20.0, MONITOR, 9, [("mission", "mode", [6])]),
             ("decay", DAY, ["mission", "orbit"], 1, [("mission", "mode", [7])]),
-            ("idle", 3600.0, quiet, 24, [])],
+            ("idle", 6 * 3600.0, quiet, 4, [])],
             "events": [("mission", "next_event_time"), ("host", "next_event_time")]},
     }
 
