@@ -188,6 +188,22 @@ def _drag_rates_kernel(y, jd, mu, bc, omega_atm, n_nodes, kernel, kernel_data):
     return _drag_sum(y, mu, bc, omega_atm, R, V, geo, rho)
 
 
+_SPECIALIZED = {}
+
+
+def _drag_function(kernel):
+    """_drag_rates_kernel with `kernel` bound at compile time. Passing a numba function as an
+    argument makes every call resolve its type (about 30 us, ten times the quadrature itself);
+    a closure over it compiles once per kernel and process."""
+    f = _SPECIALIZED.get(kernel)
+    if f is None:
+        @njit(cache=False)
+        def f(y, jd, mu, bc, omega_atm, n_nodes, kernel_data):
+            return _drag_rates_kernel(y, jd, mu, bc, omega_atm, n_nodes, kernel, kernel_data)
+        _SPECIALIZED[kernel] = f
+    return f
+
+
 @njit(cache=True)
 def _state_N(y, mu):
     """(r_N, v_N) arrays of the mean elements y (two-body)."""
@@ -367,8 +383,7 @@ class OrbitAveraged:
         self.evaluations += 1
         kern = self.atmosphere.kernel
         if kern is not None:
-            return _drag_rates_kernel(y, jd, self.mu, bc, self.omega_atm, self.n_nodes, kern,
-                                      self.atmosphere.kernel_data)
+            return _drag_function(kern)(y, jd, self.mu, bc, self.omega_atm, self.n_nodes, self.atmosphere.kernel_data)
         R, V, geo = _nodes(y, self.mu, self.n_nodes)
         rho = np.array([self.atmosphere.density(R[k], jd) for k in range(self.n_nodes)])
         return _drag_sum(y, self.mu, bc, self.omega_atm, R, V, geo, rho)

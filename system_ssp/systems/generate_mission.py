@@ -18,8 +18,10 @@ mission.next_event_time and host.next_event_time:
                  controller (the other two suspended); orbit, ground, host, power and data every
                  33rd step (0.495 s), in the burn also the manager and the propulsion
   determination  mode 5, phase 1 (10 min of attitude determination): 1 s, no attitude loop
-  contact        mode 4 (final-confirmation contact): 1 s;   awaiting  mode 3: 10 s
-  monitoring     mode 6 (GPS beacon during contacts): 20 s, without host and propulsion
+  contact        mode 4 (final-confirmation contact): 1 s
+  awaiting       mode 3: 5 s while ground.near_contact, else 240 s (no contact can begin sooner)
+  monitoring     mode 6 (GPS beacon during contacts): 10 s while ground.near_contact, else 240 s;
+                 without host and propulsion
   decay          mode 7 (battery empty: only the orbit left until re-entry): 1 day
   idle           modes 1-2 (idle, grace period): 6 h, only host, mission, power and orbit
 The attitude loop (dynamics, controllers, thrusters) is suspended until the detumble starts, so
@@ -65,6 +67,9 @@ MONITOR = ["mission", "orbit", "ground", "power", "data"]  # after the burn: no 
 # During the 15 ms attitude phases the orbit, ground station, host, power and data step every
 # 33rd step (0.495 s, about the thesis' 0.5 s burn step), ahead with inputs held.
 SLOW_EVERY = 33
+# Waiting for a contact: 240 s steps while the station's near_contact is false (a contact cannot
+# begin within 448 s of that, components/ground_station.py), 5-10 s steps while it is true.
+FAR_STEP = 240.0
 SLOW = {c: SLOW_EVERY for c in ("host", "orbit", "ground", "power", "data")}
 ALL = ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking", "selector",
        "thrusters", "dynamics"]
@@ -173,8 +178,10 @@ def system(orbit_fmu):
              dict(SLOW, mission=SLOW_EVERY, propulsion=SLOW_EVERY)),
             ("determination", 1.0, BUS, 10, [("mission", "mode", [5])]),
             ("contact", 1.0, BUS, 10, [("mission", "mode", [4])]),
-            ("awaiting", 10.0, BUS, 6, [("mission", "mode", [3])]),
-            ("monitoring", 20.0, MONITOR, 9, [("mission", "mode", [6])]),
+            ("awaiting_near", 5.0, BUS, 12, [("mission", "mode", [3]), ("ground", "near_contact", [1])]),
+            ("awaiting", FAR_STEP, BUS, 1, [("mission", "mode", [3])]),
+            ("monitoring_near", 10.0, MONITOR, 6, [("mission", "mode", [6]), ("ground", "near_contact", [1])]),
+            ("monitoring", FAR_STEP, MONITOR, 1, [("mission", "mode", [6])]),
             ("decay", DAY, ["mission", "orbit"], 1, [("mission", "mode", [7])]),
             ("idle", 6 * 3600.0, quiet, 4, [])],
             "events": [("mission", "next_event_time"), ("host", "next_event_time")]},
