@@ -204,6 +204,12 @@ def build_fmu(script, dest_dir):
                                    canGetAndSetFMUstate=cls.can_get_and_set_state)
         with zipfile.ZipFile(raw) as src:
             entries = {info.filename: src.read(info.filename) for info in src.infolist()}
+    if not any(name.startswith("binaries/") for name in entries):
+        import pythonfmu
+
+        raise BuildError(f"{script.name}: pythonfmu wrote no binaries/; the pythonfmu package in use "
+                         f"({Path(pythonfmu.__file__).parent}) lacks its resources/binaries, e.g. the copy "
+                         "inside an extracted FMU. Import build_fmus before running FMUs in-process.")
     entries["modelDescription.xml"] = complete_model_description(
         entries["modelDescription.xml"], instance.fmu_meta, cls.can_get_and_set_state, instance.values)
     dest = dest_dir / f"{cls.__name__}.fmu"

@@ -280,12 +280,3 @@ def j2_secular_rates(a, e, i, mu=MU_EARTH, j2=J2_EGM96, r_eq=R_EQ):
     k = n * r_eq * r_eq * j2 / (p * p)
     si = math.sin(i)
     return -1.5 * k * math.cos(i), 0.75 * k * (4.0 - 5.0 * si * si)
-
-
-def deorbit_delta_v(r1, r2, mu=MU_EARTH):
-    """Thesis Eq. 2: delta-v (m/s, negative for r2 < r1) that lowers the perigee of a circular
-    orbit of radius r1 to r2 with one tangential impulse."""
-    r1, r2 = float(r1), float(r2)
-    if not (r1 > 0.0 and r2 > 0.0):
-        raise ValueError(f"radii r1 = {r1!r} and r2 = {r2!r} must be > 0 m")
-    return math.sqrt(_check_mu(mu) / r1) * (math.sqrt(2.0 * r2 / (r1 + r2)) - 1.0)

@@ -16,6 +16,7 @@ getters, so an output that depends directly on inputs is recomputed from the inp
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
 """
 import copy
+import math
 import os
 import sys
 
@@ -139,6 +140,59 @@ class NeighborSlave(Fmi2Slave):
                           "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
                           depends_on=deps)
         self.output("done", lambda: self.feedthrough(done), None, done_description, bool, depends_on=done_inputs)
+
+    def inertia_parameters(self, mass_description):
+        """The spacecraft inertia parameters shared by RigidBody and the controllers that use
+        the inertia: mass and box edges (Eq. 4) or a full tensor inertia_B[i,j]."""
+        self.parameter("mass", 12.0, "kg", mass_description)
+        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
+        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
+        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
+        self.parameter("inertia_from_box", True, None,
+                       "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
+        for i in range(1, 4):
+            for j in range(1, 4):
+                self.parameter(f"inertia_B[{i},{j}]", 0.0, "kg.m2",
+                               f"Inertia tensor element ({i},{j}) in B, used when inertia_from_box is false")
+
+    def inertia(self, box_inertia):
+        """The 3x3 inertia from the inertia_parameters values (box_inertia: the Eq. 4 function)."""
+        v = self.values
+        if v["inertia_from_box"]:
+            return box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"])
+        return [[v[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
+
+    def orbit_interface(self, default_sma, mu, epoch, mean):
+        """Parameters and inputs every orbit FMU shares (the Orbit / OrbitAveraged connector
+        contract), so that a system swaps one for the other by replacing a component. `mean`:
+        the initial elements are mean elements (orbit-averaged model) rather than osculating."""
+        kind = "mean " if mean else ""
+        self.parameter("epoch", epoch, None, "Scenario epoch, ISO 8601 UTC; simulation time is seconds since it",
+                       str)
+        self.parameter("sma0", default_sma, "m", f"Initial {kind}semi-major axis (thesis Table 3: 6798.1363 km); "
+                       "perigee must be above reentry_altitude")
+        self.parameter("ecc0", 0.0, "1", f"Initial {kind}eccentricity, in [0, 1)")
+        self.parameter("inc0", math.radians(51.6), "rad", "Initial inclination, in [1e-4, pi - 1e-4] (the element "
+                       "set is singular for equatorial orbits)" if mean else "Initial inclination, in [0, pi]")
+        self.parameter("raan0", 0.0, "rad", "Initial right ascension of the ascending node")
+        self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
+        self.parameter("ta0", 0.0, "rad",
+                       "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
+        self.parameter("Cd", 2.2, "1", "Drag coefficient (> 0, <= 10; thesis Table 2: 2.2)")
+        self.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
+        self.parameter("reentry_altitude", 250e3, "m", "Re-entry altitude (thesis: 250 km), compared with the "
+                       + ("mean perigee altitude" if mean else "geodetic altitude") + "; an initial perigee "
+                       "altitude sma0 (1 - ecc0) - 6378136.3 m below it is an error")
+        atmosphere_parameters(self)
+        self.parameter("mu", mu, "m3/s2", "Earth's gravitational parameter (thesis: 398600.4415 km3/s2), > 0")
+        self.input_array("F_thrust_B", [0.0, 0.0, 0.0], "N",
+                         "Thrust force in the body frame B, held over a step (rotated to N with q_BN)")
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         "Attitude quaternion of B relative to N, scalar last (A(q) maps N to B)")
+        self.input("retrograde", False, None,
+                   "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
+                   "ignoring q_BN", bool)
+        self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
 
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute):

@@ -13,7 +13,7 @@ falls below reentry_altitude; the model then holds its state (the system's stop 
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, atmosphere_model, atmosphere_parameters, use_bundled_components
+from neighbor_fmu_support import NeighborSlave, atmosphere_model, use_bundled_components
 
 use_bundled_components(__file__)
 
@@ -29,36 +29,10 @@ class Orbit(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
-                       "Scenario epoch, ISO 8601 UTC; simulation time is seconds since it", str)
-        self.parameter("sma0", R_EQ + 420e3, "m",
-                       "Initial semi-major axis (thesis Table 3: 6798.1363 km); perigee must be above reentry_altitude")
-        self.parameter("ecc0", 0.0, "1", "Initial eccentricity, in [0, 1)")
-        self.parameter("inc0", math.radians(51.6), "rad", "Initial inclination, in [0, pi]")
-        self.parameter("raan0", 0.0, "rad", "Initial right ascension of the ascending node")
-        self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
-        self.parameter("ta0", 0.0, "rad",
-                       "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
-        self.parameter("Cd", 2.2, "1", "Drag coefficient (> 0; thesis Table 2: 2.2)")
-        self.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
-        self.parameter("reentry_altitude", 250e3, "m",
-                       "Geodetic altitude of re-entry (thesis: 250 km); an initial perigee altitude "
-                       "sma0 (1 - ecc0) - 6378136.3 m below it is an error")
-        atmosphere_parameters(self)
-        self.parameter("mu", orbit_elements.MU_EARTH, "m3/s2",
-                       "Earth's gravitational parameter (thesis: 398600.4415 km3/s2), > 0")
+        self.orbit_interface(R_EQ + 420e3, orbit_elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
         self.parameter("zonal_degree", 6, None,
                        "Zonal gravity terms: 0 = point mass only, 2 = J2, ..., 6 = J2..J6 (EGM96)", int)
         self.parameter("drag", True, None, "Atmospheric drag on (false: gravity and thrust only)", bool)
-
-        self.input_array("F_thrust_B", [0.0, 0.0, 0.0], "N",
-                         "Thrust force in the body frame B, held over a step (rotated to N with q_BN)")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         "Attitude quaternion of B relative to N, scalar last (A(q) maps N to B)")
-        self.input("retrograde", False, None,
-                   "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
-                   "ignoring q_BN", bool)
-        self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
 
         out = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731
         vec = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731

@@ -24,16 +24,7 @@ class RigidBody(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.parameter("mass", 12.0, "kg", "Spacecraft mass for the box inertia (Eq. 4)")
-        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
-        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
-        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
-        self.parameter("inertia_from_box", True, None,
-                       "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.parameter(f"inertia_B[{i},{j}]", 0.0, "kg.m2",
-                               f"Inertia tensor element ({i},{j}) in B, used when inertia_from_box is false")
+        self.inertia_parameters("Spacecraft mass for the box inertia (Eq. 4)")
         self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
                              "Initial attitude quaternion q_BN, scalar last (rk4 normalizes it, euler keeps it as given like the thesis scripts; zero norm is an error)")
         self.parameter_array("omega0", [0.0, 0.0, 0.0], "rad/s", "Initial angular velocity omega_BN_B")
@@ -64,11 +55,7 @@ class RigidBody(NeighborSlave):
                          "(gyroscopic term omega x h_w); 0 without wheels")
 
     def build_model(self):
-        if self.values["inertia_from_box"]:
-            J = rigid_body.box_inertia(self.values["mass"], self.values["edge_a"], self.values["edge_b"],
-                                       self.values["edge_c"])
-        else:
-            J = [[self.values[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
+        J = self.inertia(rigid_body.box_inertia)
         return rigid_body.RigidBody(J, self.vector("q0", 4), self.vector("omega0", 3),
                                     self.values["integrator"], self.values["max_substep"])
 

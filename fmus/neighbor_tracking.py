@@ -38,16 +38,7 @@ class TrackingController(NeighborSlave):
                        "disabled; false: q_d starts at q_d0 at the start of the run", bool)
         self.parameter_array("q_d0", [0.0, 0.0, 0.0, 1.0], "1",
                              "Initial desired quaternion q_BN, scalar last (used when q_d_from_measured is false)")
-        self.parameter("mass", 12.0, "kg", "Spacecraft mass for the box inertia the law uses (Eq. 4)")
-        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
-        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
-        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
-        self.parameter("inertia_from_box", True, None,
-                       "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.parameter(f"inertia_B[{i},{j}]", 0.0, "kg.m2",
-                               f"Inertia tensor element ({i},{j}) in B, used when inertia_from_box is false")
+        self.inertia_parameters("Spacecraft mass for the box inertia the law uses (Eq. 4)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
         self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
@@ -69,11 +60,7 @@ class TrackingController(NeighborSlave):
                           depends_on=Q_INPUTS + RATE_INPUTS)
 
     def build_model(self):
-        if self.values["inertia_from_box"]:
-            J = rigid_body.box_inertia(self.values["mass"], self.values["edge_a"], self.values["edge_b"],
-                                       self.values["edge_c"])
-        else:
-            J = [[self.values[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
+        J = self.inertia(rigid_body.box_inertia)
         q_d0 = None if self.values["q_d_from_measured"] else self.vector("q_d0", 4)
         return deorbit_tracking.DeorbitTrackingController(
             J, self.values["k"], self.vector("G", 3), self.vector("e", 3), self.vector("omega_d", 3),

@@ -3,6 +3,7 @@
 Built by `System.run`; not meant to be used directly.
 """
 import ctypes
+import math
 import sys
 
 import numpy as np
@@ -311,6 +312,14 @@ class Run:
                 raise _Failed(ci, name, s)
             last[0] = sent
 
+    def _read_row(self, r):
+        """Read every recorded variable into the row array r."""
+        for fn, c, vr, m, buf, view, a, b, ci, name in self.recs:
+            s = fn(c, vr, m, buf)
+            if s > 1:
+                raise _Failed(ci, name, s)
+            r[a:b] = view
+
     def _initialize(self):
         sysm = self.system
         n = len(sysm.comps)
@@ -343,18 +352,12 @@ class Run:
         n_rows = N // every + 2
         rec = np.zeros((n_rows, self.ncols), dtype=np.float64)
         times = np.zeros(n_rows, dtype=np.float64)
-        recs = self.recs
         stop_ops = self.stop_ops
         row = 0
 
         def record(t):
             nonlocal row
-            r = rec[row]
-            for fn, c, vr, m, buf, view, a, b, ci, name in recs:
-                s = fn(c, vr, m, buf)
-                if s > 1:
-                    raise _Failed(ci, name, s)
-                r[a:b] = view
+            self._read_row(rec[row])
             times[row] = t
             row += 1
 
@@ -553,7 +556,7 @@ class Run:
                                   + ", ".join(f"{op[5]}={int(read(op))}" for mode in modes for op, _ in mode[4])
                                   + "); end the schedule with an unconditional nc:Mode")
 
-        recs, stop_ops = self.recs, self.stop_ops
+        stop_ops = self.stop_ops
         rows, times = [], []
         set_, get = self._set, self._get
 
@@ -568,11 +571,7 @@ class Run:
                 if has_ft[ci]:
                     get(ci)
             r = np.empty(self.ncols, dtype=np.float64)
-            for fn, c, vr, m, buf, view, a, b, ci, name in recs:
-                s = fn(c, vr, m, buf)
-                if s > 1:
-                    raise _Failed(ci, name, s)
-                r[a:b] = view
+            self._read_row(r)
             rows.append(r)
             times.append(t)
 
@@ -602,7 +601,9 @@ class Run:
         fired = check_stop() if stop_ops else None
         steps = 0
         since_record = 0
-        tol = 1e-9 * max(1.0, abs(stop))
+        # Times closer than this are the same instant: a few ulps of the largest time in the run
+        # (1.5e-5 s at 40 years), far below any step, so that t + (t_event - t) lands on t_event.
+        tol = 64.0 * math.ulp(max(1.0, abs(start), abs(stop)))
         step_fns = self.step_fns
         bar = None
         if progress:
@@ -639,6 +640,8 @@ class Run:
                         continue  # ahead of the master (stepped with a multiple)
                     k = mult[ci]
                     end = t1 if k == 1 else min(t + k * h_mode, stop)
+                    if end - t_c <= tol:
+                        continue  # already at the end of this step (it ran ahead)
                     if profile:
                         w0 = perf()
                     set_(ci)
