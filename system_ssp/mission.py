@@ -1,10 +1,10 @@
 """The NEIGHBOR mission from deployment to re-entry, run through the master, with the thesis'
 figures and a summary beside the published numbers.
 
-    python -m system_ssp mission [--scenario 420km] [--orbit cowell|averaged] [--out results/mission]
+    python -m system_ssp mission [--scenario 420km] [--orbit averaged|cowell] [--out results/mission]
 
-Runs build/ssp/neighbor_mission.ssp (Cowell orbit) or neighbor_mission_lifetime.ssp (orbit-
-averaged) with the scenario's parameter set (system_ssp/systems/parameters/
+Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
+minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter set (system_ssp/systems/parameters/
 neighbor_mission_<scenario>.ssv), and writes into --out:
 - timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode);
 - summary.json     every computed figure beside the thesis' (also printed as a table);
@@ -49,7 +49,7 @@ RECORD = (["mission.mode", "mission.phase", "host.heartbeat", "orbit.sma", "orbi
           + [f"dynamics.q_BN[{i}]" for i in (1, 2, 3, 4)])
 
 
-def run_mission(scenario="420km", orbit="cowell", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
+def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
                 parameters=None, profile=False, progress=False):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`."""
     if orbit not in SYSTEMS:
@@ -205,7 +205,7 @@ def plot(d, s, out):
         if not sel.any():
             continue
         tt = t[sel] - t[sel][0]
-        fig, axes = plt.subplots(2, 1, figsize=(8, 6), sharex=True)
+        fig, axes = plt.subplots(3 if p == BURN else 2, 1, figsize=(8, 8 if p == BURN else 6), sharex=True)
         for i in (1, 2, 3):
             axes[0].plot(tt, np.degrees(d[f"dynamics.omega_BN_B[{i}]"][sel]), label=f"omega_{'xyz'[i - 1]}")
         axes[0].set_ylabel("rate (deg/s)")
@@ -218,10 +218,10 @@ def plot(d, s, out):
                 axes[1].plot(tt, np.degrees(d[f"dynamics.euler123[{i}]"][sel]), label=f"1-2-3 angle {i}")
             axes[1].set_ylabel("angle (deg)")
         if p == BURN:
-            ax2 = axes[1].twinx()
-            ax2.plot(tt, np.degrees(d["tracking.attitude_error"][sel]), color="k", linewidth=0.7)
-            ax2.set_ylabel("tracking error (deg)")
-        axes[1].set_xlabel("time in phase (s)")
+            axes[2].plot(tt, np.degrees(d["tracking.attitude_error"][sel]), color="k", linewidth=0.3,
+                         label="angle from the desired attitude")
+            axes[2].set_ylabel("tracking error (deg)")
+        axes[-1].set_xlabel("time in phase (s)")
         for a in axes:
             a.legend(fontsize=7, loc="upper right")
             a.grid(alpha=0.3)
@@ -256,7 +256,7 @@ def plot(d, s, out):
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="python -m system_ssp mission", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
-    ap.add_argument("--orbit", choices=list(SYSTEMS), default="cowell")
+    ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
     ap.add_argument("--out", default="results/mission")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)
