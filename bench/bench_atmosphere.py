@@ -2,7 +2,7 @@
 call from numba code (a loop inside an njit function, as the orbit right-hand side calls it),
 plus the cost of one NRLMSIS call through pymsis and of the Python `density` method.
 
-    /work/venv/bin/python bench/bench_atmosphere.py
+    python bench/bench_atmosphere.py
 """
 import sys
 import time

@@ -3,7 +3,7 @@ model (420 km, 51.6 deg, thesis Table 3 orbit; J2..J6 + drag; communication step
 per-call numbers behind it, and the tolerance convergence check (position difference after one day
 against a run with rtol 1e-13).
 
-    /work/venv/bin/python bench/bench_orbit.py [days]   (default 3 simulated days; msis: 0.25 day)
+    python bench/bench_orbit.py [days]   (default 3 simulated days; msis: 0.25 day)
 
 Speed target (issue 3): Cowell with Jacchia-Roberts <= 60 s of wall time per simulated year.
 Compilation (numba, first step of each model) is reported separately and excluded from the rates.

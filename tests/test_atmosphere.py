@@ -11,7 +11,7 @@ import pytest
 from components import atmosphere, geodesy, jacchia_roberts, space_weather, sun, time_utils
 from fmu_helpers import check_declarations, instantiate
 
-GMAT_VECTORS = Path("/work/shared/data/atmosphere/jacchia_roberts_gmat_test_2011.csv")
+GMAT_VECTORS = Path(__file__).resolve().parent / "data" / "jacchia_roberts_gmat_test_2011.csv"
 R_EQ = geodesy.WGS84_A
 JD_2023 = time_utils.julian_date(time_utils.DEFAULT_EPOCH)
 # FMU instances and the support module stay referenced until the process ends (conftest leaves

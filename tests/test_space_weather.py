@@ -10,7 +10,8 @@ import pytest
 from components import space_weather as sw_mod
 from components.space_weather import ConstantSpaceWeather, SpaceWeather
 
-SHARED_FILE = Path("/work/shared/data/space_weather/SW-All_CSSI_2026-08-22.txt")
+# the team's shared reference data, beside the repository (as in CI)
+SHARED_FILE = Path(__file__).resolve().parents[2] / "shared" / "data" / "space_weather" / "SW-All_CSSI_2026-08-22.txt"
 
 
 def jd(y, m, d, hour=0.0):
@@ -47,6 +48,8 @@ def test_observed_values_from_the_file_lines(sw):
 
 def test_bundled_copy_is_the_shared_file_trimmed(sw):
     """The bundled file equals the shared CelesTrak file from 2000-01-01 on."""
+    if not SHARED_FILE.is_file():
+        pytest.skip(f"the shared reference file {SHARED_FILE} is not beside the repository")
     full = SpaceWeather.from_file(SHARED_FILE)
     assert full.first_jd == jd(1957, 10, 1) and sw.first_jd == jd(2000, 1, 1)
     off = int(sw.first_jd - full.first_jd)
