@@ -280,3 +280,16 @@ def j2_secular_rates(a, e, i, mu=MU_EARTH, j2=J2_EGM96, r_eq=R_EQ):
     k = n * r_eq * r_eq * j2 / (p * p)
     si = math.sin(i)
     return -1.5 * k * math.cos(i), 0.75 * k * (4.0 - 5.0 * si * si)
+
+
+def initial_elements(p, mu=MU_EARTH):
+    """(a, e, i, raan, argp, nu) of an orbit FMU's initial-state parameters `p` (a dict): the
+    elements sma0 ... ta0, or with p["cartesian0"] the elements of the state r0_N, v0_N."""
+    if not p.get("cartesian0"):
+        return p["sma0"], p["ecc0"], p["inc0"], p["raan0"], p["argp0"], p["ta0"]
+    r = [p[f"r0_N[{k}]"] for k in (1, 2, 3)]
+    v = [p[f"v0_N[{k}]"] for k in (1, 2, 3)]
+    try:
+        return cartesian_to_kepler(r, v, mu)
+    except ValueError as exc:
+        raise ValueError(f"r0_N = {r} m, v0_N = {v} m/s: {exc}") from None

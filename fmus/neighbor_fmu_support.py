@@ -178,6 +178,13 @@ class NeighborSlave(Fmi2Slave):
         self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
         self.parameter("ta0", 0.0, "rad",
                        "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
+        self.parameter("cartesian0", False, None, "True: start from r0_N and v0_N (osculating state in N) instead of "
+                       "the elements sma0 ... ta0", bool)
+        a = default_sma
+        v = math.sqrt(mu / a)
+        self.parameter_array("r0_N", [a, 0.0, 0.0], "m", "Initial position in N, used when cartesian0 is true")
+        self.parameter_array("v0_N", [0.0, v * math.cos(math.radians(51.6)), v * math.sin(math.radians(51.6))], "m/s",
+                             "Initial velocity in N, used when cartesian0 is true (must give a closed orbit)")
         self.parameter("Cd", 2.2, "1", "Drag coefficient (> 0, <= 10; thesis Table 2: 2.2)")
         self.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
         self.parameter("reentry_altitude", 250e3, "m", "Re-entry altitude (thesis: 250 km), compared with the "

@@ -55,10 +55,11 @@ class Orbit(NeighborSlave):
         v = self.values
         if not (0.0 <= v["inc0"] <= math.pi):
             raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [0, pi]")
-        density = atmosphere_model(v, inclination=v["inc0"]) if v["drag"] else None
+        sma, ecc, inc, raan, argp, ta = orbit_elements.initial_elements(v, v["mu"])
+        density = atmosphere_model(v, inclination=inc) if v["drag"] else None
         return orbit.CowellOrbit(
-            epoch=v["epoch"], sma0=v["sma0"], ecc0=v["ecc0"], inc0=v["inc0"], raan0=v["raan0"], argp0=v["argp0"],
-            ta0=v["ta0"], Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],
+            epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
+            ta0=ta, Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],
             density_model=density, drag=v["drag"], zonal_degree=v["zonal_degree"], mu=v["mu"], t0=self.start_time)
 
     def do_step(self, current_time, step_size):

@@ -67,13 +67,14 @@ class OrbitAveraged(NeighborSlave):
 
     def build_model(self):
         v = self.values
-        inc = v["inc0"]
-        if not (0.0 <= inc <= math.pi):
-            raise ValueError(f"inc0 = {inc!r} rad must be in [1e-4, pi - 1e-4]")
+        if not (0.0 <= v["inc0"] <= math.pi):
+            raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [1e-4, pi - 1e-4]")
+        # a Cartesian start is taken as the mean state (no short-period correction)
+        sma, ecc, inc, raan, argp, ta = orbit_elements.initial_elements(v, v["mu"])
         density = atmosphere_model(v, inclination=inc) if v["drag"] else None
         return orbit_averaged.OrbitAveraged(
-            density, epoch=v["epoch"], sma0=v["sma0"], ecc0=v["ecc0"], inc0=inc, raan0=v["raan0"], argp0=v["argp0"],
-            ta0=v["ta0"], Cd=v["Cd"], area=v["area"], reentry_altitude=v["reentry_altitude"], mu=v["mu"],
+            density, epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
+            ta0=ta, Cd=v["Cd"], area=v["area"], reentry_altitude=v["reentry_altitude"], mu=v["mu"],
             j2=v["j2"], quadrature_nodes=v["quadrature_nodes"], max_step=v["max_step"],
             max_da_step=v["max_da_step"], thrust_step=v["thrust_step"], t0=self.start_time)
 

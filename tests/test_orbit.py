@@ -345,3 +345,30 @@ def test_orbit_fmu_rejects_bad_parameters(build_one, tmp_path):
     fmu.enterInitializationMode()
     with pytest.raises(Exception):
         fmu.exitInitializationMode()
+
+
+def test_orbit_fmu_cartesian_start_equals_the_elements(build_one, tmp_path):
+    """cartesian0 with the state of the Table 3 elements gives the same trajectory."""
+    path = build_one("neighbor_orbit.py")
+    r0, v0 = oe.kepler_to_cartesian(R + 420e3, 0.001, math.radians(51.6), 0.3, 0.2, 0.1)
+    finals = []
+    for name, cartesian in (("orbit_elements", False), ("orbit_cartesian", True)):
+        fmu, vr = instantiate(path, tmp_path, name)
+        fmu.setString([vr["density_model"]], ["exponential"])
+        if cartesian:
+            fmu.setBoolean([vr["cartesian0"]], [True])
+            fmu.setReal([vr[f"r0_N[{k}]"] for k in (1, 2, 3)] + [vr[f"v0_N[{k}]"] for k in (1, 2, 3)],
+                        list(r0) + list(v0))
+        else:
+            fmu.setReal([vr[n] for n in ("ecc0", "raan0", "argp0", "ta0")], [0.001, 0.3, 0.2, 0.1])
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        fmu.doStep(0.0, 600.0)
+        finals.append(fmu.getReal([vr[f"r_BN_N[{k}]"] for k in (1, 2, 3)]))
+        fmu.terminate()
+    np.testing.assert_allclose(finals[0], finals[1], rtol=0, atol=1e-3)
+    assert oe.initial_elements({"cartesian0": True, **{f"r0_N[{k}]": x for k, x in zip((1, 2, 3), r0)},
+                                **{f"v0_N[{k}]": x for k, x in zip((1, 2, 3), v0)}})[0] == pytest.approx(R + 420e3)
+    with pytest.raises(ValueError, match="r0_N"):
+        oe.initial_elements({"cartesian0": True, **{f"r0_N[{k}]": 0.0 for k in (1, 2, 3)},
+                             **{f"v0_N[{k}]": 0.0 for k in (1, 2, 3)}})
