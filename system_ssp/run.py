@@ -312,6 +312,17 @@ class Run:
                 raise _Failed(ci, name, s)
             last[0] = sent
 
+    def _check_stop(self):
+        """Name of the first stop signal that is true, or None."""
+        for fn, c, vr, m, buf, ci, names in self.stop_ops:
+            s = fn(c, vr, m, buf)
+            if s > 1:
+                raise _Failed(ci, "fmi2GetBoolean", s)
+            for j in range(m):
+                if buf[j]:
+                    return names[j]
+        return None
+
     def _read_row(self, r):
         """Read every recorded variable into the row array r."""
         for fn, c, vr, m, buf, view, a, b, ci, name in self.recs:
@@ -361,19 +372,9 @@ class Run:
             times[row] = t
             row += 1
 
-        def check_stop():
-            for fn, c, vr, m, buf, ci, names in stop_ops:
-                s = fn(c, vr, m, buf)
-                if s > 1:
-                    raise _Failed(ci, "fmi2GetBoolean", s)
-                for j in range(m):
-                    if buf[j]:
-                        return names[j]
-            return None
-
         self.t = start
         record(start)
-        fired = check_stop() if stop_ops else None
+        fired = self._check_stop() if stop_ops else None
         steps = 0
         bar = None
         if progress and N >= 2000:
@@ -420,7 +421,7 @@ class Run:
                     if k1 % every == 0 or k1 == N:
                         record(t1)
                     if stop_ops:
-                        fired = check_stop()
+                        fired = self._check_stop()
                     for ci in range(n):
                         if all_one or k1 % mult[ci] == 0 or k1 >= N:
                             set_(ci)
@@ -447,7 +448,7 @@ class Run:
                     if steps % every == 0 or steps == N:
                         record(t_last)
                     if stop_ops:
-                        fired = check_stop()
+                        fired = self._check_stop()
                 if fired is not None and times[row - 1] != t_last:
                     record(t_last)
                 if bar is not None and steps % chunk == 0:
@@ -575,16 +576,6 @@ class Run:
             rows.append(r)
             times.append(t)
 
-        def check_stop():
-            for fn, c, vr, m, buf, ci, names in stop_ops:
-                s = fn(c, vr, m, buf)
-                if s > 1:
-                    raise _Failed(ci, "fmi2GetBoolean", s)
-                for j in range(m):
-                    if buf[j]:
-                        return names[j]
-            return None
-
         profile = p.get("profile")
         spent = [0.0] * n
         mode_time = {m[0]: 0.0 for m in modes}
@@ -598,7 +589,7 @@ class Run:
         active_order = mode[2]
         suspended = [ci not in active_order for ci in range(n)]
         record(t)
-        fired = check_stop() if stop_ops else None
+        fired = self._check_stop() if stop_ops else None
         steps = 0
         since_record = 0
         # Times closer than this are the same instant: a few ulps of the largest time in the run
@@ -666,7 +657,7 @@ class Run:
                 mode_time[name] += h
                 mode_steps[name] += 1
                 if stop_ops and any(changed[ci] for ci in stop_comps):
-                    fired = check_stop()
+                    fired = self._check_stop()
                 for j, ci in enumerate(ev_comps):
                     if changed[ci]:
                         ev_values[j] = read(events[j])
