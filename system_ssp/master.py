@@ -579,6 +579,17 @@ class System:
         if m.origin:
             lines.append(f"master annotation ({m.origin}): stepSize={m.step_size} algorithm={m.algorithm} "
                          f"order={m.order} stepMultiples={m.step_multiples} stopConditions={m.stop_conditions}")
+        if m.schedule:
+            lines.append(f"schedule ({m.schedule.origin}): first matching mode wins")
+            for mode in m.schedule.modes:
+                when = " and ".join(f"{c}.{v} in {{{', '.join(str(x) for x in sorted(vals))}}}"
+                                    for c, v, vals in mode.conditions) or "always"
+                active = " ".join(mode.active) if mode.active is not None else "all"
+                every = ("; stepped every k-th step: " + ", ".join(f"{c} {k}" for c, k in mode.every.items())
+                         if mode.every else "")
+                lines.append(f"  mode {mode.name}: when {when}: step {mode.step_size:g} s, active {active}{every}")
+            for c, v in m.schedule.events:
+                lines.append(f"  steps land on {c}.{v}")
         try:
             lines.append("default Gauss-Seidel order: " + ", ".join(self.default_order()))
         except SSPError as exc:
