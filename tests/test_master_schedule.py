@@ -116,3 +116,11 @@ def test_component_suspended_from_the_start_joins_at_the_current_time(fmus, tmp_
     # integ is suspended until 0.5 (x = x0 = 1), then steps 0.5 -> 0.75 -> 1.0 with u = gain.y:
     # x = 1 + 0.25 * 1 = 1.25, then 1.25 + 0.25 * 1.25 (not a 0.5 s step from t = 0)
     assert r.final["integ.steps"] == 2 and r.final["integ.x"] == pytest.approx(1.5625, rel=1e-12)
+
+
+def test_info_lists_the_schedule(fmus, tmp_path):
+    with system_ssp.System(scheduled_system(tmp_path, fmus)) as s:
+        text = s.info()
+    assert "mode before: when timer.expired in {0}: step 0.1 s, active all" in text
+    assert "mode after: when always: step 0.25 s, active integ timer" in text
+    assert "steps land on timer.next_event_time" in text
