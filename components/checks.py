@@ -1,4 +1,4 @@
-"""Input and parameter checks shared by the models: finite vectors and parameter sets."""
+"""Input and parameter checks shared by the models: positive numbers, finite vectors and parameter sets."""
 import math
 
 
@@ -29,3 +29,18 @@ def finite_vector(v, n, what, note=None):
     if len(t) != n or not all(math.isfinite(x) for x in t):
         raise ValueError(f"{what} {list(t)} must be {n} finite numbers{suffix}")
     return t
+
+
+def positive(name, value, unit=""):
+    """value as a float > 0; ValueError naming `name` (and its unit) for anything else, a Boolean
+    or a non-number included."""
+    text = f"{name} = {value!r}{' ' + unit if unit else ''} must be a finite positive number"
+    if isinstance(value, bool):
+        raise ValueError(text)
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(text) from None
+    if not (math.isfinite(x) and x > 0.0):
+        raise ValueError(text)
+    return x

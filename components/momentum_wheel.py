@@ -29,18 +29,12 @@ spin-up rate.
 import math
 
 from . import attitude
+from .checks import positive
 
 RPM = 2.0 * math.pi / 60.0
 DEFAULT_INERTIA = 2.0e-5  # kg.m2
 DEFAULT_MAX_TORQUE = 1.0e-3  # N.m
 DEFAULT_MAX_SPEED = 6000.0 * RPM  # rad/s
-
-
-def _positive(name, value, unit):
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} = {value!r} must be a finite number > 0 {unit}")
-    return value
 
 
 class MomentumWheel:
@@ -51,9 +45,9 @@ class MomentumWheel:
             raise ValueError(f"axis_B {list(axis)} must be a finite, non-zero 3-vector (it is normalized)")
         n = attitude.norm(axis)
         self.axis = (axis[0] / n, axis[1] / n, axis[2] / n)
-        self.inertia = _positive("J_w", inertia, "kg.m2")
-        self.max_torque = _positive("max_torque", max_torque, "N.m")
-        self.max_speed = _positive("max_speed", max_speed, "rad/s")
+        self.inertia = positive("J_w", inertia, "kg.m2")
+        self.max_torque = positive("max_torque", max_torque, "N.m")
+        self.max_speed = positive("max_speed", max_speed, "rad/s")
         omega0 = float(omega0)
         if not (math.isfinite(omega0) and abs(omega0) <= self.max_speed):
             raise ValueError(f"Omega0 = {omega0!r} must be a finite wheel rate in [-max_speed, max_speed] "

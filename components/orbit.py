@@ -42,6 +42,7 @@ from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from . import attitude, geodesy, time_utils
+from .checks import positive
 from .gravity import accel_zonal, zonal_coefficients
 from .orbit_elements import MU_EARTH, R_EQ, kepler_to_cartesian, osculating_ecc, osculating_sma
 
@@ -215,13 +216,6 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
     return t, y, h_abs, reentered, steps, rejected
 
 
-def _check_positive(name, value, unit):
-    value = float(value)
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} = {value!r} {unit} must be a finite number > 0")
-    return value
-
-
 class CowellOrbit:
     """Cowell propagation of r, v in N; see the module docstring.
 
@@ -235,9 +229,9 @@ class CowellOrbit:
                  rtol=RTOL, atol_position=ATOL_POSITION, atol_velocity=ATOL_VELOCITY):
         self.epoch = epoch
         self.jd0 = time_utils.julian_date(time_utils.parse_epoch(epoch, "epoch"))
-        self.mu = _check_positive("mu", mu, "m3/s2")
-        self.Cd = _check_positive("Cd", Cd, "(drag coefficient)")
-        self.area = _check_positive("area", area, "m2")
+        self.mu = positive("mu", mu, "m3/s2")
+        self.Cd = positive("Cd", Cd, "(drag coefficient)")
+        self.area = positive("area", area, "m2")
         self.reentry_altitude = float(reentry_altitude)
         if not math.isfinite(self.reentry_altitude):
             raise ValueError(f"reentry_altitude = {reentry_altitude!r} m must be finite")
@@ -245,9 +239,9 @@ class CowellOrbit:
             raise ValueError(f"zonal_degree = {zonal_degree!r} must be 0 (point mass) or an integer in [2, 6]")
         self.zonal_degree = int(zonal_degree)
         self.J = zonal_coefficients(self.zonal_degree)
-        self.rtol = _check_positive("rtol", rtol, "")
-        self.atol = np.array([_check_positive("atol_position", atol_position, "m")] * 3
-                             + [_check_positive("atol_velocity", atol_velocity, "m/s")] * 3)
+        self.rtol = positive("rtol", rtol, "")
+        self.atol = np.array([positive("atol_position", atol_position, "m")] * 3
+                             + [positive("atol_velocity", atol_velocity, "m/s")] * 3)
         sma0, ecc0, inc0 = float(sma0), float(ecc0), float(inc0)
         if not (math.isfinite(sma0) and sma0 > 0.0):
             raise ValueError(f"sma0 = {sma0!r} m must be a finite number > 0")
@@ -287,7 +281,7 @@ class CowellOrbit:
         self.F_B = (0.0, 0.0, 0.0)
         self.q_BN = (0.0, 0.0, 0.0, 1.0)
         self.retrograde = False
-        self.mass = _check_positive("mass", mass, "kg")
+        self.mass = positive("mass", mass, "kg")
         self._outputs = None
 
     # ---- inputs --------------------------------------------------------------------------
@@ -307,7 +301,7 @@ class CowellOrbit:
         if retrograde is not None:
             self.retrograde = bool(retrograde)
         if mass is not None:
-            self.mass = _check_positive("mass", mass, "kg")
+            self.mass = positive("mass", mass, "kg")
 
     def thrust_acceleration_N(self):
         """A(q)^T F_B / m (m/s^2) for the held inputs (not used when retrograde)."""

@@ -35,6 +35,7 @@ from the next step on it is zero.
 import math
 
 from . import checks
+from .checks import positive
 
 MU_EARTH = 398600.4415e9  # m^3/s^2, thesis Section 3.2
 EARTH_RADIUS_EQ = 6378136.3  # m, thesis Section 3.2
@@ -60,18 +61,6 @@ N_NOZZLES = 16
 MANIFOLD_FRACTION = 0.20
 
 
-def _positive(name, value):
-    if isinstance(value, bool):
-        raise ValueError(f"{name} = {value!r} must be a finite positive number")
-    try:
-        value = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name} = {value!r} must be a finite positive number") from None
-    if not (math.isfinite(value) and value > 0.0):
-        raise ValueError(f"{name} = {value!r} must be a finite positive number")
-    return value
-
-
 def _non_negative(name, value):
     value = float(value)
     if not (math.isfinite(value) and value >= 0.0):
@@ -83,7 +72,7 @@ def _non_negative(name, value):
 def delta_v_eq2(r1, r2, mu=MU_EARTH):
     """Thesis Eq. 2 (m/s, signed): speed change at r1 that puts the other apside at r2 (m).
     Negative when lowering (r2 < r1)."""
-    r1, r2, mu = _positive("r1", r1), _positive("r2", r2), _positive("mu", mu)
+    r1, r2, mu = positive("r1", r1), positive("r2", r2), positive("mu", mu)
     return math.sqrt(mu / r1) * (math.sqrt(2.0 * r2 / (r1 + r2)) - 1.0)
 
 
@@ -91,11 +80,11 @@ def deorbit_delta_v(altitude_initial, altitude_target, mu=MU_EARTH, earth_radius
     """|dV| (m/s) of the single retrograde burn from a circular orbit at `altitude_initial` to a
     perigee at `altitude_target` (m above the 6378.1363 km equatorial radius), as Appendix A:
     DeltaV = -sqrt(mu/r1) (sqrt(2 r2/(r1+r2)) - 1). 420 -> 350 km: 19.84 m/s."""
-    h1 = _positive("altitude_initial", altitude_initial)
-    h2 = _positive("altitude_target", altitude_target)
+    h1 = positive("altitude_initial", altitude_initial)
+    h2 = positive("altitude_target", altitude_target)
     if h2 >= h1:
         raise ValueError(f"altitude_target = {h2!r} m must be below altitude_initial = {h1!r} m")
-    R = _positive("earth_radius", earth_radius)
+    R = positive("earth_radius", earth_radius)
     return -delta_v_eq2(R + h1, R + h2, mu)
 
 
@@ -105,22 +94,22 @@ def propellant_mass(delta_v, mass0=MASS0, isp=ISP, g0=G0):
     dv = abs(float(delta_v))
     if not math.isfinite(dv):
         raise ValueError(f"delta_v = {delta_v!r} must be a finite number of m/s")
-    m0, isp, g0 = _positive("mass0", mass0), _positive("isp", isp), _positive("g0", g0)
+    m0, isp, g0 = positive("mass0", mass0), positive("isp", isp), positive("g0", g0)
     return m0 * -math.expm1(-dv / (isp * g0))
 
 
 def delta_v_of_propellant(propellant, mass0=MASS0, isp=ISP, g0=G0):
     """Inverse of Eq. 3: |dV| (m/s) that `propellant` kg delivers from `mass0`."""
-    m0 = _positive("mass0", mass0)
+    m0 = positive("mass0", mass0)
     mp = _non_negative("propellant", propellant)
     if mp >= m0:
         raise ValueError(f"propellant = {mp!r} kg must be below mass0 = {m0!r} kg")
-    return _positive("isp", isp) * _positive("g0", g0) * math.log(m0 / (m0 - mp))
+    return positive("isp", isp) * positive("g0", g0) * math.log(m0 / (m0 - mp))
 
 
 def mass_flow(thrust, isp=ISP, g0=G0):
     """Propellant flow (kg/s) at total thrust `thrust` (N): mdot = F / (Isp g0)."""
-    return _positive("thrust", thrust) / (_positive("isp", isp) * _positive("g0", g0))
+    return positive("thrust", thrust) / (positive("isp", isp) * positive("g0", g0))
 
 
 def burn_time(propellant, thrust=N_THRUSTERS * THRUST_PER_THRUSTER, isp=ISP, g0=G0):
@@ -130,7 +119,7 @@ def burn_time(propellant, thrust=N_THRUSTERS * THRUST_PER_THRUSTER, isp=ISP, g0=
 
 def propellant_from_impulse(impulse, isp=ISP, g0=G0):
     """Eq. 74: m_p = I_t / (Isp g0) (kg) for total impulse I_t (N s)."""
-    return _non_negative("impulse", impulse) / (_positive("isp", isp) * _positive("g0", g0))
+    return _non_negative("impulse", impulse) / (positive("isp", isp) * positive("g0", g0))
 
 
 def deorbit_scenario(altitude_initial, altitude_target, mass0=MASS0, thrust=N_THRUSTERS * THRUST_PER_THRUSTER,
@@ -150,15 +139,15 @@ def tank_sizing(propellant, molar_mass=MOLAR_MASS_R236FA, pressure=STORAGE_PRESS
     Returns SI values: moles, volume (inner, m3), inner_radius, wall_thickness, outer_radius (m),
     outer_volume, shell_volume (m3), shell_mass, tank_and_propellant_mass (kg).
     0.587 kg: 3.86 mol, 376.4 cm3, r 4.48 cm, t_w 0.41 cm, shell 111.8 cm3 / 301.9 g."""
-    mp = _positive("propellant", propellant)
-    P, T = _positive("pressure", pressure), _positive("temperature", temperature)
-    n = mp / _positive("molar_mass", molar_mass)
-    V = n * _positive("r_gas", r_gas) * T / P
+    mp = positive("propellant", propellant)
+    P, T = positive("pressure", pressure), positive("temperature", temperature)
+    n = mp / positive("molar_mass", molar_mass)
+    V = n * positive("r_gas", r_gas) * T / P
     r_i = (3.0 * V / (4.0 * math.pi)) ** (1.0 / 3.0)
-    t_w = P * r_i / (2.0 * _positive("yield_strength", yield_strength)) * _positive("safety_factor", safety_factor)
+    t_w = P * r_i / (2.0 * positive("yield_strength", yield_strength)) * positive("safety_factor", safety_factor)
     r_o = r_i + t_w
     V_o = 4.0 * math.pi / 3.0 * r_o ** 3
-    shell_mass = (V_o - V) * _positive("density", density)
+    shell_mass = (V_o - V) * positive("density", density)
     return {"moles": n, "volume": V, "inner_radius": r_i, "wall_thickness": t_w, "outer_radius": r_o,
             "outer_volume": V_o, "shell_volume": V_o - V, "shell_mass": shell_mass,
             "tank_and_propellant_mass": shell_mass + mp}
@@ -181,16 +170,16 @@ def feed_lines(lengths=None, outer_diameter=FEED_LINE_OD, pressure=STORAGE_PRESS
     lengths = feed_line_lengths() if lengths is None else tuple(lengths)
     if not lengths:
         raise ValueError("lengths must list at least one feed line")
-    lengths = tuple(_positive(f"lengths[{i}]", x) for i, x in enumerate(lengths))
-    D = _positive("outer_diameter", outer_diameter)
-    t_w = (_positive("pressure", pressure) * D / (2.0 * _positive("yield_strength", yield_strength))
-           * _positive("safety_factor", safety_factor))
+    lengths = tuple(positive(f"lengths[{i}]", x) for i, x in enumerate(lengths))
+    D = positive("outer_diameter", outer_diameter)
+    t_w = (positive("pressure", pressure) * D / (2.0 * positive("yield_strength", yield_strength))
+           * positive("safety_factor", safety_factor))
     r_o = 0.5 * D
     r_i = r_o - t_w
     if r_i <= 0.0:
         raise ValueError(f"feed-line wall {t_w!r} m is thicker than the outer radius {r_o!r} m "
                          "(lower pressure or safety_factor, or a stronger material)")
-    rho = _positive("density", density)
+    rho = positive("density", density)
     material = tuple(math.pi * (r_o ** 2 - r_i ** 2) * l for l in lengths)
     outer = tuple(math.pi * r_o ** 2 * l for l in lengths)
     masses = tuple(rho * v for v in material)
@@ -221,16 +210,16 @@ class MainThrusters:
 
     def __init__(self, thrust_per_thruster=THRUST_PER_THRUSTER, n_thrusters=N_THRUSTERS, isp=ISP, g0=G0,
                  mass0=MASS0, propellant_budget=None, axis_B=(1.0, 0.0, 0.0)):
-        self.thrust_per_thruster = _positive("thrust_per_thruster", thrust_per_thruster)
+        self.thrust_per_thruster = positive("thrust_per_thruster", thrust_per_thruster)
         if isinstance(n_thrusters, bool) or int(n_thrusters) != n_thrusters or int(n_thrusters) < 1:
             raise ValueError(f"n_thrusters = {n_thrusters!r} must be an integer >= 1")
         self.n_thrusters = int(n_thrusters)
-        self.isp, self.g0 = _positive("isp", isp), _positive("g0", g0)
-        self.mass0 = _positive("mass0", mass0)
+        self.isp, self.g0 = positive("isp", isp), positive("g0", g0)
+        self.mass0 = positive("mass0", mass0)
         if propellant_budget is None:
             propellant_budget = deorbit_scenario(420e3, 350e3, self.mass0, self.thrust, self.isp,
                                                  self.g0)["propellant"]
-        self.budget = _positive("propellant_budget", propellant_budget)
+        self.budget = positive("propellant_budget", propellant_budget)
         if self.budget >= self.mass0:
             raise ValueError(f"propellant_budget = {self.budget!r} kg must be below mass0 = {self.mass0!r} kg")
         axis = checks.finite_vector(axis_B, 3, "axis_B", "thrust direction in B")

@@ -100,6 +100,7 @@ torque_ff = J omega_dot_ref + omega_ref x J omega_ref.
 import math
 
 from . import attitude
+from .checks import positive
 
 TWO_PI = 2.0 * math.pi
 
@@ -119,13 +120,6 @@ def _quat(q, what):
     if len(q) != 4 or not all(math.isfinite(x) for x in q):
         raise ValueError(f"{what} {list(q)} must be four finite numbers")
     return attitude.normalized(q, what)
-
-
-def _positive(name, value, unit):
-    value = float(value)
-    if not (math.isfinite(value) and value > 0):
-        raise ValueError(f"{name} = {value!r} must be a finite number > 0 ({unit})")
-    return value
 
 
 def angle_between(u, v):
@@ -278,8 +272,8 @@ class SunAvoidanceGuidance:
         self.epsilon, self.margin = epsilon, margin
         self.q0 = _quat(q0, "q0")
         self.q_f = _quat(q_f, "q_f")
-        self.w_max = _positive("w_max", w_max, "rad/s")
-        self.a_max = _positive("a_max", a_max, "rad/s2")
+        self.w_max = positive("w_max", w_max, "rad/s")
+        self.a_max = positive("a_max", a_max, "rad/s2")
         t_start = float(t_start)
         if not math.isfinite(t_start):
             raise ValueError(f"t_start = {t_start!r} s must be finite")
