@@ -13,7 +13,7 @@ from numba import njit
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from components import atmosphere  # noqa: E402
+from components.environment import atmosphere  # noqa: E402
 
 JD = 2459945.5  # 2023-01-01
 

@@ -28,8 +28,9 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from components import atmosphere, propulsion  # noqa: E402
-from components import orbit_averaged as oa  # noqa: E402
+from components.environment import atmosphere  # noqa: E402
+from components.orbit import propulsion  # noqa: E402
+from components.orbit import averaged as oa  # noqa: E402
 
 YEAR = 365.25 * 86400.0
 THESIS = {420: (4.38, 2.20), 475: (25.04, 3.44), 525: (97.41, 3.19)}  # years without / with NEIGHBOR

@@ -17,7 +17,8 @@ import numpy as np
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from components import atmosphere, orbit  # noqa: E402
+from components.environment import atmosphere  # noqa: E402
+from components.orbit import cowell  # noqa: E402
 
 STEP = 300.0
 DAY = 86400.0
@@ -33,7 +34,7 @@ def timed_run(model, days):
 
 
 def density_call_cost(dm, n=2000):
-    r = np.array([orbit.R_EQ + 420e3, 0.0, 0.0])
+    r = np.array([cowell.R_EQ + 420e3, 0.0, 0.0])
     jd = 2459945.5
     dm.density(r, jd)
     t0 = time.perf_counter()
@@ -53,12 +54,12 @@ def density_call_cost(dm, n=2000):
 def main():
     days = float(sys.argv[1]) if len(sys.argv) > 1 else 3.0
     print(f"Cowell, 420 km / 51.6 deg, J2..J6 + drag, communication step {STEP:.0f} s, "
-          f"rtol {orbit.RTOL:g}, atol {orbit.ATOL_POSITION:g} m / {orbit.ATOL_VELOCITY:g} m/s")
+          f"rtol {cowell.RTOL:g}, atol {cowell.ATOL_POSITION:g} m / {cowell.ATOL_VELOCITY:g} m/s")
     print(f"{'model':16s} {'compile s':>9s} {'days':>5s} {'s/day':>8s} {'s/year':>8s} {'steps/day':>9s} "
           f"{'us/step':>8s} {'rho py us':>9s} {'rho nb us':>9s}")
     for name in atmosphere.MODELS:
         dm = atmosphere.make_density_model(name, inclination=math.radians(51.6))
-        m = orbit.CowellOrbit(density_model=dm)
+        m = cowell.CowellOrbit(density_model=dm)
         t0 = time.perf_counter()
         m.advance_to(STEP)  # first step: numba compilation of the integrator for this kernel
         compile_s = time.perf_counter() - t0
@@ -71,11 +72,11 @@ def main():
               f"{wall / (m.steps - s0) * 1e6:8.1f} {py * 1e6:9.1f} {nb * 1e6:9.2f}")
     print("\nconvergence (exponential, 1 day): position difference vs rtol 1e-13 / atol 1e-6 m, 1e-9 m/s")
     dm = atmosphere.make_density_model("exponential")
-    ref = orbit.CowellOrbit(density_model=dm, rtol=1e-13, atol_position=1e-6, atol_velocity=1e-9)
+    ref = cowell.CowellOrbit(density_model=dm, rtol=1e-13, atol_position=1e-6, atol_velocity=1e-9)
     timed_run(ref, 1.0)
-    for rtol, atr, atv in ((1e-9, 1e-2, 1e-5), (1e-10, 1e-3, 1e-6), (orbit.RTOL, orbit.ATOL_POSITION,
-                                                                     orbit.ATOL_VELOCITY), (1e-12, 1e-5, 1e-8)):
-        m = orbit.CowellOrbit(density_model=dm, rtol=rtol, atol_position=atr, atol_velocity=atv)
+    for rtol, atr, atv in ((1e-9, 1e-2, 1e-5), (1e-10, 1e-3, 1e-6), (cowell.RTOL, cowell.ATOL_POSITION,
+                                                                     cowell.ATOL_VELOCITY), (1e-12, 1e-5, 1e-8)):
+        m = cowell.CowellOrbit(density_model=dm, rtol=rtol, atol_position=atr, atol_velocity=atv)
         wall, _ = timed_run(m, 1.0)
         print(f"  rtol {rtol:g} atol {atr:g} m {atv:g} m/s: |dr| = {np.linalg.norm(m.position() - ref.position()):.2e} m, "
               f"{m.steps} steps, {wall:.3f} s")

@@ -25,7 +25,7 @@ import numpy as np
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 import system_ssp  # noqa: E402
-from components.acs_modes import MODE_NAMES  # noqa: E402
+from components.acs.modes import MODE_NAMES  # noqa: E402
 
 SSP = ROOT / "build" / "ssp" / "acs_modes.ssp"
 SCENARIO = "parameters/acs_modes_sun_facing.ssv"

@@ -9,7 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import acs_control, acs_modes  # noqa: E402 (after use_bundled_components)
+from components.acs import control, modes  # noqa: E402 (after use_bundled_components)
 
 PARAMETERS = (
     ("Ix", "kg.m2", "Spacecraft inertia about X (> 0)"),
@@ -42,9 +42,9 @@ class AcsControl(NeighborSlave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         for name, unit, text in PARAMETERS:
-            default = acs_control.PARAMETER_DEFAULTS[name]
+            default = control.PARAMETER_DEFAULTS[name]
             self.parameter(name, default, unit, f"{text}; default {default:.6g}")
-        self.input("mode", 0, None, f"ACS mode ({acs_modes.MODE_TABLE})", int)
+        self.input("mode", 0, None, f"ACS mode ({modes.MODE_TABLE})", int)
         self.input("coils_enabled", False, None, "Coils permitted (false: zero dipole command)", bool)
         self.input("wheel_enabled", False, None, "Wheel permitted (false: zero torque command)", bool)
         self.input("time_in_mode", 0.0, "s", "Time since the current mode was entered (Reorient schedule)")
@@ -66,7 +66,7 @@ class AcsControl(NeighborSlave):
                                   v["time_in_mode"])
 
     def build_model(self):
-        return acs_control.AcsControl({name: self.values[name] for name, _, _ in PARAMETERS})
+        return control.AcsControl({name: self.values[name] for name, _, _ in PARAMETERS})
 
     def do_step(self, current_time, step_size):
         return True

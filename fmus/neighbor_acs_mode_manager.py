@@ -10,7 +10,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import acs_modes  # noqa: E402 (after use_bundled_components)
+from components.acs import modes  # noqa: E402 (after use_bundled_components)
 
 PARAMETERS = (
     ("xz_momentum_error_threshold", "N.m.s", "Detumbled when the X-Z body momentum error is at or below it (> 0)"),
@@ -55,12 +55,12 @@ class AcsModeManager(NeighborSlave):
         super().__init__(**kwargs)
         self._start_time = 0.0
         for name, unit, text in PARAMETERS:
-            default = acs_modes.PARAMETER_DEFAULTS[name]
+            default = modes.PARAMETER_DEFAULTS[name]
             self.parameter(name, default, unit, f"{text}; default {default:.6g}")
         for name, unit, text, kind in INPUTS:
-            self.input(name, acs_modes.INPUT_DEFAULTS[name], unit, text, kind)
+            self.input(name, modes.INPUT_DEFAULTS[name], unit, text, kind)
         self.output("mode", lambda: self.model.mode, None,
-                    f"ACS mode ({acs_modes.MODE_TABLE}), decided at the start of the last step", int)
+                    f"ACS mode ({modes.MODE_TABLE}), decided at the start of the last step", int)
         self.output("time_in_mode", lambda: self.model.time_in_mode, "s", "Time since the current mode was entered")
         self.output("coils_enabled", lambda: self.model.permissions[0], None,
                     "Magnetic torque coils may be commanded (false: zero dipole)", bool)
@@ -78,7 +78,7 @@ class AcsModeManager(NeighborSlave):
 
     def build_model(self):
         params = {name: self.values[name] for name, _, _ in PARAMETERS}
-        return acs_modes.AcsModeManager(params, self._start_time)
+        return modes.AcsModeManager(params, self._start_time)
 
     def setup_experiment(self, start_time, stop_time=None, tolerance=None):
         self._start_time = float(start_time)

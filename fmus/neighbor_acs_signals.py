@@ -9,7 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import acs_signals  # noqa: E402 (after use_bundled_components)
+from components.acs import signals  # noqa: E402 (after use_bundled_components)
 
 H_IN = [f"H_B[{i}]" for i in (1, 2, 3)]
 HW_IN = [f"wheel_momentum_B[{i}]" for i in (1, 2, 3)]
@@ -23,7 +23,7 @@ class AcsSignals(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        d = acs_signals.PARAMETER_DEFAULTS
+        d = signals.PARAMETER_DEFAULTS
         self.parameter("Iy", d["Iy"], "kg.m2", "Spacecraft inertia about Y for H_d = Iy spin_rate (> 0)")
         self.parameter("spin_rate", d["spin_rate"], "rad/s", "Desired spin rate about +Y (> 0; seed 5 deg/s)")
         self.parameter("command_start", d["command_start"], "s", "Ground command true from this time")
@@ -51,7 +51,7 @@ class AcsSignals(NeighborSlave):
                                  self.vector("omega_BN_B", 3), self.vector("sun_heading_B", 3))
 
     def build_model(self):
-        return acs_signals.AcsSignals({k: self.values[k] for k in acs_signals.PARAMETER_DEFAULTS}, self.start_time)
+        return signals.AcsSignals({k: self.values[k] for k in signals.PARAMETER_DEFAULTS}, self.start_time)
 
     def do_step(self, current_time, step_size):
         self.model.step(step_size)

@@ -12,7 +12,8 @@ from neighbor_fmu_support import NeighborSlave, atmosphere_model, atmosphere_par
 
 use_bundled_components(__file__)
 
-from components import atmosphere, time_utils  # noqa: E402 (after use_bundled_components)
+from components.environment import atmosphere  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
 
 class Atmosphere(NeighborSlave):

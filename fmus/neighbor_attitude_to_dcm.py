@@ -8,7 +8,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import air_bearing  # noqa: E402 (after use_bundled_components)
+from components.sensing import air_bearing  # noqa: E402 (after use_bundled_components)
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 

@@ -9,7 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import detumble, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.attitude import detumble, thruster_control  # noqa: E402 (after use_bundled_components)
 
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
 ACCEL_INPUTS = [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)]

@@ -7,7 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import eclipse  # noqa: E402 (after use_bundled_components)
+from components.environment import eclipse  # noqa: E402 (after use_bundled_components)
 
 R_INPUTS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 SUN_INPUTS = [f"r_SN_N[{i}]" for i in (1, 2, 3)]

@@ -32,11 +32,20 @@ def use_bundled_components(wrapper_file):
     provides the `components` package for all. Its extracted folder may be gone by the time a
     later FMU imports a submodule nobody imported yet (fmpy.simulate_fmu removes its folder),
     so each wrapper puts its own folder first on the package's search path; missing folders
-    are skipped. Call it before importing from `components`; a no-op in the source tree."""
+    are skipped. The same holds for every subpackage already imported (components.core, ...).
+    Call it before importing from `components`; a no-op in the source tree."""
     bundled = os.path.join(os.path.dirname(os.path.abspath(wrapper_file)), "components")
-    package = sys.modules.get("components")
-    if package is not None and os.path.isdir(bundled) and bundled not in package.__path__:
-        package.__path__.insert(0, bundled)
+    if not os.path.isdir(bundled):
+        return
+    for name, package in list(sys.modules.items()):
+        if name != "components" and not name.startswith("components."):
+            continue
+        path = getattr(package, "__path__", None)
+        if path is None:
+            continue  # a module, not a package
+        folder = os.path.join(bundled, *name.split(".")[1:])
+        if os.path.isdir(folder) and folder not in path:
+            path.insert(0, folder)
 
 
 class ParameterError(ValueError):
@@ -297,7 +306,7 @@ def atmosphere_model(values, inclination=None):
     `atmosphere_parameters` (a mapping name -> value, e.g. slave.values). `inclination` (rad)
     sets the Harris-Priester exponent when hp_exponent is 0. ValueError naming the parameter
     for a bad value. A space-weather file is parsed once per path and process."""
-    from components import atmosphere, space_weather
+    from components.environment import atmosphere, space_weather
 
     name = values["density_model"]
     if name not in atmosphere.MODELS:

@@ -10,7 +10,8 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import ground_station as gs, time_utils  # noqa: E402 (after use_bundled_components)
+from components.mission import ground_station as gs  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
 R = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
 

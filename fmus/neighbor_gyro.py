@@ -7,7 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import sensors  # noqa: E402 (after use_bundled_components)
+from components.sensing import sensors  # noqa: E402 (after use_bundled_components)
 
 RATE = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
 

@@ -9,7 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import host  # noqa: E402 (after use_bundled_components)
+from components.mission import host  # noqa: E402 (after use_bundled_components)
 
 
 class HostSpacecraft(NeighborSlave):

@@ -10,7 +10,8 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import magnetic_field, time_utils  # noqa: E402 (after use_bundled_components)
+from components.environment import magnetic_field  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
 R_IN = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 Q_IN = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]

@@ -12,7 +12,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import mission_manager as mm  # noqa: E402 (after use_bundled_components)
+from components.mission import manager as mm  # noqa: E402 (after use_bundled_components)
 
 D = mm.PARAMETER_DEFAULTS
 PARAMETERS = (

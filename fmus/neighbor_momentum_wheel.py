@@ -9,7 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import momentum_wheel  # noqa: E402 (after use_bundled_components)
+from components.acs import momentum_wheel  # noqa: E402 (after use_bundled_components)
 
 
 class MomentumWheel(NeighborSlave):

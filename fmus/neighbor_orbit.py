@@ -17,9 +17,10 @@ from neighbor_fmu_support import NeighborSlave, atmosphere_model, use_bundled_co
 
 use_bundled_components(__file__)
 
-from components import orbit, orbit_elements, time_utils  # noqa: E402 (after use_bundled_components)
+from components.orbit import cowell, elements  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
-R_EQ = orbit_elements.R_EQ
+R_EQ = elements.R_EQ
 
 
 class Orbit(NeighborSlave):
@@ -29,7 +30,7 @@ class Orbit(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, orbit_elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
+        self.orbit_interface(R_EQ + 420e3, elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
         self.parameter("zonal_degree", 6, None,
                        "Zonal gravity terms: 0 = point mass only, 2 = J2, ..., 6 = J2..J6 (EGM96)", int)
         self.parameter("drag", True, None, "Atmospheric drag on (false: gravity and thrust only)", bool)
@@ -55,9 +56,9 @@ class Orbit(NeighborSlave):
         v = self.values
         if not (0.0 <= v["inc0"] <= math.pi):
             raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [0, pi]")
-        sma, ecc, inc, raan, argp, ta = orbit_elements.initial_elements(v, v["mu"])
+        sma, ecc, inc, raan, argp, ta = elements.initial_elements(v, v["mu"])
         density = atmosphere_model(v, inclination=inc) if v["drag"] else None
-        return orbit.CowellOrbit(
+        return cowell.CowellOrbit(
             epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
             ta0=ta, Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],
             density_model=density, drag=v["drag"], zonal_degree=v["zonal_degree"], mu=v["mu"], t0=self.start_time)

@@ -21,9 +21,10 @@ from neighbor_fmu_support import NeighborSlave, atmosphere_model, use_bundled_co
 
 use_bundled_components(__file__)
 
-from components import orbit_averaged, orbit_elements, time_utils  # noqa: E402 (after use_bundled_components)
+from components.orbit import averaged, elements  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
-R_EQ = orbit_elements.R_EQ
+R_EQ = elements.R_EQ
 
 
 class OrbitAveraged(NeighborSlave):
@@ -32,10 +33,10 @@ class OrbitAveraged(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, orbit_elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
+        self.orbit_interface(R_EQ + 420e3, elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
         self.parameter("drag", True, None, "Atmospheric drag on (false: J2 and thrust only, density output 0)",
                        bool)
-        self.parameter("j2", orbit_averaged.J2, "1",
+        self.parameter("j2", averaged.J2, "1",
                        "J2 of the secular drift of RAAN, argp and M (EGM96 1.0826e-3), in [0, 0.01]; 0 = none")
         self.parameter("quadrature_nodes", 16, None,
                        "Nodes of the orbit-average quadrature (trapezoidal in eccentric longitude), 8..512", int)
@@ -70,9 +71,9 @@ class OrbitAveraged(NeighborSlave):
         if not (0.0 <= v["inc0"] <= math.pi):
             raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [1e-4, pi - 1e-4]")
         # a Cartesian start is taken as the mean state (no short-period correction)
-        sma, ecc, inc, raan, argp, ta = orbit_elements.initial_elements(v, v["mu"])
+        sma, ecc, inc, raan, argp, ta = elements.initial_elements(v, v["mu"])
         density = atmosphere_model(v, inclination=inc) if v["drag"] else None
-        return orbit_averaged.OrbitAveraged(
+        return averaged.OrbitAveraged(
             density, epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
             ta0=ta, Cd=v["Cd"], area=v["area"], reentry_altitude=v["reentry_altitude"], mu=v["mu"],
             j2=v["j2"], quadrature_nodes=v["quadrature_nodes"], max_step=v["max_step"],

@@ -7,7 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import paddles  # noqa: E402 (after use_bundled_components)
+from components.acs import paddles  # noqa: E402 (after use_bundled_components)
 
 
 class Paddles(NeighborSlave):

@@ -10,7 +10,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import power  # noqa: E402 (after use_bundled_components)
+from components.mission import power  # noqa: E402 (after use_bundled_components)
 
 
 class Power(NeighborSlave):

@@ -14,7 +14,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import propulsion  # noqa: E402 (after use_bundled_components)
+from components.orbit import propulsion  # noqa: E402 (after use_bundled_components)
 
 _DEFAULT_BUDGET = propulsion.deorbit_scenario(420e3, 350e3)["propellant"]
 

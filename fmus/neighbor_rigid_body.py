@@ -15,7 +15,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import rigid_body  # noqa: E402 (after use_bundled_components)
+from components.attitude import rigid_body  # noqa: E402 (after use_bundled_components)
 
 
 class RigidBody(NeighborSlave):

@@ -12,7 +12,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import rigid_body, sun_avoidance  # noqa: E402 (after use_bundled_components)
+from components.attitude import rigid_body, sun_avoidance  # noqa: E402 (after use_bundled_components)
 
 MAX_SEGMENTS = 3
 

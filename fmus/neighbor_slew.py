@@ -9,7 +9,8 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import attitude, slew, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.core import rotations  # noqa: E402 (after use_bundled_components)
+from components.attitude import slew, thruster_control  # noqa: E402 (after use_bundled_components)
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
@@ -52,7 +53,7 @@ class SlewController(NeighborSlave):
         return self.model.done(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _angle(self):
-        dq = attitude.normalized(self.model.error_quaternion(self.vector("q_BN", 4)), "q_BN")
+        dq = rotations.normalized(self.model.error_quaternion(self.vector("q_BN", 4)), "q_BN")
         return 2.0 * math.acos(min(1.0, abs(dq[3])))
 
     def do_step(self, current_time, step_size):

@@ -8,7 +8,8 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import sun, time_utils  # noqa: E402 (after use_bundled_components)
+from components.environment import sun  # noqa: E402 (after use_bundled_components)
+from components.core import time_utils  # noqa: E402 (after use_bundled_components)
 
 
 class SunEphemeris(NeighborSlave):

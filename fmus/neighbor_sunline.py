@@ -8,7 +8,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import sunline  # noqa: E402 (after use_bundled_components)
+from components.sensing import sunline  # noqa: E402 (after use_bundled_components)
 
 R_SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
 R_SC = [f"r_BN_N[{i}]" for i in (1, 2, 3)]

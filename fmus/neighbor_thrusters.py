@@ -8,7 +8,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import thrusters  # noqa: E402 (after use_bundled_components)
+from components.attitude import thrusters  # noqa: E402 (after use_bundled_components)
 
 CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
 

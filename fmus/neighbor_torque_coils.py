@@ -7,7 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import magnetorquer  # noqa: E402 (after use_bundled_components)
+from components.acs import magnetorquer  # noqa: E402 (after use_bundled_components)
 
 CMD_IN = [f"dipole_cmd_B[{i}]" for i in (1, 2, 3)] + ["enabled"]
 B_IN = [f"B_B[{i}]" for i in (1, 2, 3)]

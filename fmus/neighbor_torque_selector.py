@@ -7,7 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import command_selector  # noqa: E402 (after use_bundled_components)
+from components.attitude import command_selector  # noqa: E402 (after use_bundled_components)
 
 
 class _Stateless:

@@ -14,7 +14,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
-from components import deorbit_tracking, rigid_body, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.attitude import deorbit_tracking, rigid_body, thruster_control  # noqa: E402 (after use_bundled_components)
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]

@@ -23,7 +23,7 @@ import os
 from pathlib import Path
 import sys
 
-from components import propulsion
+from components.orbit import propulsion
 
 from .errors import SSPError
 from .master import System, write_csv_atomic

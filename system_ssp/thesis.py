@@ -20,7 +20,7 @@ import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
-from components import attitude
+from components.core import rotations
 
 from .master import System
 
@@ -96,7 +96,7 @@ def slew_case3(slew, start, integrator="euler", stop_time=None):
     target = q
     parts = []
     for axis in "xyz":
-        target = attitude.circle_cross(attitude.from_axis_angle(AXES[axis], math.pi), target)
+        target = rotations.circle_cross(rotations.from_axis_angle(AXES[axis], math.pi), target)
         params = _initial(q, w)
         params.update({f"slew.q_d[{i}]": v for i, v in enumerate(target, 1)})
         part, (q, w) = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params)

@@ -9,8 +9,9 @@ import pytest
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from components import acs_control as ac  # noqa: E402
-from components import acs_signals, magnetorquer, momentum_wheel, optical_tracker, paddles, rigid_body  # noqa: E402
+from components.acs import control as ac  # noqa: E402
+from components.acs import signals, magnetorquer, momentum_wheel, optical_tracker, paddles  # noqa: E402
+from components.attitude import rigid_body  # noqa: E402
 
 J = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3)
 B0 = (2.0e-5, -1.0e-5, 3.0e-5)
@@ -19,7 +20,7 @@ D = math.radians
 
 def closed_loop(mode, omega0, seconds, sun=(0.3, 0.5, 0.8), wheel0=0.0, B=B0, h=1.0, params=None, tim=0.0):
     """Body, coils and wheel in a fixed inertial field and Sun, the law in `mode` in the loop."""
-    from components import attitude
+    from components.core import rotations
     c = ac.AcsControl(params)
     body = rigid_body.RigidBody(J, (0, 0, 0, 1), omega0, "rk4", 0.05)
     coils, wheel = magnetorquer.TorqueCoils(), momentum_wheel.MomentumWheel(omega0=wheel0)
@@ -27,7 +28,7 @@ def closed_loop(mode, omega0, seconds, sun=(0.3, 0.5, 0.8), wheel0=0.0, B=B0, h=
     sun = [x / n for x in sun]
     t = 0.0
     while t < seconds:
-        A = attitude.attitude_matrix(body.q)
+        A = rotations.attitude_matrix(body.q)
         bB = [sum(A[i][j] * B[j] for j in range(3)) for i in range(3)]
         sB = [sum(A[i][j] * sun[j] for j in range(3)) for i in range(3)]
         m, tw = c.command(mode, True, True, body.omega, bB, sB, wheel.rate, tim + t)
@@ -35,7 +36,7 @@ def closed_loop(mode, omega0, seconds, sun=(0.3, 0.5, 0.8), wheel0=0.0, B=B0, h=
         body.step(coils.torque(m, bB)[1], h, wheel.torque_B(tw), hw)
         wheel.step(tw, True, h)
         t += h
-    A = attitude.attitude_matrix(body.q)
+    A = rotations.attitude_matrix(body.q)
     sB = [sum(A[i][j] * sun[j] for j in range(3)) for i in range(3)]
     return body, wheel, sB
 
@@ -123,7 +124,7 @@ def test_bad_parameters_and_mode():
 
 
 def test_signals_definitions():
-    s = acs_signals.AcsSignals({"command_start": 10.0, "command_end": 20.0})
+    s = signals.AcsSignals({"command_start": 10.0, "command_end": 20.0})
     hd = 0.13 * D(5)
     v = s.values((0.003, 0.5 * hd, -0.004), (0.0, 0.5 * hd, 0.0), (0.0, 0.0, 0.1), (1.0, 1.0, 0.0))
     assert v["xz_momentum_error"] == pytest.approx(0.005)
@@ -200,7 +201,7 @@ def test_fmu_validates_and_simulates(acs_fmu_dir, name):
 
 
 def test_precession_tapers_off_with_the_momentum_error():
-    from components import acs_control as ac
+    from components.acs import control as ac
     c = ac.AcsControl({"k_momentum": 1e-12})
     hd = c.p["Iy"] * c.p["spin_rate"]
     s = (0.6, 0.5, 0.6)
@@ -214,7 +215,7 @@ def test_precession_tapers_off_with_the_momentum_error():
 
 
 def test_fine_modes_use_their_own_precession_gain():
-    from components import acs_control as ac
+    from components.acs import control as ac
     B, s, w = (2e-5, 1e-5, -3e-5), (0.3, 0.2, 0.93), (0.0, 0.0, 0.0)
     wr = 0.13 * ac.PARAMETER_DEFAULTS["spin_rate"] / 2e-5
     a = ac.AcsControl({"k_precession_fine": 1e-3}).command(ac.ORBIT_DAY, True, True, w, B, s, wr)[0]

@@ -15,7 +15,7 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from components import acs_modes as am  # noqa: E402
+from components.acs import modes as am  # noqa: E402
 
 P = am.PARAMETER_DEFAULTS
 W, DT, SU, RE, DW, AC, DP, OD, ON, GC = range(10)

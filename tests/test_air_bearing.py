@@ -13,8 +13,8 @@ from hypothesis import given, settings
 from hypothesis import strategies as st
 from scipy.linalg import expm
 
-from components import air_bearing as ab
-from components import attitude
+from components.sensing import air_bearing as ab
+from components.core import rotations
 
 ROOT = Path(__file__).resolve().parents[1]
 TAU = math.radians(40.0)
@@ -43,22 +43,22 @@ def assert_rotation(c, tol=1e-12):
 # ---- conventions and extraction ------------------------------------------------------------
 def test_conventions_yaw_pitch_roll_and_quaternions():
     # A yaw about n3 is the attitude matrix of from_axis_angle(e3, psi): [BN] = R3(psi).
-    q = attitude.from_axis_angle((0.0, 0.0, 1.0), 0.7)
+    q = rotations.from_axis_angle((0.0, 0.0, 1.0), 0.7)
     np.testing.assert_allclose(ab.euler321_from_quaternion(q), (0.7, 0.0, 0.0), atol=1e-15)
     # [BN] = R_321 = R1(phi) R2(theta) R3(psi) = A(q_x (x) q_y (x) q_z)
     rng = np.random.default_rng(7)
     for _ in range(200):
         psi, theta, phi = rng.uniform(-math.pi, math.pi), rng.uniform(-1.5, 1.5), rng.uniform(-math.pi, math.pi)
         c = R321(psi, theta, phi)
-        r1 = np.array(attitude.attitude_matrix(attitude.from_axis_angle((1.0, 0.0, 0.0), phi)))
-        r2 = np.array(attitude.attitude_matrix(attitude.from_axis_angle((0.0, 1.0, 0.0), theta)))
-        r3 = np.array(attitude.attitude_matrix(attitude.from_axis_angle((0.0, 0.0, 1.0), psi)))
+        r1 = np.array(rotations.attitude_matrix(rotations.from_axis_angle((1.0, 0.0, 0.0), phi)))
+        r2 = np.array(rotations.attitude_matrix(rotations.from_axis_angle((0.0, 1.0, 0.0), theta)))
+        r3 = np.array(rotations.attitude_matrix(rotations.from_axis_angle((0.0, 0.0, 1.0), psi)))
         np.testing.assert_allclose(c, r1 @ r2 @ r3, atol=1e-14)
-        np.testing.assert_allclose(attitude.attitude_matrix(ab.quaternion_from_euler321(psi, theta, phi)), c,
+        np.testing.assert_allclose(rotations.attitude_matrix(ab.quaternion_from_euler321(psi, theta, phi)), c,
                                    atol=1e-14)
         q = ab.quaternion_from_dcm(c)
         assert q[3] >= 0 and abs(math.fsum(x * x for x in q) - 1) < 1e-15
-        np.testing.assert_allclose(attitude.attitude_matrix(q), c, atol=1e-14)
+        np.testing.assert_allclose(rotations.attitude_matrix(q), c, atol=1e-14)
         np.testing.assert_allclose(ab.euler321_from_quaternion(q), (psi, theta, phi), atol=1e-12)
         # the tilt of b3 from n3: cos = cos(theta) cos(phi)
         assert c[2, 2] == pytest.approx(math.cos(theta) * math.cos(phi), abs=1e-14)
@@ -122,7 +122,7 @@ def test_pitch_and_roll_are_clamped_yaw_kept_dcm_orthonormal(angles, expected, l
     c = np.array(out["dcm_out_BN"])
     assert_rotation(c)
     np.testing.assert_allclose(c, R321(*out["euler321"]), atol=1e-15)
-    np.testing.assert_allclose(attitude.attitude_matrix(out["q_BN"]), c, atol=1e-14)
+    np.testing.assert_allclose(rotations.attitude_matrix(out["q_BN"]), c, atol=1e-14)
     assert c[2, 2] >= math.cos(TAU) ** 2 - 1e-15  # the tilt stays within the table's limit
     if not limited:
         np.testing.assert_allclose(c, c_in, atol=1e-14)
@@ -132,7 +132,7 @@ def test_pitch_and_roll_are_clamped_yaw_kept_dcm_orthonormal(angles, expected, l
 @given(st.lists(st.floats(-1.0, 1.0), min_size=4, max_size=4).filter(lambda v: sum(x * x for x in v) > 1e-3),
        st.floats(0.05, 1.5))
 def test_limiter_properties_for_any_attitude(qv, tau):
-    c = attitude.attitude_matrix(attitude.normalized(qv))
+    c = rotations.attitude_matrix(rotations.normalized(qv))
     psi, theta, phi = ab.euler321_from_quaternion(ab.quaternion_from_dcm(c))
     out = ab.AirBearingKinematics(tau).evaluate(c)
     y, p, r = out["euler321"]
@@ -296,7 +296,7 @@ def test_get_and_set_state_restores_everything():
 
 def test_attitude_to_dcm_normalizes():
     q = (1.0, 2.0, 3.0, 4.0)
-    np.testing.assert_allclose(ab.AttitudeToDcm().dcm(q), attitude.attitude_matrix(attitude.normalized(q)),
+    np.testing.assert_allclose(ab.AttitudeToDcm().dcm(q), rotations.attitude_matrix(rotations.normalized(q)),
                                atol=1e-15)
 
 
@@ -350,7 +350,7 @@ def test_fmus_simulate_alone(ab_fmus):
     q = (0.1, -0.2, 0.3, 0.5)
     r = fmpy.simulate_fmu(str(ab_fmus / "AttitudeToDcm.fmu"), stop_time=0.1, output_interval=0.1,
                           start_values={f"q_BN[{i}]": v for i, v in enumerate(q, 1)})
-    a = attitude.attitude_matrix(attitude.normalized(q))
+    a = rotations.attitude_matrix(rotations.normalized(q))
     for i in range(3):
         for j in range(3):
             assert r[f"dcm_BN[{i + 1},{j + 1}]"][-1] == pytest.approx(a[i][j], abs=1e-15)

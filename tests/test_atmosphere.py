@@ -8,7 +8,9 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from components import atmosphere, geodesy, jacchia_roberts, space_weather, sun, time_utils
+from components.environment import atmosphere, geodesy, space_weather, sun
+from components.environment.atmosphere import jacchia_roberts
+from components.core import time_utils
 from fmu_helpers import check_declarations, instantiate
 
 GMAT_VECTORS = Path(__file__).resolve().parent / "data" / "jacchia_roberts_gmat_test_2011.csv"

@@ -17,7 +17,9 @@ sys.path.insert(0, str(ROOT))
 
 import build_fmus  # noqa: E402
 import system_ssp  # noqa: E402
-from components import attitude, rigid_body, sensors, triad  # noqa: E402
+from components.core import rotations  # noqa: E402
+from components.attitude import rigid_body  # noqa: E402
+from components.sensing import sensors, triad  # noqa: E402
 
 WRAPPERS = {"HorizonSensor": "neighbor_horizon_sensor", "SunSensor": "neighbor_sun_sensor", "Gyro": "neighbor_gyro",
             "GpsReceiver": "neighbor_gps", "AttitudeDetermination": "neighbor_attitude_determination"}
@@ -27,11 +29,11 @@ R_LEO = (6798137.0, 0.0, 0.0)
 
 
 def random_quaternion(rng):
-    return attitude.normalized(tuple(rng.standard_normal(4)))
+    return rotations.normalized(tuple(rng.standard_normal(4)))
 
 
 def rot(q, v):
-    return sensors.rotate_vector(attitude.attitude_matrix(q), v)
+    return sensors.rotate_vector(rotations.attitude_matrix(q), v)
 
 
 # ---- components: TRIAD and Shepperd ------------------------------------------------------
@@ -39,17 +41,17 @@ def test_shepperd_inverts_the_attitude_matrix_on_every_branch():
     rng = np.random.default_rng(11)
     qs = [random_quaternion(rng) for _ in range(500)]
     # near-180 deg rotations about each axis exercise the q1, q2, q3 branches
-    qs += [attitude.from_axis_angle(axis, math.pi - 1e-3) for axis in ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
+    qs += [rotations.from_axis_angle(axis, math.pi - 1e-3) for axis in ((1, 0, 0), (0, 1, 0), (0, 0, 1))]
     qs += [(0.0, 0.0, 0.0, 1.0), (1.0, 0.0, 0.0, 0.0), (0.0, 1.0, 0.0, 0.0), (0.0, 0.0, 1.0, 0.0)]
     branches = set()
     for q in qs:
-        A = attitude.attitude_matrix(q)
+        A = rotations.attitude_matrix(q)
         p = triad.dcm_to_quaternion(A)
         tr = A[0][0] + A[1][1] + A[2][2]
         cand = (A[0][0], A[1][1], A[2][2], tr)
         branches.add(cand.index(max(cand)))
         assert p[3] >= 0.0
-        assert np.allclose(attitude.attitude_matrix(p), A, rtol=0, atol=1e-12)
+        assert np.allclose(rotations.attitude_matrix(p), A, rtol=0, atol=1e-12)
         assert min(np.abs(np.subtract(p, q)).max(), np.abs(np.add(p, q)).max()) < 1e-12
     assert branches == {0, 1, 2, 3}
 
@@ -59,12 +61,12 @@ def test_triad_recovers_the_attitude_exactly_from_noise_free_vectors():
     for _ in range(300):
         q = random_quaternion(rng)
         r1, r2 = rng.standard_normal(3) * 1e7, rng.standard_normal(3)
-        A = attitude.attitude_matrix(q)
+        A = rotations.attitude_matrix(q)
         b1, b2 = sensors.rotate_vector(A, r1), sensors.rotate_vector(A, r2)
         At = triad.triad(b1, b2, r1, r2)
         assert np.allclose(At, A, rtol=0, atol=1e-12)
         qt = triad.triad_quaternion(b1, b2, r1, r2)
-        assert np.allclose(attitude.attitude_matrix(qt), At, rtol=0, atol=1e-12)
+        assert np.allclose(rotations.attitude_matrix(qt), At, rtol=0, atol=1e-12)
         assert triad.error_angle(qt, q) < 1e-9
         # TRIAD reproduces b1 exactly, whatever b2 is (here b2 perturbed)
         b2n = np.add(b2, 0.05 * rng.standard_normal(3))
@@ -115,15 +117,15 @@ def test_noise_free_sensors_measure_the_truth():
 def test_sensor_noise_statistics_match_sigma():
     n = 3000
     q = (0.1, -0.2, 0.3, 0.9)
-    q = attitude.normalized(q)
+    q = rotations.normalized(q)
     sigma = 0.25 * DEG
     h = sensors.HorizonSensor(sigma=sigma, seed=21)
     true = rot(q, (-1.0, 0.0, 0.0))
     angles, perp = [], []
     for _ in range(n):
         b, _ = h.measure(R_LEO, q)
-        assert abs(attitude.norm(b) - 1.0) < 1e-14
-        angles.append(math.atan2(attitude.norm(attitude.cross(true, b)), attitude.dot(true, b)))
+        assert abs(rotations.norm(b) - 1.0) < 1e-14
+        angles.append(math.atan2(rotations.norm(rotations.cross(true, b)), rotations.dot(true, b)))
         d = np.subtract(b, true)
         perp.append(d / np.linalg.norm(d))
         h.step()
@@ -156,7 +158,7 @@ def _outputs(sensor, n, *args):
 
 
 def test_noise_is_reproducible_and_state_restores_the_generator():
-    q = attitude.normalized((0.3, 0.1, -0.2, 0.9))
+    q = rotations.normalized((0.3, 0.1, -0.2, 0.9))
     for make, args in ((lambda s: sensors.HorizonSensor(seed=s), (R_LEO, q)),
                        (lambda s: sensors.Gyro(sigma=1e-3, seed=s), ((0.1, 0.0, 0.0),)),
                        (lambda s: sensors.GpsReceiver(seed=s), (R_LEO,))):
@@ -234,7 +236,7 @@ def test_triad_error_rms_matches_the_first_order_prediction(theta_deg, nadir_deg
 
 def test_attitude_determination_orders_by_sigma():
     # Exact nadir, Sun 10 deg off: nadir-first keeps the nadir exact, Sun-first does not.
-    q = attitude.normalized((0.2, -0.1, 0.4, 0.8))
+    q = rotations.normalized((0.2, -0.1, 0.4, 0.8))
     r_sun = (0.0, 1.5e11, 0.0)
     nadir_B = rot(q, (-1.0, 0.0, 0.0))
     sun_B = sensors.perturb(rot(q, sensors.unit_vector(np.subtract(r_sun, R_LEO), "s")), 10 * DEG, 0.7)
@@ -252,14 +254,14 @@ def test_attitude_determination_orders_by_sigma():
 
 def test_propagation_is_exact_for_a_constant_rate_and_follows_the_bias():
     w = (0.02, -0.01, 0.03)
-    q0 = attitude.normalized((0.1, 0.2, 0.3, 0.9))
+    q0 = rotations.normalized((0.1, 0.2, 0.3, 0.9))
     # reference: RK4 on q_dot = 1/2 Xi(q) w in 5 ms steps
     q = np.array(q0)
     for _ in range(2000):
-        k1 = np.array(attitude.quaternion_rate(q, w))
-        k2 = np.array(attitude.quaternion_rate(q + 0.0025 * k1, w))
-        k3 = np.array(attitude.quaternion_rate(q + 0.0025 * k2, w))
-        k4 = np.array(attitude.quaternion_rate(q + 0.005 * k3, w))
+        k1 = np.array(rotations.quaternion_rate(q, w))
+        k2 = np.array(rotations.quaternion_rate(q + 0.0025 * k1, w))
+        k3 = np.array(rotations.quaternion_rate(q + 0.0025 * k2, w))
+        k4 = np.array(rotations.quaternion_rate(q + 0.005 * k3, w))
         q = q + 0.005 / 6 * (k1 + 2 * k2 + 2 * k3 + k4)
     ad = triad.AttitudeDetermination(q0=q0)
     none = ((0, 0, 0), False, (0, 0, 0), False, R_LEO, (0, 1e11, 0))
@@ -273,7 +275,7 @@ def test_propagation_is_exact_for_a_constant_rate_and_follows_the_bias():
     bias = (1e-3, -1e-3, 1e-3)
     gyro = sensors.Gyro(bias=bias, sigma=5.5e-4, seed=3)
     ad = triad.AttitudeDetermination(q0=q0)
-    b = attitude.norm(bias)
+    b = rotations.norm(bias)
     for k in range(1, 601):
         ad.step(none, gyro.measure(body.omega), 0.1)
         body.step((0, 0, 0), 0.1)
@@ -331,7 +333,7 @@ def test_fmus_validate_and_declare_dependencies(ad_fmus):
 
 def test_fmus_simulate_alone(ad_fmus):
     _, x = ad_fmus
-    q = attitude.normalized((0.2, -0.1, 0.4, 0.8))
+    q = rotations.normalized((0.2, -0.1, 0.4, 0.8))
     qv = {f"q_BN[{i}]": v for i, v in enumerate(q, 1)}
     r = fmpy.simulate_fmu(x["HorizonSensor"], stop_time=1.0, output_interval=0.1, start_values={"sigma": 0.0, **qv})
     assert np.allclose([r[f"nadir_B[{i}]"][-1] for i in (1, 2, 3)], rot(q, (-1, 0, 0)), atol=1e-15)
@@ -469,7 +471,7 @@ def test_system_noisy_fix_errors_match_the_sensor_accuracies(ad_ssp):
     ssv = _ssv_values("attitude_determination_ad") | _ssv_values("attitude_determination_gps")
     r_sc = [ssv[f"r_BN_N[{i}]"] for i in (1, 2, 3)]
     sun_N = sensors.unit_vector(np.subtract([ssv[f"r_SN_N[{i}]"] for i in (1, 2, 3)], r_sc), "sun")
-    theta = math.acos(attitude.dot(sun_N, sensors.unit_vector([-x for x in r_sc], "nadir")))
+    theta = math.acos(rotations.dot(sun_N, sensors.unit_vector([-x for x in r_sc], "nadir")))
     # fixed positions: the angle between the two vectors, and so the prediction, is constant
     predicted = [triad.triad_error_rms(ssv["sun_sigma"], ssv["nadir_sigma"], theta)]
     assert ssv["sun_sigma"] < ssv["nadir_sigma"]

@@ -7,7 +7,7 @@ import math
 import fmpy
 import pytest
 
-from components import data_storage as ds
+from components.mission import data_storage as ds
 from fmu_helpers import check_declarations, instantiate
 
 # De-orbit mode phases that record (Appendix I: attitude determination, control, burn), s

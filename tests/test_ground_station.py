@@ -7,7 +7,9 @@ import math
 import numpy as np
 import pytest
 
-from components import circular_orbit, geodesy, ground_station as gsm
+from components.orbit import circular
+from components.environment import geodesy
+from components.mission import ground_station as gsm
 from fmu_helpers import check_declarations, instantiate
 
 SIDEREAL_DAY = 86164.0905  # s
@@ -122,7 +124,7 @@ def test_contact_statistics_420_km_51_6_deg(raan_deg):
     horizon passes last typically 8-11 min, with a 10 deg mask 3-7 min. Upper bound: the
     visibility cone's central angle 2 acos(|r_site| / |r|) (41 deg) swept at no less than the
     relative rate n - omega_earth."""
-    orbit = circular_orbit.CircularOrbit(420e3, math.radians(51.6), raan=math.radians(raan_deg))
+    orbit = circular.CircularOrbit(420e3, math.radians(51.6), raan=math.radians(raan_deg))
     gs0 = gsm.GroundStation()
     found = passes(gs0, orbit, 86400.0, 5.0)
     durations = np.array([b - a for a, b in found]) / 60.0
@@ -188,7 +190,7 @@ def test_ground_station_fmu(build_one, tmp_path):
 def test_near_contact_gives_warning_before_every_contact():
     """near_contact (elevation above mask - 20 deg) turns true at least 240 s before each
     contact of a 420 km, 51.6 deg orbit over a day (the coarse step a master may take outside)."""
-    from components import orbit_elements as oe
+    from components.orbit import elements as oe
 
     station = gsm.GroundStation(epoch="2023-01-01T00:00:00Z")
     r0, v0 = oe.kepler_to_cartesian(oe.R_EQ + 420e3, 0.0, math.radians(51.6), 0.0, 0.0, 0.0)

@@ -8,8 +8,10 @@ import fmpy
 import numpy as np
 import pytest
 
-from components import attitude, magnetic_field as mf, magnetorquer, momentum_wheel, time_utils
-from components.rigid_body import RigidBody, box_inertia
+from components.core import rotations, time_utils
+from components.environment import magnetic_field as mf
+from components.acs import magnetorquer, momentum_wheel
+from components.attitude.rigid_body import RigidBody, box_inertia
 from fmu_helpers import check_declarations, instantiate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -155,7 +157,7 @@ def test_field_in_N_follows_the_earth_rotation_and_attitude():
         b = f.field_N((0.0, -7.0e6, 0.0), t)
         assert b[2] > 0.9 * math.sqrt(b[0] ** 2 + b[1] ** 2 + b[2] ** 2)
     # B_B = A(q) B_N: a 90 deg turn of B about z gives [By, -Bx, Bz].
-    q = attitude.from_axis_angle((0, 0, 1), math.pi / 2)
+    q = rotations.from_axis_angle((0, 0, 1), math.pi / 2)
     bB = f.field_B(r_N, q)
     bN = f.field_N(r_N)
     np.testing.assert_allclose(bB, [bN[1], -bN[0], bN[2]], rtol=0, atol=1e-18)
@@ -237,15 +239,15 @@ def test_wheel_integrates_the_saturated_torque_and_respects_the_speed_limit():
 
 # ---- rigid body with wheels ---------------------------------------------------------------------
 def inertial_momentum(body, h_w):
-    A = np.array(attitude.attitude_matrix(body.q))
+    A = np.array(rotations.attitude_matrix(body.q))
     return A.T @ np.array(body.total_angular_momentum(h_w))
 
 
 def test_zero_wheel_inputs_are_bit_identical_to_the_wheelless_body():
     J = box_inertia(12.0, 0.1, 0.2, 0.3)
     for integrator in ("euler", "rk4"):
-        a = RigidBody(J, attitude.normalized((0.1, -0.2, 0.3, 0.9)), (0.2, -0.1, 0.05), integrator)
-        b = RigidBody(J, attitude.normalized((0.1, -0.2, 0.3, 0.9)), (0.2, -0.1, 0.05), integrator)
+        a = RigidBody(J, rotations.normalized((0.1, -0.2, 0.3, 0.9)), (0.2, -0.1, 0.05), integrator)
+        b = RigidBody(J, rotations.normalized((0.1, -0.2, 0.3, 0.9)), (0.2, -0.1, 0.05), integrator)
         for k in range(200):
             torque = (0.0025 * (k % 3 - 1), -0.0025 * (k % 2), 0.0)
             a.step(torque, 0.015)
@@ -255,7 +257,7 @@ def test_zero_wheel_inputs_are_bit_identical_to_the_wheelless_body():
 
 def test_spinning_wheel_conserves_total_momentum():
     J = box_inertia(12.0, 0.1, 0.2, 0.3)
-    body = RigidBody(J, attitude.normalized((0.3, 0.1, -0.2, 0.9)), (0.05, 0.1, -0.03), "rk4")
+    body = RigidBody(J, rotations.normalized((0.3, 0.1, -0.2, 0.9)), (0.05, 0.1, -0.03), "rk4")
     h_w = (0.0, 0.008, 0.0)  # a wheel spinning at 400 rad/s, no motor torque, no external torque
     H0 = inertial_momentum(body, h_w)
     for _ in range(600):
@@ -263,7 +265,7 @@ def test_spinning_wheel_conserves_total_momentum():
     H1 = inertial_momentum(body, h_w)
     assert np.linalg.norm(H1 - H0) < 1e-10 * np.linalg.norm(H0)
     # the gyroscopic term matters: without it the body would move differently
-    free = RigidBody(J, attitude.normalized((0.3, 0.1, -0.2, 0.9)), (0.05, 0.1, -0.03), "rk4")
+    free = RigidBody(J, rotations.normalized((0.3, 0.1, -0.2, 0.9)), (0.05, 0.1, -0.03), "rk4")
     for _ in range(600):
         free.step((0.0, 0.0, 0.0), 0.1)
     assert np.linalg.norm(np.subtract(free.omega, body.omega)) > 1e-3
@@ -341,7 +343,7 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
 def test_fmus_simulate_alone(ma_fmus):
     epoch = "2023-06-01T00:00:00Z"
     r_N = (4.0e6, -3.0e6, 4.5e6)
-    q = attitude.normalized((0.2, -0.4, 0.1, 0.8))
+    q = rotations.normalized((0.2, -0.4, 0.1, 0.8))
     start = {"epoch": epoch, **{f"r_BN_N[{i + 1}]": r_N[i] for i in range(3)},
              **{f"q_BN[{i + 1}]": q[i] for i in range(4)}}
     res = fmpy.simulate_fmu(str(ma_fmus["MagneticField"]), start_time=60.0, stop_time=3660.0, output_interval=600.0,
@@ -396,7 +398,7 @@ def test_wheel_and_body_fmus_cosimulate_and_restore_state(ma_fmus, tmp_path):
         t = 0.0
 
         def total():
-            A = np.array(attitude.attitude_matrix(body.getReal(q_out)))
+            A = np.array(rotations.attitude_matrix(body.getReal(q_out)))
             return A.T @ (np.array(body.getReal(H_out)) + wheel.getReal(h_out))
 
         def advance(n, cmd):

@@ -6,8 +6,8 @@ import math
 
 import pytest
 
-from components import host as host_model
-from components import mission_manager as mm
+from components.mission import host as host_model
+from components.mission import manager as mm
 from fmu_helpers import check_declarations, instantiate
 
 DAY = 86400.0

@@ -6,7 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from components import atmosphere, attitude, geodesy, gravity, orbit, orbit_elements as oe
+from components.environment import atmosphere, geodesy, gravity
+from components.core import rotations
+from components.orbit import cowell, elements as oe
 from fmu_helpers import check_declarations, instantiate
 
 R = oe.R_EQ
@@ -112,7 +114,7 @@ def test_zonal_gravity_is_the_gradient_of_the_potential():
 # ---- Cowell propagation -----------------------------------------------------------------------
 @pytest.mark.parametrize("ecc, inc", [(0.0, 51.6 * DEG), (0.02, 98.0 * DEG), (0.0, 0.0)])
 def test_two_body_matches_kepler_within_1_m_after_one_day(ecc, inc):
-    m = orbit.CowellOrbit(sma0=R + 500e3, ecc0=ecc, inc0=inc, raan0=0.3, argp0=0.5, ta0=1.0,
+    m = cowell.CowellOrbit(sma0=R + 500e3, ecc0=ecc, inc0=inc, raan0=0.3, argp0=0.5, ta0=1.0,
                           zonal_degree=0, drag=False)
     r0, v0 = m.position(), m.velocity()
     run(m, 86400.0, 300.0)
@@ -123,7 +125,7 @@ def test_two_body_matches_kepler_within_1_m_after_one_day(ecc, inc):
 
 def test_j2_node_regression_matches_secular_rate_within_1_percent():
     a0, i0 = R + 420e3, 51.6 * DEG
-    m = orbit.CowellOrbit(sma0=a0, inc0=i0, zonal_degree=2, drag=False)
+    m = cowell.CowellOrbit(sma0=a0, inc0=i0, zonal_degree=2, drag=False)
     t, raan = [], []
     for k in range(1, 10 * 144 + 1):  # 10 days, 600 s steps
         m.advance_to(600.0 * k)
@@ -142,14 +144,14 @@ def test_drag_lowers_sma_by_the_eq_1_amount(exponential):
     output along the orbit, trapezoid rule over 300 s (2 %). Point-mass gravity: with J2 the
     osculating a of the two runs carries short-periodic terms of different phase."""
     kw = dict(sma0=R + 300e3, Cd=2.2, area=0.02, mass=12.0, reentry_altitude=100e3, zonal_degree=0)
-    m = orbit.CowellOrbit(density_model=exponential, **kw)
-    ref = orbit.CowellOrbit(drag=False, **kw)
+    m = cowell.CowellOrbit(density_model=exponential, **kw)
+    ref = cowell.CowellOrbit(drag=False, **kw)
     expected = 0.0
     for k in range(1, 289):
         o0 = m.outputs()
         v = np.array(o0["v_BN_N"])
         r = np.array(o0["r_BN_N"])
-        v_rel = v - np.cross([0, 0, orbit.OMEGA_EARTH], r)
+        v_rel = v - np.cross([0, 0, cowell.OMEGA_EARTH], r)
         # da/dt = 2 a^2 / mu (v . a_drag)
         adot = 2 * o0["sma"] ** 2 / MU * (v @ (-0.5 * o0["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel))
         m.advance_to(300.0 * k)
@@ -157,7 +159,7 @@ def test_drag_lowers_sma_by_the_eq_1_amount(exponential):
         o1 = m.outputs()
         v = np.array(o1["v_BN_N"])
         r = np.array(o1["r_BN_N"])
-        v_rel = v - np.cross([0, 0, orbit.OMEGA_EARTH], r)
+        v_rel = v - np.cross([0, 0, cowell.OMEGA_EARTH], r)
         adot1 = 2 * o1["sma"] ** 2 / MU * (v @ (-0.5 * o1["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel))
         expected += 0.5 * (adot + adot1) * 300.0
     da = m.outputs()["sma"] - ref.outputs()["sma"]
@@ -170,7 +172,7 @@ def test_retrograde_burn_lowers_a_by_the_rocket_equation_delta_v():
     propulsion FMU would feed it: the energy change matches -dv * mean speed with dv from Eq. 3."""
     F, isp, g0, m0 = 0.1, 42.0, 9.81, 12.0
     mdot = F / (isp * g0)
-    m = orbit.CowellOrbit(zonal_degree=0, drag=False, mass=m0)
+    m = cowell.CowellOrbit(zonal_degree=0, drag=False, mass=m0)
     r0, v0 = m.position(), m.velocity()
     e0 = 0.5 * v0 @ v0 - MU / np.linalg.norm(r0)
     h = 0.5
@@ -190,12 +192,12 @@ def test_retrograde_burn_lowers_a_by_the_rocket_equation_delta_v():
 
 
 def test_body_frame_thrust_rotated_with_the_attitude():
-    m = orbit.CowellOrbit(zonal_degree=0, drag=False)
+    m = cowell.CowellOrbit(zonal_degree=0, drag=False)
     r, v = m.position(), m.velocity()
     x_b = -v / np.linalg.norm(v)                  # body x along -v
     z_b = np.cross(r, v) / np.linalg.norm(np.cross(r, v))
     y_b = np.cross(z_b, x_b)
-    q = attitude.dcm_to_quaternion([list(x_b), list(y_b), list(z_b)])
+    q = rotations.dcm_to_quaternion([list(x_b), list(y_b), list(z_b)])
     m.set_inputs(F_thrust_B=(0.1, 0.0, 0.0), q_BN=q, mass=12.0)
     np.testing.assert_allclose(m.thrust_acceleration_N(), x_b * 0.1 / 12.0, atol=1e-15)
     m.set_inputs(F_thrust_B=(0.0, 0.0, 0.2))
@@ -203,14 +205,14 @@ def test_body_frame_thrust_rotated_with_the_attitude():
     # a 10 s body-x burn along -v does what the retrograde burn does, except that the retrograde
     # direction follows v, which turns at the mean motion n: they part by (F/m) n t^3 / 6 = 1.57 mm
     m.set_inputs(F_thrust_B=(0.1, 0.0, 0.0))
-    retro = orbit.CowellOrbit(zonal_degree=0, drag=False)
+    retro = cowell.CowellOrbit(zonal_degree=0, drag=False)
     retro.set_inputs(F_thrust_B=(0.0, 0.1, 0.0), retrograde=True)
     m.advance_to(10.0)
     retro.advance_to(10.0)
     expected = 0.1 / 12.0 * oe.mean_motion(R + 420e3) * 10.0 ** 3 / 6.0
     assert np.linalg.norm(m.position() - retro.position()) == pytest.approx(expected, rel=0.02)
     # a normal (orbit-plane) burn changes the inclination, not a
-    n = orbit.CowellOrbit(zonal_degree=0, drag=False)
+    n = cowell.CowellOrbit(zonal_degree=0, drag=False)
     n.set_inputs(F_thrust_B=(0.0, 0.0, 0.1), q_BN=q)
     n.advance_to(60.0)
     a, e, i, *_ = oe.cartesian_to_kepler(n.position(), n.velocity())
@@ -219,23 +221,23 @@ def test_body_frame_thrust_rotated_with_the_attitude():
 
 
 def test_outputs_geodetic_altitude_and_elements(exponential):
-    m = orbit.CowellOrbit(density_model=exponential)
+    m = cowell.CowellOrbit(density_model=exponential)
     run(m, 3000.0, 300.0)
     o = m.outputs()
     r = o["r_BN_N"]
     lat, lon, alt = geodesy.geodetic_from_inertial(r, m.jd_state())
     assert (o["latitude"], o["longitude"], o["altitude"]) == (lat, lon, alt)
-    assert orbit.geodetic_altitude_nb(*r) == pytest.approx(alt, abs=1e-6)
+    assert cowell.geodetic_altitude_nb(*r) == pytest.approx(alt, abs=1e-6)
     assert o["altitude_spherical"] == pytest.approx(np.linalg.norm(r) - R, abs=1e-6)
     assert o["perigee_altitude"] <= o["sma"] - R <= o["apogee_altitude"]
     assert o["density"] == exponential.density(np.array(r), m.jd_state())
     # on the equator and at the pole
-    assert orbit.geodetic_altitude_nb(geodesy.WGS84_A + 400e3, 0.0, 0.0) == pytest.approx(400e3, abs=1e-6)
-    assert orbit.geodetic_altitude_nb(0.0, 0.0, geodesy.WGS84_B + 400e3) == pytest.approx(400e3, abs=1e-6)
+    assert cowell.geodetic_altitude_nb(geodesy.WGS84_A + 400e3, 0.0, 0.0) == pytest.approx(400e3, abs=1e-6)
+    assert cowell.geodetic_altitude_nb(0.0, 0.0, geodesy.WGS84_B + 400e3) == pytest.approx(400e3, abs=1e-6)
 
 
 def test_reentry_latches_and_holds_the_state(exponential):
-    m = orbit.CowellOrbit(density_model=exponential)
+    m = cowell.CowellOrbit(density_model=exponential)
     m.set_inputs(F_thrust_B=(20.0, 0.0, 0.0), retrograde=True)  # drops the perigee below the ground
     m.advance_to(120.0)
     m.set_inputs(F_thrust_B=(0.0, 0.0, 0.0))
@@ -252,7 +254,7 @@ def test_reentry_latches_and_holds_the_state(exponential):
 
 
 def test_get_set_state_reproduces_steps_exactly(exponential):
-    m = orbit.CowellOrbit(density_model=exponential)
+    m = cowell.CowellOrbit(density_model=exponential)
     run(m, 1800.0)
     s = m.get_state()
     m.set_inputs(F_thrust_B=(0.1, 0.0, 0.0), retrograde=True, mass=11.9)
@@ -266,19 +268,19 @@ def test_get_set_state_reproduces_steps_exactly(exponential):
 
 def test_errors(exponential):
     with pytest.raises(ValueError, match="perigee altitude"):
-        orbit.CowellOrbit(sma0=R + 240e3, density_model=exponential)
+        cowell.CowellOrbit(sma0=R + 240e3, density_model=exponential)
     with pytest.raises(ValueError, match="perigee altitude"):
-        orbit.CowellOrbit(sma0=R + 420e3, ecc0=0.03, density_model=exponential)
+        cowell.CowellOrbit(sma0=R + 420e3, ecc0=0.03, density_model=exponential)
     for kw, what in ((dict(mass=0.0), "mass"), (dict(area=-1.0), "area"), (dict(Cd=0.0), "Cd"),
                      (dict(ecc0=1.2), "ecc0"), (dict(inc0=4.0), "inc0"), (dict(zonal_degree=7), "zonal_degree"),
                      (dict(epoch="2023-01-01"), "epoch"), (dict(mu=-1.0), "mu")):
         with pytest.raises(ValueError, match=what):
-            orbit.CowellOrbit(density_model=exponential, **kw)
+            cowell.CowellOrbit(density_model=exponential, **kw)
     with pytest.raises(ValueError, match="unknown"):
-        orbit.CowellOrbit(density_model="jacchia_robert")
+        cowell.CowellOrbit(density_model="jacchia_robert")
     with pytest.raises(ValueError, match="density_model"):
-        orbit.CowellOrbit(density_model=None)
-    m = orbit.CowellOrbit(density_model=exponential)
+        cowell.CowellOrbit(density_model=None)
+    m = cowell.CowellOrbit(density_model=exponential)
     with pytest.raises(ValueError, match="mass"):
         m.set_inputs(mass=-1.0)
     with pytest.raises(ValueError, match="q_BN"):
@@ -325,7 +327,7 @@ def test_orbit_fmu(build_one, tmp_path, exponential):
     assert fmu.getReal(refs) == first
     fmu.freeFMUstate(state)
     # the same run through the component
-    m = orbit.CowellOrbit(density_model=exponential)
+    m = cowell.CowellOrbit(density_model=exponential)
     run(m, 1800.0)
     m.set_inputs(F_thrust_B=(0.1, 0.0, 0.0), retrograde=True)
     m.advance_to(1800.5)

@@ -9,8 +9,9 @@ import numpy as np
 import pytest
 from numba import njit
 
-from components import atmosphere, orbit_elements, propulsion
-from components import orbit_averaged as oa
+from components.environment import atmosphere
+from components.orbit import elements, propulsion
+from components.orbit import averaged as oa
 from fmu_helpers import check_declarations, instantiate
 
 MU, R_EQ, J2 = oa.MU_EARTH, oa.R_EQ, oa.J2
@@ -47,8 +48,8 @@ class PythonOnly(ConstantDensity):
 
 def elements_vector(r, v):
     """(a, ex, ey, i, raan, lam) of a Cartesian state, through orbit_elements."""
-    a, e, i, raan, argp, nu = orbit_elements.cartesian_to_kepler(r, v, MU)
-    M = orbit_elements.mean_from_true(nu, e)
+    a, e, i, raan, argp, nu = elements.cartesian_to_kepler(r, v, MU)
+    M = elements.mean_from_true(nu, e)
     return np.array([a, e * math.cos(argp), e * math.sin(argp), i, raan, argp + M])
 
 
@@ -56,7 +57,7 @@ def test_state_reconstruction_matches_orbit_elements():
     for e, argp, ta in ((0.0, 0.0, 0.3), (0.01, 1.0, 2.5), (0.05, 4.0, 5.9)):
         m = oa.OrbitAveraged(None, sma0=7.2e6, ecc0=e, inc0=1.1, raan0=0.4, argp0=argp, ta0=ta)
         r, v = m.state_vectors()
-        r_ref, v_ref = orbit_elements.kepler_to_cartesian(7.2e6, e, 1.1, 0.4, argp, ta, MU)
+        r_ref, v_ref = elements.kepler_to_cartesian(7.2e6, e, 1.1, 0.4, argp, ta, MU)
         np.testing.assert_allclose(r, r_ref, rtol=0, atol=1e-5)
         np.testing.assert_allclose(v, v_ref, rtol=0, atol=1e-8)
 
@@ -154,7 +155,7 @@ def test_j2_drift_equals_analytic_rates():
     # (ex, ey) rotate under RK4 with one-day steps of 0.06 rad: phase error ~1e-7
     assert (m.argp - 0.5) == pytest.approx(argp_rate * t, rel=1e-6)
     assert m.ecc == pytest.approx(e, rel=1e-7) and m.sma == a  # RK4 amplitude error of the rotation
-    lam_expected = (0.5 + orbit_elements.mean_from_true(0.0, e) + (argp_rate + m_rate) * t) % (2 * math.pi)
+    lam_expected = (0.5 + elements.mean_from_true(0.0, e) + (argp_rate + m_rate) * t) % (2 * math.pi)
     assert m.mean_arg_latitude == pytest.approx(lam_expected, abs=1e-6)
 
 
@@ -337,12 +338,12 @@ def test_mean_decay_agrees_with_cowell(zonal_degree, tolerance):
     two-body formulae, so its mean geodetic altitude is 0.8 km above the Cowell orbit's at the
     same mean a, the first-order J2 short-period offset of the radius, and the density there
     is 1.5 % lower; J3..J6 add their own long-period eccentricity)."""
-    from components import orbit
+    from components.orbit import cowell
 
     dens = atmosphere.make_density_model("exponential")
     a0, days = R_EQ + 350e3, 30.0
-    period = orbit_elements.period(a0)
-    c = orbit.CowellOrbit(sma0=a0, density_model=dens, zonal_degree=zonal_degree)
+    period = elements.period(a0)
+    c = cowell.CowellOrbit(sma0=a0, density_model=dens, zonal_degree=zonal_degree)
     sma = lambda mdl: mdl.outputs()["sma"]  # noqa: E731
     s0 = _orbit_mean(c, 0.0, sma, period)
     c.advance_to(days * 86400.0)

@@ -7,7 +7,7 @@ import math
 import fmpy
 import pytest
 
-from components import power
+from components.mission import power
 from fmu_helpers import check_declarations, instantiate
 
 WH = 3600.0

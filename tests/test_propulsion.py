@@ -5,7 +5,7 @@ import math
 import fmpy
 import pytest
 
-from components import propulsion as p
+from components.orbit import propulsion as p
 from fmu_helpers import check_declarations, instantiate
 
 REL = 0.005  # the brief's 0.5 %

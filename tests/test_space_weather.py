@@ -7,8 +7,8 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from components import space_weather as sw_mod
-from components.space_weather import ConstantSpaceWeather, SpaceWeather
+from components.environment import space_weather as sw_mod
+from components.environment.space_weather import ConstantSpaceWeather, SpaceWeather
 
 # the team's shared reference data, beside the repository (as in CI)
 SHARED_FILE = Path(__file__).resolve().parents[2] / "shared" / "data" / "space_weather" / "SW-All_CSSI_2026-08-22.txt"

@@ -10,10 +10,10 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 sys.path.insert(0, str(ROOT / "system_ssp" / "systems"))
 
-from components import attitude as at  # noqa: E402
-from components import reference_tracking as rt  # noqa: E402
-from components import rigid_body  # noqa: E402
-from components import sun_avoidance as sa  # noqa: E402
+from components.core import rotations as at  # noqa: E402
+from components.attitude import reference_tracking as rt  # noqa: E402
+from components.attitude import rigid_body  # noqa: E402
+from components.attitude import sun_avoidance as sa  # noqa: E402
 
 import generate_sas as gen  # noqa: E402
 

@@ -8,7 +8,9 @@ import fmpy
 import numpy as np
 import pytest
 
-from components import circular_orbit, eclipse, sun, time_utils
+from components.orbit import circular
+from components.environment import eclipse, sun
+from components.core import time_utils
 from fmu_helpers import check_declarations, instantiate
 
 ROOT = Path(__file__).resolve().parents[1]
@@ -207,8 +209,8 @@ def test_cylindrical_eclipse_fraction():
 
 # ---- orbit ------------------------------------------------------------------------------------
 def test_circular_orbit_is_two_body_circular_motion():
-    o = circular_orbit.CircularOrbit(altitude=400e3, inclination=math.radians(51.6), raan=0.7, arg_latitude0=0.3)
-    mu, a = circular_orbit.MU_EARTH, R_E + 400e3
+    o = circular.CircularOrbit(altitude=400e3, inclination=math.radians(51.6), raan=0.7, arg_latitude0=0.3)
+    mu, a = circular.MU_EARTH, R_E + 400e3
     assert o.period == pytest.approx(2 * math.pi * math.sqrt(a ** 3 / mu), rel=1e-14)
     assert o.period / 60.0 == pytest.approx(92.56, abs=0.005)  # thesis Eq. 67
     h_hat = np.array(o.normal())
@@ -221,7 +223,7 @@ def test_circular_orbit_is_two_body_circular_motion():
     np.testing.assert_allclose(o.position(o.period), o.position(0.0), atol=1e-6)
     assert math.degrees(math.acos(h_hat[2])) == pytest.approx(51.6, abs=1e-12)
     # ascending node direction (cos RAAN, sin RAAN, 0) at u = 0
-    o0 = circular_orbit.CircularOrbit(altitude=400e3, raan=0.7)
+    o0 = circular.CircularOrbit(altitude=400e3, raan=0.7)
     np.testing.assert_allclose(np.array(o0.position(0.0)) / a, [math.cos(0.7), math.sin(0.7), 0.0], atol=1e-15)
     assert o0.velocity(0.0)[2] > 0  # ascending
 
@@ -229,7 +231,7 @@ def test_circular_orbit_is_two_body_circular_motion():
 def test_circular_orbit_matches_numerical_two_body_integration():
     from scipy.integrate import solve_ivp
 
-    o = circular_orbit.CircularOrbit(altitude=420e3, inclination=1.2, raan=-0.4, arg_latitude0=2.0)
+    o = circular.CircularOrbit(altitude=420e3, inclination=1.2, raan=-0.4, arg_latitude0=2.0)
     mu = o.mu
 
     def f(_, y):
@@ -244,19 +246,19 @@ def test_circular_orbit_matches_numerical_two_body_integration():
 
 
 def test_circular_orbit_state_and_parameters():
-    o = circular_orbit.CircularOrbit(t0=100.0)
+    o = circular.CircularOrbit(t0=100.0)
     assert o.t == 100.0 and o.position() == o.position(100.0)
     o.step(10.0)
     s = o.get_state()
     o.advance_to(5000.0)
     o.set_state(s)
-    assert o.t == 110.0 and o.position() == circular_orbit.CircularOrbit().position(110.0)
+    assert o.t == 110.0 and o.position() == circular.CircularOrbit().position(110.0)
     for kwargs, name in (({"altitude": 0.0}, "altitude"), ({"inclination": 4.0}, "inclination"),
                          ({"inclination": -0.1}, "inclination"), ({"raan": math.inf}, "raan"),
                          ({"arg_latitude0": math.nan}, "arg_latitude0"), ({"mu": -1.0}, "mu"),
                          ({"earth_radius": 0.0}, "earth_radius")):
         with pytest.raises(ValueError, match=name):
-            circular_orbit.CircularOrbit(**kwargs)
+            circular.CircularOrbit(**kwargs)
 
 
 # ---- FMUs -------------------------------------------------------------------------------------
@@ -305,7 +307,7 @@ def test_fmus_simulate_alone_and_report_the_communication_point(se_fmus):
 
     r = fmpy.simulate_fmu(str(se_fmus["CircularOrbit"]), start_time=100.0, stop_time=6000.0, output_interval=50.0,
                           start_values={"altitude": 400e3, "raan": 1.0})
-    o = circular_orbit.CircularOrbit(altitude=400e3, raan=1.0)
+    o = circular.CircularOrbit(altitude=400e3, raan=1.0)
     assert r["time"][0] == 100.0 and r["period"][0] == pytest.approx(92.5604 * 60, abs=0.01)
     for row in r:
         np.testing.assert_allclose([row[f"r_BN_N[{i}]"] for i in (1, 2, 3)], o.position(row["time"]), atol=1e-6)
@@ -369,7 +371,7 @@ def test_system_eclipses_once_per_orbit_with_cylindrical_duration(se_ssp):
     assert 2 * period <= d["time"][-1] < 2 * period + 10.0  # two orbits
     t = d["time"]
     # the master shows each FMU's output at the communication point
-    o, s = circular_orbit.CircularOrbit(), sun.SunEphemeris()
+    o, s = circular.CircularOrbit(), sun.SunEphemeris()
     for k in (0, 1, 5000, len(t) - 1):
         np.testing.assert_allclose([d[f"orbit.r_BN_N[{i}]"][k] for i in (1, 2, 3)], o.position(t[k]), atol=1e-6)
         np.testing.assert_allclose([d[f"sun.r_SN_N[{i}]"][k] for i in (1, 2, 3)], s.position(t[k]), atol=1e-3)

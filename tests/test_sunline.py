@@ -14,7 +14,8 @@ ROOT = Path(__file__).resolve().parents[1]
 if str(ROOT) not in sys.path:
     sys.path.insert(0, str(ROOT))
 
-from components import attitude, mrp, sunline  # noqa: E402
+from components.core import rotations, mrp  # noqa: E402
+from components.sensing import sunline  # noqa: E402
 
 SYSTEMS = ROOT / "system_ssp" / "systems"
 if str(SYSTEMS) not in sys.path:
@@ -35,7 +36,7 @@ def random_quaternions(n, seed=4):
 # ---- MRP conversions --------------------------------------------------------------------
 def test_mrp_dcm_equals_attitude_matrix_for_q_and_minus_q():
     for q in random_quaternions(500):
-        A = np.array(attitude.attitude_matrix(q))
+        A = np.array(rotations.attitude_matrix(q))
         for qq in (q, tuple(-x for x in q)):
             sigma = mrp.from_quaternion(qq)
             assert np.abs(np.array(mrp.to_dcm(sigma)) - A).max() < 1e-13
@@ -46,14 +47,14 @@ def test_mrp_dcm_equals_attitude_matrix_for_q_and_minus_q():
 
 def test_mrp_known_values():
     # sigma = e tan(phi/4) (Schaub and Junkins); 90 deg about z maps N x to -B y
-    sigma = mrp.from_quaternion(attitude.from_axis_angle((0.0, 0.0, 1.0), math.pi / 2))
+    sigma = mrp.from_quaternion(rotations.from_axis_angle((0.0, 0.0, 1.0), math.pi / 2))
     assert sigma == pytest.approx((0.0, 0.0, TAN_PI_8), abs=1e-15)
     assert np.array(mrp.to_dcm(sigma)) == pytest.approx(np.array([[0, 1, 0], [-1, 0, 0], [0, 0, 1]]), abs=1e-15)
-    sigma = mrp.from_quaternion(attitude.from_axis_angle((1.0, 1.0, 1.0), 2.0))
+    sigma = mrp.from_quaternion(rotations.from_axis_angle((1.0, 1.0, 1.0), 2.0))
     assert sigma == pytest.approx([math.tan(0.5) / math.sqrt(3.0)] * 3, rel=1e-14)
     assert mrp.to_dcm((0.0, 0.0, 0.0)) == ((1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0))
     # 180 deg: |sigma| = 1, shadow set = -sigma
-    sigma = mrp.from_quaternion(attitude.from_axis_angle((0.0, 1.0, 0.0), math.pi))
+    sigma = mrp.from_quaternion(rotations.from_axis_angle((0.0, 1.0, 0.0), math.pi))
     assert sigma == pytest.approx((0.0, 1.0, 0.0), abs=1e-15)
     assert mrp.shadow(sigma) == pytest.approx((0.0, -1.0, 0.0), abs=1e-15)
 
@@ -68,17 +69,17 @@ def test_mrp_quaternion_round_trip_shadow_and_short_sets():
         assert np.array(mrp.shadow(s)) == pytest.approx(np.array(sigma), rel=1e-13, abs=1e-15)
         assert np.abs(np.array(mrp.to_dcm(s)) - np.array(mrp.to_dcm(sigma))).max() < 1e-13
         short = mrp.short(sigma)
-        assert attitude.norm(short) <= 1.0
+        assert rotations.norm(short) <= 1.0
         assert mrp.short(s) == pytest.approx(short, abs=1e-14)
         assert short == pytest.approx(mrp.from_quaternion(q, short=True), abs=1e-14)
         assert (short == sigma) == (q[3] >= 0.0)  # sigma = q_v/(1+q4) is short exactly when q4 >= 0
 
 
 def test_dcm_to_mrp_round_trip():
-    for q in random_quaternions(300, seed=11) + [attitude.from_axis_angle(a, math.pi) for a in AXES[:3]]:
-        A = attitude.attitude_matrix(q)
+    for q in random_quaternions(300, seed=11) + [rotations.from_axis_angle(a, math.pi) for a in AXES[:3]]:
+        A = rotations.attitude_matrix(q)
         sigma = mrp.from_dcm(A)
-        assert attitude.norm(sigma) <= 1.0 + 1e-15
+        assert rotations.norm(sigma) <= 1.0 + 1e-15
         assert np.abs(np.array(mrp.to_dcm(sigma)) - np.array(A)).max() < 1e-13
         qq = mrp.dcm_to_quaternion(A)
         assert qq[3] >= 0.0 and np.abs(np.abs(np.dot(qq, q)) - 1.0) < 1e-13
@@ -121,7 +122,7 @@ def test_seed_cases_sun_at_origin(r_sc, rotation):
                       "x90": ((1.0, 0.0, 0.0), _rotated_x90(d_N))}[rotation]
     angle = 0.0 if rotation == "none" else math.pi / 2
     sigma = tuple(a * math.tan(angle / 4) for a in axis)
-    q = attitude.from_axis_angle(axis, angle)
+    q = rotations.from_axis_angle(axis, angle)
     got = sunline.sun_heading_B((0.0, 0.0, 0.0), r_sc, sigma)
     assert max(abs(g - e) for g, e in zip(got, expected)) < 1e-12
     got_q = sunline.sun_heading_B_quaternion((0.0, 0.0, 0.0), r_sc, q)
@@ -150,7 +151,7 @@ def test_shadow_set_and_quaternion_input_give_the_same_heading():
         r_sc = tuple(rng.normal(size=3) * 7e6)
         sigma = mrp.from_quaternion(q)
         h = sunline.sun_heading_B(r_sun, r_sc, sigma)
-        assert abs(attitude.norm(h) - 1.0) < 1e-14
+        assert abs(rotations.norm(h) - 1.0) < 1e-14
         h_shadow = sunline.sun_heading_B(r_sun, r_sc, mrp.shadow(sigma))
         assert max(abs(a - b) for a, b in zip(h, h_shadow)) < 1e-12
         for qq in (q, tuple(-x for x in q), tuple(3.7 * x for x in q)):  # either sign, any norm
@@ -261,7 +262,7 @@ def test_fmu_direct_feedthrough_and_state(sunline_fmus, tmp_path):
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
         assert fmu.getReal(out) == [1.0, 0.0, 0.0]
-        q = attitude.from_axis_angle((0.0, 0.0, 1.0), math.pi / 2)
+        q = rotations.from_axis_angle((0.0, 0.0, 1.0), math.pi / 2)
         fmu.setReal(q_in, list(q))  # read without a step: direct feedthrough
         assert fmu.getReal(out) == pytest.approx([0.0, -1.0, 0.0], abs=1e-15)
         saved = fmu.getFMUstate()
@@ -312,7 +313,7 @@ def test_system_heading_turns_with_the_spin(sunline_ssp, axis, rate, sets):
     d_N = (np.array(g.R_SUN_N) - np.array(g.R_SC_N))
     dist = np.linalg.norm(d_N)
     d_N /= dist
-    d_B0 = np.array(attitude.attitude_matrix(g.Q0)) @ d_N
+    d_B0 = np.array(rotations.attitude_matrix(g.Q0)) @ d_N
     h = np.column_stack([r.data[f"sunline.sun_heading_B[{i}]"] for i in (1, 2, 3)])
     expected = np.array([_rot(axis, rate * t) @ d_B0 for t in r.data["time"]])
     assert np.abs(h - expected).max() < 1e-9
@@ -322,7 +323,7 @@ def test_system_heading_turns_with_the_spin(sunline_ssp, axis, rate, sets):
     # at every sample the heading is A(q) d_N of the dynamics' recorded quaternion
     for row, hb in zip(r.data[::20], h[::20]):
         q = [row[f"dynamics.q_BN[{i}]"] for i in (1, 2, 3, 4)]
-        assert np.abs(np.array(attitude.attitude_matrix(q)) @ d_N - hb).max() < 1e-12
+        assert np.abs(np.array(rotations.attitude_matrix(q)) @ d_N - hb).max() < 1e-12
     assert np.abs(r.data["sunline.sun_distance"] - dist).max() <= 1e-15 * dist
 
 

@@ -1,7 +1,7 @@
 """The torque selector between the attitude controllers and the thrusters."""
 import pytest
 
-from components.command_selector import select_command
+from components.attitude.command_selector import select_command
 from fmu_helpers import check_declarations, instantiate
 
 CMDS = {"detumble": (1.0, 2.0, 3.0), "slew": (-1.0, 0.0, 0.5), "tracking": (0.0, -0.2, 0.0)}

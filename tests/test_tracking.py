@@ -6,7 +6,8 @@ import math
 
 import pytest
 
-from components import attitude, deorbit_tracking as dtr, rigid_body, thrusters
+from components.core import rotations
+from components.attitude import deorbit_tracking as dtr, rigid_body, thrusters
 from fmu_helpers import check_declarations, instantiate
 
 J_BOX = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3)  # Appendix A
@@ -28,16 +29,16 @@ def test_tracking_rate_eq_67_68():
 def test_target_quaternion_turns_at_omega_d():
     """TargetQuaternion (explicit Euler of q_dot = 1/2 Xi(q) w) follows the exact rotation
     q_d(t) = q(y, w t) (x) q_d0 to first order in w h; no normalization, as the script."""
-    q0 = attitude.from_euler123(0.3, -0.2, 1.0)
+    q0 = rotations.from_euler123(0.3, -0.2, 1.0)
     c = dtr.DeorbitTrackingController(J_BOX, q_d0=q0)
     w = c.omega_d[1]
     n = 10000
     for _ in range(n):
         c.advance(1.0, (0.0, 0.0, 0.0, 1.0))  # the measured q is ignored when q_d0 is given
-    exact = attitude.circle_cross(attitude.from_axis_angle((0, 1, 0), w * n), q0)
-    unit = attitude.normalized(c.q_d)
+    exact = rotations.circle_cross(rotations.from_axis_angle((0, 1, 0), w * n), q0)
+    unit = rotations.normalized(c.q_d)
     assert max(abs(a - b) for a, b in zip(unit, exact)) < 1e-6  # phase error O(n (w h)^3)
-    assert attitude.norm(c.q_d) - 1.0 == pytest.approx(n * (0.5 * w) ** 2 / 2, rel=1e-3)  # Euler's drift
+    assert rotations.norm(c.q_d) - 1.0 == pytest.approx(n * (0.5 * w) ** 2 / 2, rel=1e-3)  # Euler's drift
     # with q_d0 given the target is propagated even while disabled
     before = c.q_d
     c.advance(1.0, (0.0, 0.0, 0.0, 1.0), enabled=False)
@@ -46,18 +47,18 @@ def test_target_quaternion_turns_at_omega_d():
 
 def test_latch_from_measured_q_and_release_when_disabled():
     c = dtr.DeorbitTrackingController(J_BOX)
-    q = attitude.from_euler123(0.1, 0.2, 0.3)
+    q = rotations.from_euler123(0.1, 0.2, 0.3)
     assert c.q_d is None and c.target(q) == q and c.attitude_error(q) == 0.0
     assert c.command(q, c.omega_d) == ([0.0, 0.0, 0.0], [0, 0, 0])  # on the surface: s = 0
     assert c.command(q, (0.0, 0.0, 0.0))[1] == [0, 1, 0]  # at rest: spin up about y
     c.advance(H, q)
-    step = attitude.from_axis_angle((0, 1, 0), c.omega_d[1] * H)
-    assert c.q_d == pytest.approx(attitude.circle_cross(step, q), abs=1e-10)
+    step = rotations.from_axis_angle((0, 1, 0), c.omega_d[1] * H)
+    assert c.q_d == pytest.approx(rotations.circle_cross(step, q), abs=1e-10)
     state = c.get_state()
     c.advance(H, q, enabled=False)
     assert c.q_d is None
     c.set_state(state)
-    assert c.q_d == pytest.approx(attitude.circle_cross(step, q), abs=1e-10)
+    assert c.q_d == pytest.approx(rotations.circle_cross(step, q), abs=1e-10)
 
 
 def test_control_law_one_evaluation_by_hand():
@@ -67,12 +68,12 @@ def test_control_law_one_evaluation_by_hand():
     J = np.array([[0.05, 0.001, 0.0], [0.001, 0.13, 0.002], [0.0, 0.002, 0.10]])
     c = dtr.DeorbitTrackingController(J, k=0.7, G=(0.2, 0.1, 0.3), e=(0.002, 0.001, 0.0005),
                                       omega_d=(0.0001, 0.0011, -0.0002), omega_dot_d=(1e-5, 0.0, 2e-5),
-                                      q_d0=attitude.from_euler123(0.01, -0.02, 0.005),
+                                      q_d0=rotations.from_euler123(0.01, -0.02, 0.005),
                                       torque_level=(1e-9, 1e-9, 1e-9))
-    q = attitude.from_euler123(0.012, -0.019, 0.0052)
+    q = rotations.from_euler123(0.012, -0.019, 0.0052)
     w = np.array([0.0004, 0.0012, -0.0001])
     qd = np.array(c.q_d)
-    dq = np.array(attitude.circle_cross(q, attitude.inverse(qd)))
+    dq = np.array(rotations.circle_cross(q, rotations.inverse(qd)))
     sg = np.sign(dq[3])
     s = (w - c.omega_d) + c.k * sg * dq[:3]
     e = np.array(c.e)
@@ -114,7 +115,7 @@ def test_420km_burn_propellant_and_tracking():
     assert math.degrees(worst_angle) < 0.1
     assert math.degrees(worst_pointing) <= math.degrees(worst_angle) + 1e-12
     # turned with the burn direction: about 150.7 deg about y, at the desired rate
-    turned = 2.0 * math.acos(min(1.0, abs(attitude.error_quaternion(body.q, Q0)[3]) / attitude.norm(body.q)))
+    turned = 2.0 * math.acos(min(1.0, abs(rotations.error_quaternion(body.q, Q0)[3]) / rotations.norm(body.q)))
     assert math.degrees(turned) == pytest.approx(math.degrees(ctl.omega_d[1] * BURN_420KM), abs=0.1)
     assert body.omega[1] == pytest.approx(ctl.omega_d[1], abs=math.radians(0.01))
 

@@ -29,11 +29,11 @@ HERE = Path(__file__).resolve().parent
 ROOT = HERE.parents[1]
 sys.path.insert(0, str(ROOT))
 
-from components import attitude  # noqa: E402
-from components.detumble import DetumbleController  # noqa: E402
-from components.rigid_body import RigidBody, box_inertia  # noqa: E402
-from components.thruster_control import pair_torques  # noqa: E402
-from components.thrusters import ThrusterPairs  # noqa: E402
+from components.core import rotations  # noqa: E402
+from components.attitude.detumble import DetumbleController  # noqa: E402
+from components.attitude.rigid_body import RigidBody, box_inertia  # noqa: E402
+from components.attitude.thruster_control import pair_torques  # noqa: E402
+from components.attitude.thrusters import ThrusterPairs  # noqa: E402
 
 FMU_DIR = ROOT / "build" / "fmus"
 MASTER_NS = "https://neighbor-cosim.org/ssp/master"
@@ -106,9 +106,9 @@ CASES = {
 # ended, so their files carry no initial state: system_ssp.thesis chains them.
 _target = tuple(Q_END_1)
 for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.items():
-    _rot = attitude.from_axis_angle({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}[axis],
+    _rot = rotations.from_axis_angle({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}[axis],
                                     math.pi)
-    _target = attitude.circle_cross(_rot, _target)
+    _target = rotations.circle_cross(_rot, _target)
     CASES[f"slew_case3_{axis}"] = {
         "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 57-66, Appendix G)",
         "dynamics": ({**vec("q0", Q_END_1), **vec("omega0", W_END_1)} if axis == "x" else {}) | {"integrator": "euler"},

@@ -52,13 +52,14 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import vec, write_ssd, write_ssv  # noqa: E402
 
-from components import circular_orbit, rigid_body  # noqa: E402
+from components.orbit import circular  # noqa: E402
+from components.attitude import rigid_body  # noqa: E402
 
 MASS, EDGES = 12.0, {"edge_a": 0.1, "edge_b": 0.2, "edge_c": 0.3}
 J = rigid_body.box_inertia(MASS, EDGES["edge_a"], EDGES["edge_b"], EDGES["edge_c"])
 IX, IY, IZ = float(J[0][0]), float(J[1][1]), float(J[2][2])
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0}
-PERIOD = circular_orbit.CircularOrbit(ORBIT["altitude"]).period
+PERIOD = circular.CircularOrbit(ORBIT["altitude"]).period
 STEP = 1.0
 W0 = [math.radians(2.0)] * 3
 
@@ -132,7 +133,7 @@ def sun_facing():
     """Long-run scenario with the seed's delays: an orbit whose plane faces the Sun at the epoch
     (node 90 deg east of the Sun, inclination chosen so the Sun is 75 deg from the plane at
     the epoch: no eclipse). The eclipse-free deployment is what RMD = 6000 s > period needs."""
-    from components import sun
+    from components.environment import sun
     ra, dec = sun.right_ascension_declination(sun.SunEphemeris().position())
     return {"orbit.raan": (ra + math.pi / 2) % (2 * math.pi), "orbit.inclination": math.radians(98.0)}
 

@@ -30,7 +30,8 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import vec, write_ssd, write_ssv  # noqa: E402
 
-from components import attitude, triad  # noqa: E402
+from components.core import rotations  # noqa: E402
+from components.sensing import triad  # noqa: E402
 
 NAME = "attitude_determination"
 AU = 1.495978707e11  # m
@@ -54,7 +55,7 @@ R_SN_N = sun_position(2459945.5)  # 2023-01-01T00:00:00Z
 SUN_N = [s - r for s, r in zip(R_SN_N, R_BN_N)]
 # Initial attitude: the Sun 20 deg off the sun sensor's +x boresight, in the B x-y plane.
 _b = (math.cos(math.radians(20.0)), math.sin(math.radians(20.0)), 0.0)
-Q0 = list(triad.triad_quaternion(_b, (0.0, 0.0, 1.0), SUN_N, attitude.cross(SUN_N, [-x for x in R_BN_N])))
+Q0 = list(triad.triad_quaternion(_b, (0.0, 0.0, 1.0), SUN_N, rotations.cross(SUN_N, [-x for x in R_BN_N])))
 OMEGA0 = [0.01, 0.005, -0.02]  # rad/s
 
 HORIZON_SIGMA = math.radians(0.25)  # CubeSat IR horizon sensor class (thesis [40], CubeSpace CubeIR)

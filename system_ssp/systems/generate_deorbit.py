@@ -37,7 +37,8 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import write_ssd, write_ssv  # noqa: E402
 
-from components import propulsion, time_utils  # noqa: E402
+from components.orbit import propulsion  # noqa: E402
+from components.core import time_utils  # noqa: E402
 
 R_EQ = propulsion.EARTH_RADIUS_EQ
 KM = 1000.0

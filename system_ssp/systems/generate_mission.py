@@ -48,7 +48,9 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import vec, write_ssd, write_ssv  # noqa: E402
 
-from components import atmosphere, orbit_averaged, propulsion, time_utils  # noqa: E402
+from components.environment import atmosphere  # noqa: E402
+from components.orbit import averaged, propulsion  # noqa: E402
+from components.core import time_utils  # noqa: E402
 
 DAY = 86400.0
 KM = 1000.0
@@ -86,7 +88,7 @@ def deployment_altitude(target_km, density="jacchia_roberts"):
     span = (IDLE_DAYS + GRACE_DAYS) * DAY
 
     def end_altitude(h0_km):
-        orb = orbit_averaged.OrbitAveraged(model, epoch=MISSION_EPOCH, sma0=R_EQ + h0_km * KM)
+        orb = averaged.OrbitAveraged(model, epoch=MISSION_EPOCH, sma0=R_EQ + h0_km * KM)
         orb.advance_to(span)
         return (orb.sma - R_EQ) / KM
 

@@ -28,16 +28,16 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import SPACECRAFT, vec, write_ssd, write_ssv  # noqa: E402
 
-from components import attitude  # noqa: E402
-from components import reference_tracking as rt  # noqa: E402
-from components import sun_avoidance as sa  # noqa: E402
+from components.core import rotations  # noqa: E402
+from components.attitude import reference_tracking as rt  # noqa: E402
+from components.attitude import sun_avoidance as sa  # noqa: E402
 
 NAME = "sun_avoidance_slew"
 BORESIGHT = (0.0, 0.0, 1.0)
 Q0 = (0.0, 0.0, 0.0, 1.0)
 # Final attitude: 120 deg about x, then 40 deg about the body z (a roll about the boresight).
-Q_F = attitude.circle_cross(attitude.from_axis_angle((0.0, 0.0, 1.0), math.radians(40.0)),
-                            attitude.from_axis_angle((1.0, 0.0, 0.0), math.radians(120.0)))
+Q_F = rotations.circle_cross(rotations.from_axis_angle((0.0, 0.0, 1.0), math.radians(40.0)),
+                            rotations.from_axis_angle((1.0, 0.0, 0.0), math.radians(120.0)))
 EPSILON = math.radians(30.0)
 MARGIN = math.radians(5.0)
 W_MAX, A_MAX = 0.05, 0.01
@@ -46,15 +46,15 @@ W_MAX, A_MAX = 0.05, 0.01
 def direct_midpoint_boresight():
     """Boresight direction (N) half-way along the direct eigenaxis slew q0 -> q_f."""
     axis, phi = sa.eigenaxis(Q0, Q_F)
-    return sa.boresight_N(attitude.circle_cross(attitude.from_axis_angle(axis, phi / 2), Q0), BORESIGHT)
+    return sa.boresight_N(rotations.circle_cross(rotations.from_axis_angle(axis, phi / 2), Q0), BORESIGHT)
 
 
 def sun_near():
     """The Sun 10 deg off the direct path's midpoint boresight (inside the 30 deg cone)."""
     mid = direct_midpoint_boresight()
     axis, _ = sa.eigenaxis(Q0, Q_F)
-    e_N = sa.mat_t_vec(attitude.attitude_matrix(Q0), axis)
-    side = sa._unit(attitude.cross(e_N, mid), "side")
+    e_N = sa.mat_t_vec(rotations.attitude_matrix(Q0), axis)
+    side = sa._unit(rotations.cross(e_N, mid), "side")
     # Rotating about the direction of motion moves the point off the path.
     return list(sa.rotate(mid, side, math.radians(10.0)))
 

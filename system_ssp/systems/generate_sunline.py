@@ -24,13 +24,13 @@ sys.path.insert(0, str(HERE))
 from generate import ROOT, vec, write_ssd, write_ssv  # noqa: E402
 
 sys.path.insert(0, str(ROOT))
-from components import attitude  # noqa: E402
+from components.core import rotations  # noqa: E402
 
 AU = 149597870700.0  # m
 # Sun about 1 au away, off every axis; spacecraft in a low Earth orbit position.
 R_SUN_N = [0.8 * AU, -0.55 * AU, 0.24 * AU]
 R_SC_N = [4.2e6, 5.1e6, 1.9e6]
-Q0 = list(attitude.from_euler123(0.3, -0.2, 0.5))
+Q0 = list(rotations.from_euler123(0.3, -0.2, 0.5))
 SPIN_Z = 0.1  # rad/s
 SPIN_X = 0.05  # rad/s
 
