@@ -1,4 +1,4 @@
-"""Orbital lifetime with the orbit-averaged model (components.orbit_averaged), no FMUs.
+"""Orbital lifetime with the orbit-averaged model (components.orbit.averaged), no FMUs.
 
     python bench/bench_lifetime.py [--models exponential jacchia_roberts ...] [--skip-timing]
                                    [--skip-scenarios] [--msis-days 5]
@@ -11,12 +11,12 @@ Prints
    Cd 2.2, 0.02 m2, epoch 2023-01-01, re-entry at a mean perigee altitude of 250 km) without and
    with the de-orbit burn, for each model in --models: the burn is a finite retrograde burn of the
    4 x 25 mN thrusters (Isp 42 s) starting at t = 0 with the library's propellant for the Eq. 2
-   delta-V (components.propulsion.deorbit_scenario), the mass falling as the propellant is used,
+   delta-V (components.orbit.propulsion.deorbit_scenario), the mass falling as the propellant is used,
    then a coast to re-entry at the final mass. Lifetimes count from the start of the burn, as in
    the thesis, and are printed beside the thesis' values.
 
 Space weather for msis / jacchia_roberts: the bundled CSSI file (observed to 2026-08, predicted to
-2041-10, then the last entry held; see components/space_weather.py), not the 2023-era data the
+2041-10, then the last entry held; see components/environment/space_weather.py), not the 2023-era data the
 thesis' FreeFlyer runs used.
 """
 import argparse

@@ -1,6 +1,6 @@
 """FMU `AcsControl` (instance `control`): the per-mode control laws of the seed-002 ACS.
 
-Wraps components.acs_control.AcsControl (the laws and their equations are in its docstring):
+Wraps components.acs.control.AcsControl (the laws and their equations are in its docstring):
 mode and permissions from the mode manager, body rate, field, Sun heading, wheel rate and time
 in mode in; commanded coil dipole and wheel motor torque out. Stateless; both outputs are
 direct feedthrough of the inputs.

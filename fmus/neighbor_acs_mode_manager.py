@@ -1,6 +1,6 @@
 """FMU `AcsModeManager` (instance `modes`): the ten-mode ACS mode manager of seed 002.
 
-Wraps components.acs_modes.AcsModeManager: the seed's decision tables as data, evaluated at
+Wraps components.acs.modes.AcsModeManager: the seed's decision tables as data, evaluated at
 each communication point with the inputs present there (do_step(t, h) decides at t; the mode
 holds over [t, t + h]). Every output is state (mode, time in mode, permissions of the mode), so
 no output depends directly on an input. The model keeps the time: the start time at

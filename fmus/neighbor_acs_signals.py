@@ -1,6 +1,6 @@
 """FMU `AcsSignals` (instance `signals`): the mode manager's state values from the truth.
 
-Wraps components.acs_signals.AcsSignals (definitions in its docstring): a stand-in for the
+Wraps components.acs.signals.AcsSignals (definitions in its docstring): a stand-in for the
 sensors and estimator. The state values depend directly on the inputs; ground_command is a
 scripted uplink window on the model's time (the start time at initialization, t + h after
 do_step(t, h)), so it is a state.

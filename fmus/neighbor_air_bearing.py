@@ -1,8 +1,8 @@
 """FMU `AirBearingKinematics` (instance `kinematics`): attitude thresholding for a spherical
 air-bearing testbed without an IMU (seed 001).
 
-Wraps components.air_bearing.AirBearingKinematics. Input: the DCM stream dcm_BN[i,j] ([BN],
-N components to B components, like components.attitude.attitude_matrix; the seed's R = R^N_B
+Wraps components.sensing.air_bearing.AirBearingKinematics. Input: the DCM stream dcm_BN[i,j] ([BN],
+N components to B components, like components.core.rotations.attitude_matrix; the seed's R = R^N_B
 (B to N) is its transpose). Outputs: the attitude rebuilt from 3-2-1 Euler angles with pitch
 and roll limited to +-tau, the angular velocity estimated from consecutive DCMs, the limited
 angles and a `limited` flag. All outputs depend directly on the DCM input (the rate through

@@ -1,6 +1,6 @@
 """FMU `Atmosphere`: atmospheric mass density and geodetic altitude at a position.
 
-Wraps components.atmosphere (exponential, Harris-Priester, NRLMSIS 2.1 or Jacchia-Roberts, with
+Wraps components.environment.atmosphere (exponential, Harris-Priester, NRLMSIS 2.1 or Jacchia-Roberts, with
 space weather from a CSSI file or constant indices; see that module). Input: the spacecraft
 position r_BN_N (m, N frame); outputs: density (kg/m3) and geodetic altitude above WGS-84 (m),
 both direct feedthrough of the position at the current time. The model keeps the simulation

@@ -1,7 +1,7 @@
 """FMU `AttitudeDetermination` (instance `ad`): TRIAD fixes from nadir and Sun vectors, gyro
 propagation between fixes.
 
-Wraps components.triad.AttitudeDetermination (thesis 3.3.1). At each communication point the
+Wraps components.sensing.triad.AttitudeDetermination (thesis 3.3.1). At each communication point the
 estimate is the TRIAD fix of the current inputs when both vectors are valid (direct
 feedthrough), otherwise the estimate propagated with the measured rate over the last step
 (state). do_step propagates the estimate at the start of the step (fix or not) with the rate

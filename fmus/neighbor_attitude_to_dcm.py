@@ -1,6 +1,6 @@
 """FMU `AttitudeToDcm` (instance `to_dcm`): quaternion to direction cosine matrix.
 
-Wraps components.air_bearing.AttitudeToDcm: dcm_BN = A(q_BN / |q_BN|) (thesis Eq. 22), [BN]
+Wraps components.sensing.air_bearing.AttitudeToDcm: dcm_BN = A(q_BN / |q_BN|) (thesis Eq. 22), [BN]
 maps N components to B components. Direct feedthrough, stateless; lets the air-bearing
 system drive the DCM-input kinematics FMU from the RigidBody FMU.
 """

@@ -1,6 +1,6 @@
 """FMU `CircularOrbit` (instance `orbit`): analytic circular two-body orbit.
 
-Wraps components.circular_orbit.CircularOrbit. No inputs; outputs are functions of time. The
+Wraps components.orbit.circular.CircularOrbit. No inputs; outputs are functions of time. The
 model keeps the simulation time: the start time at initialization, t + h after do_step(t, h).
 """
 import math

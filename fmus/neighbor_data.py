@@ -1,7 +1,7 @@
 """FMU `DataStorage` (instance `data`): NEIGHBOR's flash data store (256 kB = 256000 bytes)
 filled at the Table 7 recording rate and emptied by the 9600-baud UHF downlink.
 
-Wraps components.data_storage.DataStorage (see its docstring for the Table 7 rate, 30.2833
+Wraps components.mission.data_storage.DataStorage (see its docstring for the Table 7 rate, 30.2833
 B/s, against Appendix I's 29.503 B/s, k = 1000, and the exact integration). Inputs are Booleans
 held over a step; every output is a state (no direct dependencies). Overflow is never silent:
 bytes that do not fit are counted in `bytes_lost` and `overflow` latches true.

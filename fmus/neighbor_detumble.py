@@ -1,6 +1,6 @@
 """FMU `DetumbleController` (instance `detumble`): PD rate damping with thruster thresholds.
 
-Wraps components.detumble.DetumbleController (thesis Eq. 9-16, Appendix C `Detumble`,
+Wraps components.attitude.detumble.DetumbleController (thesis Eq. 9-16, Appendix C `Detumble`,
 stop test of Appendix D). Stateless: every output is a function of the current inputs.
 """
 import math

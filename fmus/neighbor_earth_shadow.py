@@ -1,6 +1,6 @@
 """FMU `EarthShadow` (instance `shadow`): conical umbra/penumbra Earth shadow.
 
-Wraps components.eclipse.EarthShadow (Montenbruck and Gill, section 3.4.2). Stateless: every
+Wraps components.environment.eclipse.EarthShadow (Montenbruck and Gill, section 3.4.2). Stateless: every
 output depends directly on both position inputs.
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components

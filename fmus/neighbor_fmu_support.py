@@ -302,7 +302,7 @@ _ATMOSPHERE_CACHE = {}
 
 
 def atmosphere_model(values, inclination=None):
-    """The components.atmosphere density model for the parameter values declared by
+    """The components.environment.atmosphere density model for the parameter values declared by
     `atmosphere_parameters` (a mapping name -> value, e.g. slave.values). `inclination` (rad)
     sets the Harris-Priester exponent when hp_exponent is 0. ValueError naming the parameter
     for a bad value. A space-weather file is parsed once per path and process."""

@@ -1,6 +1,6 @@
 """FMU `GpsReceiver` (instance `gps`): position with seeded noise, and time.
 
-Wraps components.sensors.GpsReceiver (thesis 3.3.1, NovAtel OEM7700 [45]). One noise sample
+Wraps components.sensing.sensors.GpsReceiver (thesis 3.3.1, NovAtel OEM7700 [45]). One noise sample
 per communication step, drawn in do_step; r_meas_N depends directly on r_BN_N, gps_time is state.
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components

@@ -1,7 +1,7 @@
 """FMU `GroundStation` (instance `ground`): contact geometry between the UIUC ground station and
 the spacecraft, and the ground's final de-orbit confirmation.
 
-Wraps components.ground_station.GroundStation (WGS-84 station, Earth rotation by GMST). Every
+Wraps components.mission.ground_station.GroundStation (WGS-84 station, Earth rotation by GMST). Every
 output depends directly on the input r_BN_N (and on the time the model keeps: the start time at
 initialization, t + h after do_step(t, h)).
 """

@@ -1,6 +1,6 @@
 """FMU `Gyro` (instance `gyro`): 3-axis rate gyro with bias and seeded white noise.
 
-Wraps components.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
+Wraps components.sensing.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
 communication step, drawn in do_step; the output depends directly on the true rate.
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components

@@ -1,6 +1,6 @@
 """FMU `HorizonSensor` (instance `horizon`): nadir vector in B with seeded noise.
 
-Wraps components.sensors.HorizonSensor (thesis 3.3.1). The noise sample is drawn once per
+Wraps components.sensing.sensors.HorizonSensor (thesis 3.3.1). The noise sample is drawn once per
 communication step in do_step; outputs are the current inputs' nadir direction perturbed by
 the current sample (direct feedthrough of r_BN_N and q_BN). The generator state is part of
 the FMU state.

@@ -1,6 +1,6 @@
 """FMU `HostSpacecraft` (instance `host`): the host spacecraft's heartbeat from a schedule.
 
-Wraps components.host.HostSpacecraft. No inputs; the outputs are functions of time: the
+Wraps components.mission.host.HostSpacecraft. No inputs; the outputs are functions of time: the
 heartbeat is present before heartbeat_loss_time, lost from it on, and toggled again at each
 time of heartbeat_return_times. `next_event_time` is the next toggle so that a master can end a
 step on it. The model keeps the time: the start time at initialization, t + h after do_step.

@@ -1,6 +1,6 @@
 """FMU `MagneticField` (instance `field`): Earth's magnetic field as a tilted dipole.
 
-Wraps components.magnetic_field.MagneticField: the first-degree IGRF-13 Gauss coefficients
+Wraps components.environment.magnetic_field.MagneticField: the first-degree IGRF-13 Gauss coefficients
 (epoch 2020.0: g10 = -29404.8, g11 = -1450.9, h11 = 4652.5 nT; Alken et al. 2021), the
 Earth-fixed frame from N by the IAU 1982 GMST. B_N depends directly on the position input,
 B_B on the position and the attitude. The model keeps the simulation time: the start time at

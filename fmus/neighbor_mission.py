@@ -1,7 +1,7 @@
 """FMU `MissionManager` (instance `mission`): NEIGHBOR's operating modes (thesis section 3.4,
 Figure 45), the de-orbit sub-phases, and what each mode powers (sections 3.5-3.6, Tables 5-7).
 
-Wraps components.mission_manager.MissionManager (its docstring has the full mode logic and the
+Wraps components.mission.manager.MissionManager (its docstring has the full mode logic and the
 thesis ambiguities). do_step(t, h) evaluates the transitions from the inputs at the start of the
 step (held over the step); internal timers (daily wake-up, grace period, attitude
 determination) fire at their exact times inside the step and `next_event_time` announces the

@@ -1,6 +1,6 @@
 """FMU `MomentumWheel` (instance `wheel`): a momentum wheel on a fixed body axis.
 
-Wraps components.momentum_wheel.MomentumWheel: J_w dOmega/dt = tau with the motor torque
+Wraps components.acs.momentum_wheel.MomentumWheel: J_w dOmega/dt = tau with the motor torque
 saturated (and none beyond the speed limit). wheel_rate and wheel_momentum_B are states (no
 direct dependencies); wheel_torque_B depends directly on torque_cmd and enabled. Connect
 wheel_torque_B and wheel_momentum_B to the RigidBody inputs of the same names.

@@ -1,6 +1,6 @@
 """FMU `OpticalTracker` (instance `optical`): the star-tracking optical system's tracking flag.
 
-Wraps components.optical_tracker.OpticalTracker (model in its docstring): lock after
+Wraps components.acs.optical_tracker.OpticalTracker (model in its docstring): lock after
 acquisition_time of low body rate (and paddles deployed), tracking = lock and (night or within
 loss_time of dawn). `tracking` depends directly on orbit_day.
 """

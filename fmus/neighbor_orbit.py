@@ -1,6 +1,6 @@
 """FMU `Orbit` (instance `orbit`): Cowell orbit propagation with EGM96 zonal gravity, drag and thrust.
 
-Wraps components.orbit.CowellOrbit (gravity point mass + J2..J6, drag per thesis Eq. 1 with the
+Wraps components.orbit.cowell.CowellOrbit (gravity point mass + J2..J6, drag per thesis Eq. 1 with the
 velocity relative to the rotating atmosphere, thrust F_B rotated to N with q_BN or along -v when
 `retrograde`). Integrated across each communication step with adaptive DOP853 (minutes in coast,
 0.5 s in burns: do_step(t, h) lands exactly on t + h). Inputs are held over a step, and every

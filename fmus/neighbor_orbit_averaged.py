@@ -1,6 +1,6 @@
 """FMU `OrbitAveraged` (instance `orbit`): orbit-averaged lifetime propagator (mean elements).
 
-Wraps components.orbit_averaged.OrbitAveraged: mean a, e cos(argp), e sin(argp), i, RAAN and
+Wraps components.orbit.averaged.OrbitAveraged: mean a, e cos(argp), e sin(argp), i, RAAN and
 argp + M under orbit-averaged drag (Gauss equations, quadrature over the eccentric longitude,
 density from the selected atmosphere model at each node's 3D position), J2 secular drift, and
 thrust through the Gauss equations at the current position (short burns). RK4 with steps of at

@@ -1,6 +1,6 @@
 """FMU `Paddles` (instance `paddles`): deployable solar paddles (seed 002).
 
-Wraps components.paddles.Paddles: deployment progresses while `deploy` is true and latches
+Wraps components.acs.paddles.Paddles: deployment progresses while `deploy` is true and latches
 deployed after deployment_time. Outputs are states (no direct dependencies).
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components

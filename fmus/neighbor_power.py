@@ -1,7 +1,7 @@
 """FMU `Power` (instance `power`): NEIGHBOR's battery (one LG HG2 cell, 10.8 Wh = 38880 J)
 drained by the components the mission manager switches on.
 
-Wraps components.power.PowerSystem (see its docstring for the load powers, Table 5 vs Table 6
+Wraps components.mission.power.PowerSystem (see its docstring for the load powers, Table 5 vs Table 6
 vs Appendix I, and the exact integration). Inputs: one Boolean per load (held over a step)
 and `solar_power` (W, default 0: NEIGHBOR has no panels; a host may charge it). `load_power`
 depends directly on the Booleans; energy, state_of_charge, energy_used and empty are states.

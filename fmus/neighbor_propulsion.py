@@ -1,6 +1,6 @@
 """FMU `Propulsion` (instance `propulsion`): NEIGHBOR's de-orbit thrusters (4 x 25 mN, Isp 42 s).
 
-Wraps components.propulsion.MainThrusters. While `burn_enable` is true and the propellant budget
+Wraps components.orbit.propulsion.MainThrusters. While `burn_enable` is true and the propellant budget
 is not spent, `F_thrust_B` = n F axis_B is the force ON THE SPACECRAFT in the body frame (the
 exhaust leaves along -axis_B) and the mass falls at mdot = n F / (Isp g0). The burn stops when
 m0 - m >= propellant_budget (thesis Appendix F); the step that crosses the budget burns only for
@@ -33,7 +33,7 @@ class Propulsion(NeighborSlave):
         self.parameter("mass0", propulsion.MASS0, "kg", "Initial total spacecraft mass (> 0)")
         self.parameter("propellant_budget", _DEFAULT_BUDGET, "kg",
                        "Propellant the burn may use, in (0, mass0); default the 420 -> 350 km scenario "
-                       "(Eq. 2-3, 0.564 kg); components.propulsion.deorbit_scenario computes others")
+                       "(Eq. 2-3, 0.564 kg); components.orbit.propulsion.deorbit_scenario computes others")
         self.parameter_array("axis_B", [1.0, 0.0, 0.0], "1",
                              "Unit direction in B of the thrust force on the spacecraft (exhaust along -axis_B)")
         self.input("burn_enable", False, None, "Burn command: thrusters fire while true and propellant remains",

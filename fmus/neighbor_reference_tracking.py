@@ -1,7 +1,7 @@
 """FMU `ReferenceTrackingController` (instance `tracker`): PD + feed-forward tracking of a
 moving attitude reference.
 
-Wraps components.reference_tracking.ReferenceTrackingController. Same controller connectors as
+Wraps components.attitude.reference_tracking.ReferenceTrackingController. Same controller connectors as
 `SlewController` (q_BN, omega_BN_B, enabled in; torque_cmd_B, thrust_flag, done out) plus the
 reference inputs from a guidance FMU. Continuous (clipped) torque by default, thruster
 threshold logic with quantize = true. Stateless.

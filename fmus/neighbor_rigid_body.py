@@ -1,6 +1,6 @@
 """FMU `RigidBody` (instance `dynamics` in the systems): rigid-body attitude dynamics.
 
-Wraps components.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
+Wraps components.attitude.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
 Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
 
 Momentum wheels: the inputs wheel_torque_B (the wheel motors' torque on the wheels; the body

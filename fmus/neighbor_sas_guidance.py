@@ -1,6 +1,6 @@
 """FMU `SunAvoidanceGuidance` (instance `guidance`): Sun-avoidance slew reference.
 
-Wraps components.sun_avoidance.SunAvoidanceGuidance: plans (from parameters only) a rest-to-
+Wraps components.attitude.sun_avoidance.SunAvoidanceGuidance: plans (from parameters only) a rest-to-
 rest eigenaxis slew from q0 to q_f, split into three eigenaxis segments around the Sun keep-out
 cone when the direct one would sweep the boresight through it, each with a bang-coast-bang
 profile, and streams the analytic reference at the communication point time. Its outputs

@@ -1,6 +1,6 @@
 """FMU `SlewController` (instance `slew`): quaternion-error PD with thruster thresholds.
 
-Wraps components.slew.SlewController (thesis Eq. 41-46, Appendix C `Slew`, stop test of
+Wraps components.attitude.slew.SlewController (thesis Eq. 41-46, Appendix C `Slew`, stop test of
 Appendix E, or of Appendix G with accept_antipodal). Stateless.
 """
 import math

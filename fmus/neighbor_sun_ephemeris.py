@@ -1,6 +1,6 @@
 """FMU `SunEphemeris` (instance `sun`): position of the Sun relative to Earth's centre.
 
-Wraps components.sun.SunEphemeris (Astronomical Almanac / Vallado Algorithm 29 low-precision
+Wraps components.environment.sun.SunEphemeris (Astronomical Almanac / Vallado Algorithm 29 low-precision
 Sun, about 0.01 deg). No inputs; the output is a function of time only. The model keeps the
 simulation time: the start time at initialization, t + h after do_step(t, h).
 """

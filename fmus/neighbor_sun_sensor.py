@@ -1,7 +1,7 @@
 """FMU `SunSensor` (instance `sun_sensor`): Sun vector in B with seeded noise, field of view
 and eclipse.
 
-Wraps components.sensors.SunSensor (thesis 3.3.1, Solar MEMS nanoSSOC-D60 [43]). The noise
+Wraps components.sensing.sensors.SunSensor (thesis 3.3.1, Solar MEMS nanoSSOC-D60 [43]). The noise
 sample is drawn once per communication step in do_step; outputs depend directly on the
 inputs. The generator state is part of the FMU state.
 """

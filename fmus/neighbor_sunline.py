@@ -1,6 +1,6 @@
 """FMU `SunlineEphemeris` (instance `sunline`): Sun heading in B from ephemeris (seed 004).
 
-Wraps components.sunline.SunlineEphemeris: d_N = (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N|,
+Wraps components.sensing.sunline.SunlineEphemeris: d_N = (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N|,
 d_B = [BN(sigma_BN)] d_N, or A(q_BN) d_N with attitude_input = "quaternion". Stateless; both
 outputs are direct feedthrough of the inputs.
 """

@@ -1,6 +1,6 @@
 """FMU `RcsThrusters` (instance `thrusters`): RCS thruster pairs of NEIGHBOR.
 
-Wraps components.thrusters.ThrusterPairs (thesis Eq. 13-16 and 74): commanded torque in,
+Wraps components.attitude.thrusters.ThrusterPairs (thesis Eq. 13-16 and 74): commanded torque in,
 applied torque and thrust flags out (direct feedthrough), firing time and propellant mass
 accumulated over the steps (states).
 """

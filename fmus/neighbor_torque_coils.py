@@ -1,6 +1,6 @@
 """FMU `TorqueCoils` (instance `coils`): three magnetic torque coils along the body axes.
 
-Wraps components.magnetorquer.TorqueCoils: the commanded dipole saturated per axis (zero when
+Wraps components.acs.magnetorquer.TorqueCoils: the commanded dipole saturated per axis (zero when
 disabled) and the torque dipole x field. Both outputs are direct feedthrough of the inputs.
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components

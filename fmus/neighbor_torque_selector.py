@@ -1,7 +1,7 @@
 """FMU `TorqueSelector` (instance `selector`): passes the torque command of the enabled
 attitude controller (detumble, slew or tracking) to the RCS thrusters.
 
-Wraps components.command_selector.select_command. Direct feedthrough; no state.
+Wraps components.attitude.command_selector.select_command. Direct feedthrough; no state.
 """
 from neighbor_fmu_support import NeighborSlave, use_bundled_components
 

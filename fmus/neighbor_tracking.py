@@ -1,6 +1,6 @@
 """FMU `TrackingController` (instance `tracking`): de-orbit attitude tracking (sliding mode).
 
-Wraps components.deorbit_tracking.DeorbitTrackingController (thesis Eq. 67-73, Appendix C
+Wraps components.attitude.deorbit_tracking.DeorbitTrackingController (thesis Eq. 67-73, Appendix C
 `Deorbit` and `TargetQuaternion`, Appendix F). Same thruster-controller connectors as the slew
 and detumble controllers (`enabled`, `torque_cmd_B[3]`, `thrust_flag[3]`, `done`), so a system
 swaps controllers by switching `enabled`; thrust time and propellant are counted by RcsThrusters.

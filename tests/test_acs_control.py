@@ -1,4 +1,4 @@
-"""Control laws of the seed-002 ACS (components.acs_control), its signals, paddles and optical
+"""Control laws of the seed-002 ACS (components.acs.control), its signals, paddles and optical
 tracker, and their FMUs."""
 import math
 import sys

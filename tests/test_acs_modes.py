@@ -1,4 +1,4 @@
-"""ACS mode manager of seed 002 (components/acs_modes.py) and its FMU (AcsModeManager)."""
+"""ACS mode manager of seed 002 (components/acs/modes.py) and its FMU (AcsModeManager)."""
 import itertools
 import math
 import sys

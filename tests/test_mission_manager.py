@@ -228,7 +228,7 @@ def test_stale_completion_flags_do_not_skip_phases():
 
 def test_powered_components_against_tables_5_and_6():
     """Sums of Table 5 over the components each state powers reproduce Table 6, whose last
-    seven values are printed one row off (see components.mission_manager): to 0.005 W."""
+    seven values are printed one row off (see components.mission.manager): to 0.005 W."""
     def state(mode, phase=mm.PHASE_NONE, awake=False, contact=False):
         m = mm.MissionManager({"initial_mode": mode if mode != mm.END else mm.IDLE}, 10.0)
         m.mode, m.phase, m.awake, m.in_contact = mode, phase, awake, contact

@@ -25,7 +25,7 @@ def _constant_kernel(r, jd, data):
 
 
 class ConstantDensity:
-    """A density model with the components.atmosphere interface and a constant density."""
+    """A density model with the components.environment.atmosphere interface and a constant density."""
 
     def __init__(self, rho):
         self.rho = rho
@@ -330,7 +330,7 @@ def _orbit_mean(model, t_start, value, period, n=48):
 @pytest.mark.parametrize("zonal_degree, tolerance", [(0, 0.005), (6, 0.05)])
 def test_mean_decay_agrees_with_cowell(zonal_degree, tolerance):
     """350 km circular, exponential density, 30 days: the decay of the orbit-mean semi-major
-    axis of the Cowell model (components.orbit, osculating a averaged over one orbit at the
+    axis of the Cowell model (components.orbit.cowell, osculating a averaged over one orbit at the
     start and the end) and of the averaged model started from the same mean a.
 
     Point mass only (zonal_degree 0, j2 0): within 0.5 % (measured 0.1 %). With J2..J6 in

@@ -34,7 +34,7 @@ FINAL_CONTACT_TIME = 7.5 * 60.0    # not stated in the thesis: a representative 
 def test_load_table_and_appendix_i_modes():
     """Table 5 values (the microprocessor from Appendix I's current model), the 10.8 Wh cell,
     and Appendix I's phase powers against Table 6's numbers, which sit one row lower than the
-    action they belong to (documented in components.power)."""
+    action they belong to (documented in components.mission.power)."""
     table5 = {"propulsion": 0.5, "horizon_sensor": 0.15, "sun_sensor": 0.115, "gyro": 0.018,
               "gps_receiver": 1.300, "gps_antenna": 0.066, "microprocessor_nominal": 0.0221,
               "microprocessor_quiescent": 9.24e-8, "uhf_rx": 0.1815, "uhf_tx": 2.64}

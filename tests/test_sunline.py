@@ -1,4 +1,4 @@
-"""Seed 004: MRP conversions (components.mrp), the sunline-ephemeris model, its FMU
+"""Seed 004: MRP conversions (components.core.mrp), the sunline-ephemeris model, its FMU
 `SunlineEphemeris` through FMPy, and the `sunline` system through the master."""
 import math
 import sys

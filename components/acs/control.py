@@ -1,5 +1,5 @@
 """Per-mode control laws of the seed-002 ACS (magnetic torque coils on X, Y, Z and a momentum
-wheel on Y), commanded by the mode manager (components.acs_modes).
+wheel on Y), commanded by the mode manager (components.acs.modes).
 
 Inputs (all in B): mode, coils_enabled / wheel_enabled (the mode manager's permissions), the body
 rate omega (rad/s), the field B (T), the Sun heading s (unit vector), the wheel rate Omega
@@ -11,7 +11,7 @@ J_w Omega y_hat the total angular momentum in B, H_d = Iy w_s y_hat the desired 
 (w_s = 5 deg/s, the seed's Spinup rate), Sun elevation sin(el) = s_y (from the X-Z plane),
 azimuth az = atan2(s_x, s_z) (about Y from +Z). A desired torque tau_d is produced by the coils
 as m = B x tau_d / |B|^2 (then m x B = tau_d minus its component along B, which coils cannot
-produce). The coils saturate per axis downstream (components.magnetorquer).
+produce). The coils saturate per axis downstream (components.acs.magnetorquer).
 
 Laws (mode: dipole; wheel):
 - 0 Wait: m = 0; tau_w = 0 ("none of the actuators active").
@@ -87,7 +87,7 @@ WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_D
 
 PARAMETER_DEFAULTS = {
     "Ix": 0.05, "Iy": 0.13, "Iz": 0.10,  # kg.m2, the 12 kg 0.3 x 0.1 x 0.2 m box
-    "J_w": 2.0e-5,  # kg.m2, components.momentum_wheel default
+    "J_w": 2.0e-5,  # kg.m2, components.acs.momentum_wheel default
     "spin_rate": math.radians(5.0),  # rad/s, the seed's +5 deg/s about Y
     "k_detumble": 2.0e-3,  # N.m.s
     "k_nutation": 2.0e-3,  # N.m.s

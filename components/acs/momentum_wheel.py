@@ -6,7 +6,7 @@ torque tau (N.m, on the wheel, about axis_B) is held constant and
     J_w dOmega/dt = tau,      h_w = J_w Omega axis_B  (N.m.s, B frame),
 
 integrated exactly (Omega += tau h / J_w). The body feels the reaction -tau axis_B; the rigid
-body (components.rigid_body) takes wheel_torque_B = tau axis_B and wheel_momentum_B = h_w and
+body (components.attitude.rigid_body) takes wheel_torque_B = tau axis_B and wheel_momentum_B = h_w and
 solves J omega_dot = L - wheel_torque_B - omega x (J omega + h_w), which conserves the total
 angular momentum J omega + h_w. With h_w the momentum relative to the body and J the inertia of
 the whole spacecraft, wheel included, this is the usual gyrostat form (Hughes, Spacecraft

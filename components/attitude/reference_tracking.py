@@ -5,7 +5,7 @@ plus the reference's feed-forward torque.
     L  = torque_ff - Kp sign(dq4) dq_1:3 + Kd (omega_ref - omega)
 
 sign(dq4) makes the controller take the short way to q_ref or -q_ref (sign(0) = 0, as in
-components/slew.py). omega_ref is the reference rate in the reference body frame; near the
+components/attitude/slew.py). omega_ref is the reference rate in the reference body frame; near the
 reference it equals its components in the actual body frame to first order in the error.
 
 Torque modes:

@@ -21,7 +21,7 @@ ch. 3; Markley and Crassidis, 2014, sec. 3.3)
 with J the inertia of the whole spacecraft. It conserves the total angular momentum
 J omega + h_w (in N) when L = 0. Within a step the wheel torque is held and h_w follows it,
 h_w(t_k + s) = h_w(t_k) + wheel_torque_B s, as the wheel's own exact integration of a held
-torque gives (components.momentum_wheel). With both wheel inputs zero the step runs the
+torque gives (components.acs.momentum_wheel). With both wheel inputs zero the step runs the
 same arithmetic plus exact zeros, so results are bit-identical to the wheel-less model.
 `angular_momentum()` (the H_B output) stays the body's own J omega; the total is
 `total_angular_momentum(h_w)`.

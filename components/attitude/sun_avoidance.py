@@ -1,7 +1,7 @@
 """Sun-avoidance slew (SAS) guidance: a rest-to-rest eigenaxis slew, split into three eigenaxis
 segments when the direct one would sweep a body-fixed boresight through the Sun keep-out cone.
 
-Conventions (CONVENTIONS.md, components/attitude.py): q = q_BN scalar last, A(q) maps N to B,
+Conventions (CONVENTIONS.md, components/core/rotations.py): q = q_BN scalar last, A(q) maps N to B,
 q_total = q_second (x) q_first, so A(q_second (x) q_first) = A(q_second) A(q_first).
 
 Inputs of the plan

@@ -11,7 +11,7 @@ components to B-frame components), so
     [BN(sigma)] = I + (8 [sigma~]^2 - 4 (1 - s2) [sigma~]) / (1 + s2)^2
     sigma_s = -sigma / s2                                      shadow set
 
-and [BN(sigma(q))] == components.attitude.attitude_matrix(q) for every unit q (tested for q and
+and [BN(sigma(q))] == components.core.rotations.attitude_matrix(q) for every unit q (tested for q and
 -q). [sigma~] is the cross-product matrix ([sigma~] v = sigma x v).
 
 q and -q give the same attitude; their MRPs are each other's shadow sets (sigma(-q) =

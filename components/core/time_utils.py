@@ -5,7 +5,7 @@ UTC string, "YYYY-MM-DDThh:mm:ss[.fff]Z" (or "+00:00" instead of "Z"); `parse_ep
 nothing else (no local times, no other offsets, no date-only strings), so a typo cannot shift
 the scenario silently.
 
-Time scale: the Julian dates here are UTC Julian dates. The Sun model of `components.sun` is the
+Time scale: the Julian dates here are UTC Julian dates. The Sun model of `components.environment.sun` is the
 low-precision algorithm (good to about 0.01 deg), which Vallado evaluates with T_UT1 for both the
 mean longitude and the mean anomaly; we use UTC for UT1 (|UT1 - UTC| < 0.9 s) and ignore the
 TT - UTC offset of 69.184 s, which moves the Sun by 0.0008 deg, well below the model's accuracy.

@@ -13,7 +13,7 @@ P_n and P_n' by Bonnet's recursion n P_n = (2n-1) s P_{n-1} - (n-1) P_{n-2} and
 P_n' = s P_{n-1}' + n P_{n-1}.
 
 Zonal terms depend only on z and |r|, and z is the same axis in N and in the Earth-fixed frame
-(no polar motion or precession, components/geodesy.py), so they are evaluated in N directly.
+(no polar motion or precession, components/environment/geodesy.py), so they are evaluated in N directly.
 
 Coefficients: unnormalized J_n = -sqrt(2n+1) C_n0bar from the fully normalized EGM96 values
 (Lemoine et al. 1998, NASA/TP-1998-206861, file egm96_to360.ascii):

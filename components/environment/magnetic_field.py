@@ -31,9 +31,9 @@ Frames: the Earth-fixed frame is N rotated about z by the Greenwich mean siderea
 
     GMST = 67310.54841 s + (876600 h + 8640184.812866 s) T + 0.093104 s T^2 - 6.2e-6 s T^3,
 
-T = Julian centuries of UT1 since J2000 (UTC used for UT1, as in components.time_utils);
+T = Julian centuries of UT1 since J2000 (UTC used for UT1, as in components.core.time_utils);
 r_ECEF = R3(GMST) r_N. Polar motion, precession and nutation are ignored (N is used as the
-true-of-date frame), like the rest of the product's N frame (components.sun).
+true-of-date frame), like the rest of the product's N frame (components.environment.sun).
 
 Secular variation (optional, `secular_variation=True`): g(t) = g(2020.0) + dg (year - 2020.0)
 with year the decimal year (Julian years of 365.25 days from 2020-01-01T00:00Z).

@@ -6,7 +6,7 @@ Two sources with the same interface:
   version 1.2 (https://celestrak.org/SpaceData/SpaceWx-format.php; the format line is in the
   file header: FORMAT(I4,I3,I3,I5,I3,8I3,I4,8I4,I4,F4.1,I2,I4,F6.1,I2,5F6.1)), with its three
   sections OBSERVED, DAILY_PREDICTED and MONTHLY_PREDICTED. `path=None` reads the bundled copy
-  components/data/SW-All_CSSI_2026-08-22_from2000.txt (see components/data/README.md: the
+  components/environment/data/SW-All_CSSI_2026-08-22_from2000.txt (see components/environment/data/README.md: the
   CelesTrak file of 2026-08-22, observed section trimmed to 2000-01-01 on, header and both
   prediction sections unchanged).
 - `ConstantSpaceWeather(f107, f107a, ap)`: the same indices on every day.

@@ -2,7 +2,7 @@
 Almanac as given by Vallado, Fundamentals of Astrodynamics and Applications, Algorithm 29
 (SUN), good to about 0.01 deg from 1950 to 2050:
 
-    T        = Julian centuries since J2000 (UTC for UT1/TDB, see components.time_utils)
+    T        = Julian centuries since J2000 (UTC for UT1/TDB, see components.core.time_utils)
     lambda_M = 280.460 deg + 36000.771 deg T                      mean longitude
     M        = 357.5291092 deg + 35999.05034 deg T                mean anomaly
     lambda   = lambda_M + 1.914666471 deg sin M + 0.019994643 deg sin 2M   ecliptic longitude

@@ -3,7 +3,7 @@ Urbana-Champaign (thesis section 3.6, Appendix I: FreeFlyer's VisibilityCalculat
 UIUC GroundStation and the spacecraft).
 
 Geometry. The station is a point at geodetic latitude/longitude/height on the WGS-84
-ellipsoid, fixed in the Earth-fixed frame E; E is N rotated by GMST (components.geodesy). The
+ellipsoid, fixed in the Earth-fixed frame E; E is N rotated by GMST (components.environment.geodesy). The
 line of sight rho = r_E(spacecraft) - r_E(station) is resolved in the station's local
 East-North-Up frame (Up = the ellipsoid normal):
     elevation = asin(rho . U / |rho|),  azimuth = atan2(rho . E, rho . N) in [0, 2 pi)

@@ -287,7 +287,7 @@ def _finite(name, value, lo=None, hi=None, lo_open=False, unit=""):
 class OrbitAveraged:
     """Mean-element lifetime propagator (see the module docstring).
 
-    `density_model`: a components.atmosphere model (.density, .kernel, .kernel_data), or None
+    `density_model`: a components.environment.atmosphere model (.density, .kernel, .kernel_data), or None
     for no drag (density 0).
     Time t is seconds since `epoch`; advance_to(t, ...) integrates to t exactly."""
 
@@ -327,7 +327,7 @@ class OrbitAveraged:
         if density_model is not None:
             for name in ("kernel", "kernel_data", "density"):
                 if not hasattr(density_model, name):
-                    raise ValueError(f"density_model {density_model!r} lacks .{name} (components.atmosphere model)")
+                    raise ValueError(f"density_model {density_model!r} lacks .{name} (components.environment.atmosphere model)")
         self.atmosphere = density_model  # None: no drag
         M = elements.mean_from_true(ta, e)
         self.y = np.array([a, e * math.cos(argp), e * math.sin(argp), inc, raan % TWO_PI, (argp + M) % TWO_PI])

@@ -4,16 +4,16 @@ Equations of motion (N frame, m and s):
 
     r' = v
     v' = a_grav(r) + a_drag + a_thrust
-    a_grav   : components.gravity.accel_zonal (point mass + J2..J`zonal_degree`)
+    a_grav   : components.environment.gravity.accel_zonal (point mass + J2..J`zonal_degree`)
     a_drag   = -1/2 rho(r, t) Cd A / m |v_rel| v_rel,  v_rel = v - omega_E x r       (thesis Eq. 1,
                with the velocity relative to the co-rotating atmosphere, omega_E = 7.292115e-5 rad/s
                about z)
-    a_thrust = A(q_BN)^T F_B / m            (body-frame thrust rotated to N, components/attitude.py)
+    a_thrust = A(q_BN)^T F_B / m            (body-frame thrust rotated to N, components/core/rotations.py)
              = -|F_B| / m * v/|v|            when `retrograde` (along -v, v relative to N, taken at
                                              every stage, so the burn follows the velocity)
 
 F_B, q_BN, `retrograde` and the mass are inputs held constant across a communication step
-(zero-order hold). The density rho comes from a model of components/atmosphere.py
+(zero-order hold). The density rho comes from a model of components/environment/atmosphere/
 (`make_density_model`) and is evaluated at every integrator stage (no caching across stages).
 
 Integrator: Dormand-Prince 8(5,3) (DOP853, Hairer's error estimator and step control, the same
@@ -27,7 +27,7 @@ in Hairer's Fortran DOP853 (scipy.integrate.ode) with the same tolerances.
 Tolerances (defaults, from a convergence check, see bench/bench_orbit.py and the report):
 rtol = 1e-11, atol = 1e-4 m on position and 1e-7 m/s on velocity.
 
-Re-entry: the geodetic altitude above WGS-84 (components/geodesy.py; it depends on z and
+Re-entry: the geodetic altitude above WGS-84 (components/environment/geodesy.py; it depends on z and
 sqrt(x^2 + y^2) only, so it is evaluated in N) is checked after every accepted internal step;
 once it is below `reentry_altitude`, `reentered` latches and the model keeps the state of that
 step (its time is `reentry_time`), while its clock still advances to the requested times.
@@ -73,7 +73,7 @@ def _zero_density(r_N, jd_utc, data):
 
 @njit(cache=True)
 def geodetic_altitude_nb(x, y, z):
-    """Height above WGS-84 (m), Bowring's method as in components/geodesy.py."""
+    """Height above WGS-84 (m), Bowring's method as in components/environment/geodesy.py."""
     a = geodesy.WGS84_A
     b = geodesy.WGS84_B
     e2 = geodesy.WGS84_E2
@@ -220,7 +220,7 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
 class CowellOrbit:
     """Cowell propagation of r, v in N; see the module docstring.
 
-    density_model: a model from components.atmosphere.make_density_model (or a name given to it,
+    density_model: a model from components.environment.atmosphere.make_density_model (or a name given to it,
     with `space_weather`); required when drag is True. zonal_degree: 0 (point mass) or 2..6.
     t0: simulation time (s since `epoch`) of the initial elements."""
 
@@ -265,7 +265,7 @@ class CowellOrbit:
                                                           inclination=float(inc0))
         if self.drag and density_model is None:
             raise ValueError("drag is on but no density_model was given; give a model from "
-                             "components.atmosphere.make_density_model or drag=False")
+                             "components.environment.atmosphere.make_density_model or drag=False")
         self.density_model = density_model
         kernel = getattr(density_model, "kernel", None) if self.drag else _zero_density
         self._kernel = kernel

@@ -8,7 +8,7 @@ rebuilds the attitude from the limited angles and publishes it.
 Conventions (CONVENTIONS.md) and how the seed maps onto them
 -----------------------------------------------------------
 - dcm_BN = [BN] maps N-frame components to B-frame components, v_B = [BN] v_N; it is
-  components.attitude.attitude_matrix(q_BN) (rows: the B axes in N components). Quaternions are
+  components.core.rotations.attitude_matrix(q_BN) (rows: the B axes in N components). Quaternions are
   scalar last, q = [q1, q2, q3, q4].
 - The seed writes R = R^N_B (B to N), so seed R^N_B = [BN]^T: a seed DCM enters as its
   transpose. The seed's explicit 3-2-1 matrix R_321(phi, theta, psi) = R1(phi) R2(theta)

@@ -7,8 +7,8 @@ filtering), rotated into B with the attitude:
     d_B = [BN(sigma_BN)] d_N                          (seed Eq. 2)
 
 r_SN_N is the Sun's position and r_BN_N the spacecraft's, both in N (m). The attitude is the
-MRP sigma_BN (Schaub and Junkins, components.mrp) or, equivalently, the scalar-last quaternion
-q_BN with A(q) (components.attitude); both map N components to B components, and both give the
+MRP sigma_BN (Schaub and Junkins, components.core.mrp) or, equivalently, the scalar-last quaternion
+q_BN with A(q) (components.core.rotations); both map N components to B components, and both give the
 same heading (to rounding) for the same attitude, whichever MRP set or quaternion sign.
 
 Limitation (as in the seed): the heading is only as good as the ephemeris; the Sun is treated

@@ -9,7 +9,7 @@ directions r1, r2 in N it builds the orthonormal triads
     b1,  b2' = (b1 x b2)/|b1 x b2|,  b3' = b1 x b2'      (same for r1, r2)
 
 and the attitude matrix A = [b1 b2' b3'] [r1 r2' r3']^T, which maps N to B exactly like
-components.attitude.attitude_matrix(q_BN). b1 is reproduced exactly; b2 only fixes the
+components.core.rotations.attitude_matrix(q_BN). b1 is reproduced exactly; b2 only fixes the
 rotation about b1.
 
 Between fixes the estimate is propagated with the measured rate, held constant over a step:
@@ -56,7 +56,7 @@ def triad(b1, b2, r1, r2, min_sin=1e-9):
 
 def dcm_to_quaternion(A):
     """Quaternion q (scalar last, q4 >= 0) with attitude.attitude_matrix(q) == A (Shepperd's
-    method, components.attitude.dcm_to_quaternion), after checking A is 3x3 and finite."""
+    method, components.core.rotations.dcm_to_quaternion), after checking A is 3x3 and finite."""
     A = [[float(x) for x in row] for row in A]
     if len(A) != 3 or any(len(row) != 3 for row in A) or not all(math.isfinite(x) for row in A for x in row):
         raise ValueError("attitude matrix must be 3x3 with finite entries")

@@ -70,7 +70,7 @@ MONITOR = ["mission", "orbit", "ground", "power", "data"]  # after the burn: no 
 # 33rd step (0.495 s, about the thesis' 0.5 s burn step), ahead with inputs held.
 SLOW_EVERY = 33
 # Waiting for a contact: 240 s steps while the station's near_contact is false (a contact cannot
-# begin within 448 s of that, components/ground_station.py), 5-10 s steps while it is true.
+# begin within 448 s of that, components/mission/ground_station.py), 5-10 s steps while it is true.
 FAR_STEP = 240.0
 SLOW = {c: SLOW_EVERY for c in ("host", "orbit", "ground", "power", "data")}
 ALL = ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking", "selector",

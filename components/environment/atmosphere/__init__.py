@@ -6,10 +6,10 @@
     model.kernel(r, jd, model.kernel_data)     # the same number from numba code (None for msis)
 
 Every model converts the inertial position itself: Earth-fixed frame by GMST rotation and WGS-84
-geodetic latitude/longitude/altitude, exactly as components.geodesy (the kernels call numba
-compilations of the same functions, components.geodesy.geodetic_from_earth_fixed and
-components.magnetic_field.gmst), and the Sun, where a model needs it, from the low-precision
-formulae of components.sun (also compiled from the same function).
+geodetic latitude/longitude/altitude, exactly as components.environment.geodesy (the kernels call numba
+compilations of the same functions, components.environment.geodesy.geodetic_from_earth_fixed and
+components.environment.magnetic_field.gmst), and the Sun, where a model needs it, from the low-precision
+formulae of components.environment.sun (also compiled from the same function).
 
 - exponential: Vallado, Fundamentals of Astrodynamics, Table 8-4 (piecewise exponential,
   0-1000 km, geodetic altitude; rho = rho0 exp(-(h - h0)/H) in the band of the largest
@@ -26,7 +26,7 @@ formulae of components.sun (also compiled from the same function).
   usual value) when neither is given.
 - msis: NRLMSIS 2.1 through pymsis (see MsisModel).
 - jacchia_roberts: Jacchia 1970 evaluated with Roberts' analytic integration, as in GMAT and
-  FreeFlyer (components.jacchia_roberts).
+  FreeFlyer (components.environment.atmosphere.jacchia_roberts).
 
 Tables: copied from the shared reference data (Vallado Table 8-4 as in GMAT
 ExponentialAtmosphere, with GMAT's corrected 350 km density 9.518e-12; Montenbruck and Gill
@@ -59,7 +59,7 @@ def _default_space_weather(space_weather):
 
 
 def make_density_model(name, space_weather=None, inclination=None, hp_exponent=None):
-    """The density model `name` (one of MODELS). `space_weather`: a components.space_weather
+    """The density model `name` (one of MODELS). `space_weather`: a components.environment.space_weather
     source (default: the bundled CSSI file), used by msis and jacchia_roberts; `inclination`
     (rad) and `hp_exponent` are used by harris_priester only."""
     if name not in MODELS:

@@ -34,9 +34,9 @@ record is the one of the UTC date, or the previous date before 08:00 UTC (05:00 
 before that record, F10.7a the observed 81-day centred mean of the record; Kp the 3-hourly Kp
 6.7 h before the epoch. After the file's last entry the last entry is held.
 
-Geometry: geodetic latitude and altitude on WGS-84 (components.geodesy; GMAT's Earth ellipsoid
+Geometry: geodetic latitude and altitude on WGS-84 (components.environment.geodesy; GMAT's Earth ellipsoid
 differs by 0.3 m in radius); Roberts' Earth radius is GMAT's polar radius 6378.1363 (1 -
-0.0033527) km. The Sun: low-precision formulae of components.sun in the kernel.
+0.0033527) km. The Sun: low-precision formulae of components.environment.sun in the kernel.
 """
 import math
 
@@ -299,7 +299,7 @@ def jr_density(z, lat, hour_angle, sun_dec, f107, f107a, kp, jd_utc):
 def jr_indices(jd, jd0, daily, f107_prev_col, f107a_col, kp_col):
     """(F10.7, F10.7a, Kp) for Jacchia-Roberts at UTC Julian date jd, GMAT's selection (module
     docstring). Raises before the first day of the table. `f107_prev_col` is a previous-day
-    column of components.space_weather (the same day's flux is the column before it)."""
+    column of components.environment.space_weather (the same day's flux is the column before it)."""
     n = daily.shape[0]
     d = space_weather.day_index(jd, jd0, n)
     if d < 0:
@@ -336,7 +336,7 @@ def jacchia_roberts_kernel(r, jd, data):
 
 
 class JacchiaRobertsModel(DensityModel):
-    """Jacchia-Roberts with indices from a components.space_weather source (observed F10.7,
+    """Jacchia-Roberts with indices from a components.environment.space_weather source (observed F10.7,
     as GMAT; `kind="adjusted"` uses the 1 AU-adjusted flux instead)."""
 
     name = "jacchia_roberts"
