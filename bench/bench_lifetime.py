@@ -31,8 +31,8 @@ sys.path.insert(0, str(ROOT))
 from components.environment import atmosphere  # noqa: E402
 from components.orbit import propulsion  # noqa: E402
 from components.orbit import averaged as oa  # noqa: E402
+from components.core.constants import DAY, YEAR  # noqa: E402
 
-YEAR = 365.25 * 86400.0
 THESIS = {420: (4.38, 2.20), 475: (25.04, 3.44), 525: (97.41, 3.19)}  # years without / with NEIGHBOR
 TARGET = {420: 350, 475: 350, 525: 300}
 
@@ -44,15 +44,15 @@ def make(name):
 def timing(name, msis_days):
     model = make(name)
     warm = oa.OrbitAveraged(model, sma0=oa.R_EQ + 525e3)
-    warm.advance_to(2 * 86400.0)  # compile the kernel path
-    span = msis_days * 86400.0 if name == "msis" else YEAR
+    warm.advance_to(2 * DAY)  # compile the kernel path
+    span = msis_days * DAY if name == "msis" else YEAR
     m = oa.OrbitAveraged(model, sma0=oa.R_EQ + 525e3)
     t0 = time.perf_counter()
     m.advance_to(span)
     wall = time.perf_counter() - t0
     per_year = wall * YEAR / span
     print(f"  {name:16s} {per_year:9.3f} s per simulated year   ({m.evaluations} drag averages over "
-          f"{span / 86400.0:.0f} days, {1e6 * wall / m.evaluations:.1f} us each)")
+          f"{span / DAY:.0f} days, {1e6 * wall / m.evaluations:.1f} us each)")
 
 
 def lifetime(model, h0, burn, cap_years=250.0):
@@ -76,7 +76,7 @@ def lifetime(model, h0, burn, cap_years=250.0):
                 "perigee_km": m.perigee_altitude / 1e3, "apogee_km": m.apogee_altitude / 1e3}
     t = m.t
     while not m.reentered and t < cap_years * YEAR:
-        t += 30 * 86400.0
+        t += 30 * DAY
         m.advance_to(t, mass=mass)
     wall = time.perf_counter() - t0
     return (m.reentry_time / YEAR if m.reentered else None), wall, info

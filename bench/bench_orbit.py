@@ -19,9 +19,9 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from components.environment import atmosphere  # noqa: E402
 from components.orbit import cowell  # noqa: E402
+from components.core.constants import DAY  # noqa: E402
 
 STEP = 300.0
-DAY = 86400.0
 
 
 def timed_run(model, days):

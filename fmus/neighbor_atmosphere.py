@@ -14,6 +14,7 @@ use_bundled_components(__file__)
 
 from components.environment import atmosphere  # noqa: E402 (after use_bundled_components)
 from components.core import time_utils  # noqa: E402 (after use_bundled_components)
+from components.core.constants import R_EQ  # noqa: E402 (after use_bundled_components)
 
 
 class Atmosphere(NeighborSlave):
@@ -25,7 +26,7 @@ class Atmosphere(NeighborSlave):
         self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
                        "Scenario epoch (simulation time 0), ISO 8601 UTC 'YYYY-MM-DDThh:mm:ss[.fff]Z'", str)
         atmosphere_parameters(self)
-        self.input_array("r_BN_N", [6378136.3 + 420e3, 0.0, 0.0], "m",
+        self.input_array("r_BN_N", [R_EQ + 420e3, 0.0, 0.0], "m",
                          "Spacecraft position relative to Earth's centre in N")
         self.output("density", lambda: self.feedthrough(self._density), "kg/m3",
                     "Atmospheric mass density at r_BN_N at the current time", depends_on=self._r_names())

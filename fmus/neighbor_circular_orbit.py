@@ -9,6 +9,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
+from components.core import constants  # noqa: E402 (after use_bundled_components)
 from components.orbit import circular  # noqa: E402 (after use_bundled_components)
 
 
@@ -22,8 +23,8 @@ class CircularOrbit(NeighborSlave):
         self.parameter("inclination", math.radians(51.6), "rad", "Orbit inclination, in [0, pi]")
         self.parameter("raan", 0.0, "rad", "Right ascension of the ascending node")
         self.parameter("arg_latitude0", 0.0, "rad", "Argument of latitude at simulation time 0 (from the node)")
-        self.parameter("mu", circular.MU_EARTH, "m3/s2", "Earth's gravitational parameter (> 0)")
-        self.parameter("earth_radius", circular.EARTH_RADIUS, "m", "Earth radius the altitude refers to (> 0)")
+        self.parameter("mu", constants.MU_EARTH_WGS84, "m3/s2", "Earth's gravitational parameter (> 0)")
+        self.parameter("earth_radius", constants.WGS84_A, "m", "Earth radius the altitude refers to (> 0)")
         self.output_array("r_BN_N", 3, lambda: self.model.position(), "m",
                           "Spacecraft position relative to Earth's centre in N")
         self.output_array("v_BN_N", 3, lambda: self.model.velocity(), "m/s",

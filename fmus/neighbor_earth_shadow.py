@@ -7,6 +7,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 
 use_bundled_components(__file__)
 
+from components.core import constants  # noqa: E402 (after use_bundled_components)
 from components.environment import eclipse  # noqa: E402 (after use_bundled_components)
 
 R_INPUTS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
@@ -20,11 +21,11 @@ class EarthShadow(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.parameter("earth_radius", eclipse.EARTH_RADIUS, "m", "Radius of the spherical Earth (> 0)")
+        self.parameter("earth_radius", constants.WGS84_A, "m", "Radius of the spherical Earth (> 0)")
         self.parameter("sun_radius", eclipse.SUN_RADIUS, "m", "Radius of the Sun (> 0)")
         self.parameter("day_threshold", eclipse.DAY_THRESHOLD, "1",
                        "orbit_day is true when sunlit_fraction exceeds this value, in [0, 1)")
-        self.input_array("r_BN_N", [eclipse.EARTH_RADIUS + 420e3, 0.0, 0.0], "m",
+        self.input_array("r_BN_N", [constants.WGS84_A + 420e3, 0.0, 0.0], "m",
                          "Spacecraft position relative to Earth's centre in N")
         self.input_array("r_SN_N", [149597870700.0, 0.0, 0.0], "m", "Sun position relative to Earth's centre in N")
         f = lambda: self.feedthrough(self._evaluate)  # noqa: E731

@@ -13,6 +13,8 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 use_bundled_components(__file__)
 
 from components.mission import manager as mm  # noqa: E402 (after use_bundled_components)
+from components.mission.modes import MODE_TABLE, PHASE_TABLE  # noqa: E402 (after use_bundled_components)
+from components.mission.power_bus import LOAD_NAMES, LOADS  # noqa: E402 (after use_bundled_components)
 
 D = mm.PARAMETER_DEFAULTS
 PARAMETERS = (
@@ -25,9 +27,9 @@ PARAMETERS = (
     ("attitude_determination_duration", "s", float, "De-orbit phase 1 (attitude determination) duration (>= 0); "
                                                     "default 600 s"),
     ("battery_empty_soc", "1", float, "Battery empty (mission ends) when state_of_charge <= this, in [0, 1)"),
-    ("initial_mode", None, int, f"Mode at the start time, 1..6 ({mm.MODE_TABLE}); grace period and attitude "
+    ("initial_mode", None, int, f"Mode at the start time, 1..6 ({MODE_TABLE}); grace period and attitude "
                                 "determination timers start at the start time"),
-    ("initial_phase", None, int, f"De-orbit phase at the start time when initial_mode = 5, 1..4 ({mm.PHASE_TABLE})"),
+    ("initial_phase", None, int, f"De-orbit phase at the start time when initial_mode = 5, 1..4 ({PHASE_TABLE})"),
     ("listen_while_awaiting", None, bool, "UHF receiver on while awaiting the final contact (thesis text); false: "
                                           "radio on only during the contact (Appendix I)"),
     ("beacon_interval", "s", float, "Monitoring: beacon (GPS + UHF) only in a contact starting at least this long "
@@ -43,17 +45,12 @@ INPUTS = (
     ("state_of_charge", "1", float, "Battery state of charge, 0..1 (Power)"),
     ("reentered", None, bool, "Spacecraft has re-entered (orbit FMU)"),
 )
+# When the manager switches a load beyond the plain mode table (components.mission.manager).
+LOAD_NOTES = {"microprocessor_quiescent": "; false when nominal or in end state",
+              "propulsion": ", from detumble to the end of the burn"}
 COMPONENT_TEXT = {
-    "microprocessor_nominal": "Microprocessor awake (nominal, Table 5: 0.0221 W)",
-    "microprocessor_quiescent": "Microprocessor quiescent (Table 5: 9.24e-8 W); false when nominal or in end state",
-    "uhf_rx": "UHF receiver on (Table 5: 0.1815 W)",
-    "uhf_tx": "UHF transmitter on (Table 5: 2.64 W)",
-    "horizon_sensor": "Horizon sensor on (Table 5: 0.15 W)",
-    "sun_sensor": "Sun sensor on (Table 5: 0.115 W)",
-    "gyro": "Gyroscope on (Table 5: 0.018 W)",
-    "gps_receiver": "GPS receiver on (Table 5: 1.300 W)",
-    "gps_antenna": "GPS antenna on (Table 5: 0.066 W)",
-    "propulsion": "Propulsion system powered (Table 5: 0.5 W), from detumble to the end of the burn",
+    **{load.name: f"Switch on: {load.description} (Table 5: {load.table5}){LOAD_NOTES.get(load.name, '')}"
+       for load in LOADS},
     "detumble_enable": "Detumble controller enabled (de-orbit phase 2)",
     "slew_enable": "Slew controller enabled (de-orbit phase 3)",
     "tracking_enable": "Burn-attitude tracking controller enabled (de-orbit phase 4)",
@@ -76,12 +73,12 @@ class MissionManager(NeighborSlave):
         for name, unit, kind, text in INPUTS:
             self.input(name, mm.INPUT_DEFAULTS[name], unit, text, kind)
         self.output("mode", lambda: self.model.mode, None,
-                    f"Operating mode ({mm.MODE_TABLE}), decided from the inputs at the start of the last step", int)
-        self.output("phase", lambda: self.model.phase, None, f"De-orbit sub-phase ({mm.PHASE_TABLE}); 0 outside "
+                    f"Operating mode ({MODE_TABLE}), decided from the inputs at the start of the last step", int)
+        self.output("phase", lambda: self.model.phase, None, f"De-orbit sub-phase ({PHASE_TABLE}); 0 outside "
                     "the de-orbit mode", int)
         self.output("end_reason", lambda: self.model.end_reason, None,
                     "Why the mission ended: 0 not ended, 1 battery empty, 2 re-entered", int)
-        for name in mm.COMPONENTS + mm.COMMANDS:
+        for name in LOAD_NAMES + mm.COMMANDS:
             self.output(name, lambda name=name: self._powered()[name], None, COMPONENT_TEXT[name], bool)
         self.output("next_event_time", lambda: self.model.next_event_time, "s",
                     "Time of the next internal timed event (wake start/end, grace end, end of attitude "

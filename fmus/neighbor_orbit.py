@@ -19,8 +19,7 @@ use_bundled_components(__file__)
 
 from components.orbit import cowell, elements  # noqa: E402 (after use_bundled_components)
 from components.core import time_utils  # noqa: E402 (after use_bundled_components)
-
-R_EQ = elements.R_EQ
+from components.core.constants import MU_EARTH, R_EQ  # noqa: E402 (after use_bundled_components)
 
 
 class Orbit(NeighborSlave):
@@ -30,15 +29,14 @@ class Orbit(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
+        self.orbit_interface(R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
         self.parameter("zonal_degree", 6, None,
                        "Zonal gravity terms: 0 = point mass only, 2 = J2, ..., 6 = J2..J6 (EGM96)", int)
         self.parameter("drag", True, None, "Atmospheric drag on (false: gravity and thrust only)", bool)
 
         out = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731
-        vec = lambda key: (lambda: self.model.outputs()[key])  # noqa: E731
-        self.output_array("r_BN_N", 3, vec("r_BN_N"), "m", "Spacecraft position relative to Earth's centre in N")
-        self.output_array("v_BN_N", 3, vec("v_BN_N"), "m/s", "Spacecraft velocity relative to N, in N")
+        self.output_array("r_BN_N", 3, out("r_BN_N"), "m", "Spacecraft position relative to Earth's centre in N")
+        self.output_array("v_BN_N", 3, out("v_BN_N"), "m/s", "Spacecraft velocity relative to N, in N")
         self.output("altitude", out("altitude"), "m", "Geodetic altitude above the WGS-84 ellipsoid")
         self.output("altitude_spherical", out("altitude_spherical"), "m", "|r| - 6378136.3 m")
         self.output("latitude", out("latitude"), "rad", "Geodetic latitude (WGS-84)")

@@ -23,8 +23,7 @@ use_bundled_components(__file__)
 
 from components.orbit import averaged, elements  # noqa: E402 (after use_bundled_components)
 from components.core import time_utils  # noqa: E402 (after use_bundled_components)
-
-R_EQ = elements.R_EQ
+from components.core.constants import MU_EARTH, R_EQ  # noqa: E402 (after use_bundled_components)
 
 
 class OrbitAveraged(NeighborSlave):
@@ -33,7 +32,7 @@ class OrbitAveraged(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, elements.MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
+        self.orbit_interface(R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
         self.parameter("drag", True, None, "Atmospheric drag on (false: J2 and thrust only, density output 0)",
                        bool)
         self.parameter("j2", averaged.J2, "1",

@@ -11,6 +11,7 @@ from neighbor_fmu_support import NeighborSlave, use_bundled_components
 use_bundled_components(__file__)
 
 from components.mission import power  # noqa: E402 (after use_bundled_components)
+from components.mission.power_bus import LOADS, LOAD_NAMES  # noqa: E402 (after use_bundled_components)
 
 
 class Power(NeighborSlave):
@@ -23,28 +24,27 @@ class Power(NeighborSlave):
                        "Battery capacity, > 0 (default 3.0 Ah x 3.6 V = 10.8 Wh = 38880 J)")
         self.parameter("initial_state_of_charge", 1.0, "1",
                        "Initial stored energy as a fraction of capacity, in [0, 1]")
-        for name in power.LOADS:
-            self.parameter(f"power_{name}", power.DEFAULT_LOAD_POWER[name], "W",
-                           f"Power drawn by: {power.LOAD_DESCRIPTIONS[name]} (>= 0)")
-        for name in power.LOADS:
-            self.input(name, False, None, f"On/off: {power.LOAD_DESCRIPTIONS[name]}", bool)
+        for load in LOADS:
+            self.parameter(f"power_{load.name}", load.power, "W", f"Power drawn by: {load.description} (>= 0)")
+        for load in LOADS:
+            self.input(load.name, False, None, f"On/off: {load.description}", bool)
         self.input("solar_power", 0.0, "W", "Charging power from a host (>= 0; default 0, NEIGHBOR has no panels)")
         m = lambda: self.model  # noqa: E731
         self.output("energy", lambda: m().energy, "J", "Stored battery energy, in [0, capacity]")
         self.output("state_of_charge", lambda: m().state_of_charge, "1", "Stored energy / capacity")
         self.output("load_power", lambda: m().load_power(self._switches()), "W",
-                    "Total power of the loads switched on", depends_on=list(power.LOADS))
+                    "Total power of the loads switched on", depends_on=list(LOAD_NAMES))
         self.output("energy_used", lambda: m().energy_used, "J",
                     "Cumulative energy delivered to the loads since the start")
         self.output("empty", lambda: m().empty, None, "True when the battery is empty (energy 0)", bool)
 
     def _switches(self):
-        return {name: self.values[name] for name in power.LOADS}
+        return {name: self.values[name] for name in LOAD_NAMES}
 
     def build_model(self):
         v = self.values
         return power.PowerSystem(v["capacity"], v["initial_state_of_charge"],
-                                 {name: v[f"power_{name}"] for name in power.LOADS})
+                                 {name: v[f"power_{name}"] for name in LOAD_NAMES})
 
     def do_step(self, current_time, step_size):
         self.model.step(self._switches(), step_size, self.values["solar_power"])

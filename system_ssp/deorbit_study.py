@@ -24,6 +24,8 @@ from pathlib import Path
 import sys
 
 from components.orbit import propulsion
+from components.core import constants
+from components.core.constants import YEAR
 
 from .errors import SSPError
 from .master import System, write_csv_atomic
@@ -31,7 +33,6 @@ from .master import System, write_csv_atomic
 ROOT = Path(__file__).resolve().parents[1]
 DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
 PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
-YEAR = 365.25 * 86400.0
 KM = 1000.0
 SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
 # Section 3.2: (initial altitude km, target perigee km, delta-V m/s, propellant kg, burn min,
@@ -134,7 +135,7 @@ def plot(summary, out):
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    r_eq = propulsion.EARTH_RADIUS_EQ
+    r_eq = constants.R_EQ
     for name, ref in THESIS.items():
         if name not in summary:
             continue

@@ -20,6 +20,9 @@ import sys
 
 import numpy as np
 
+from components.core.constants import DAY, R_EQ, YEAR
+from components.mission.modes import DeorbitPhase, MissionMode
+
 from .errors import SSPError
 from .master import System, write_csv_atomic
 
@@ -28,12 +31,7 @@ DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
 PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
-DAY = 86400.0
-YEAR = 365.25 * DAY
-R_EQ = 6378136.3
 WH = 3600.0
-DEORBIT, MONITORING, END = 5, 6, 7
-AD, DETUMBLE, SLEW, BURN = 1, 2, 3, 4
 # Thesis figures for the 420 km scenario (sections 3.2, 3.3.9, 3.5, 3.6)
 THESIS = {"soc_after_burn_percent": 79.65, "energy_used_Wh": 2.2, "energy_left_Wh": 8.6,
           "battery_empty_days_after_burn": 14.0, "max_storage_MB": 0.1, "contacts_to_downlink": 2,
@@ -95,27 +93,27 @@ def summarize(r, scenario, orbit):
         s["profile_s"] = r.profile
 
     def phase_start(p):
-        i = _first((mode == DEORBIT) & (phase == p))
+        i = _first((mode == MissionMode.DEORBIT) & (phase == p))
         return None if i is None else (i, float(t[i]))
 
-    i_deorbit = _first(mode == DEORBIT)
-    i_mon = _first(mode == MONITORING)
+    i_deorbit = _first(mode == MissionMode.DEORBIT)
+    i_mon = _first(mode == MissionMode.MONITORING)
     if i_deorbit is None or i_mon is None:
         s["error"] = "the de-orbit did not complete (no monitoring mode reached)"
         return s
     t0 = float(t[i_deorbit])
-    starts = {p: phase_start(p) for p in (AD, DETUMBLE, SLEW, BURN)}
+    starts = {p: phase_start(p) for p in DeorbitPhase if p != DeorbitPhase.NONE}
     t_mon = float(t[i_mon])
     s["deorbit_start_days"] = t0 / DAY
     s["altitude_at_deorbit_km"] = float(d["orbit.sma"][i_deorbit] - R_EQ) / 1e3
-    s["attitude_determination_s"] = starts[DETUMBLE][1] - starts[AD][1]
-    s["detumble_time_s"] = starts[SLEW][1] - starts[DETUMBLE][1]
-    s["slew_time_s"] = starts[BURN][1] - starts[SLEW][1]
-    s["burn_time_min"] = (t_mon - starts[BURN][1]) / 60.0
+    s["attitude_determination_s"] = starts[DeorbitPhase.DETUMBLE][1] - starts[DeorbitPhase.ATTITUDE_DETERMINATION][1]
+    s["detumble_time_s"] = starts[DeorbitPhase.SLEW][1] - starts[DeorbitPhase.DETUMBLE][1]
+    s["slew_time_s"] = starts[DeorbitPhase.BURN][1] - starts[DeorbitPhase.SLEW][1]
+    s["burn_time_min"] = (t_mon - starts[DeorbitPhase.BURN][1]) / 60.0
     rcs = d["thrusters.propellant_mass"]
-    s["detumble_propellant_g"] = 1e3 * float(rcs[starts[SLEW][0]] - rcs[starts[DETUMBLE][0]])
-    s["slew_propellant_g"] = 1e3 * float(rcs[starts[BURN][0]] - rcs[starts[SLEW][0]])
-    s["tracking_propellant_g"] = 1e3 * float(rcs[i_mon] - rcs[starts[BURN][0]])
+    s["detumble_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.SLEW][0]] - rcs[starts[DeorbitPhase.DETUMBLE][0]])
+    s["slew_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.BURN][0]] - rcs[starts[DeorbitPhase.SLEW][0]])
+    s["tracking_propellant_g"] = 1e3 * float(rcs[i_mon] - rcs[starts[DeorbitPhase.BURN][0]])
     s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
     s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
     soc, energy = d["power.state_of_charge"], d["power.energy"]
@@ -133,7 +131,7 @@ def summarize(r, scenario, orbit):
     rises = np.flatnonzero(after[1:] & vis[1:] & ~vis[:-1]) + 1
     i_clear = _first(after & (store <= 0.5))
     s["contacts_to_downlink"] = None if i_clear is None else int(np.sum(rises <= i_clear))
-    s["lifetime_with_burn_years"] = (r.stop_time - starts[BURN][1]) / YEAR if s["reentered"] else None
+    s["lifetime_with_burn_years"] = (r.stop_time - starts[DeorbitPhase.BURN][1]) / YEAR if s["reentered"] else None
     s["thesis"] = THESIS if scenario == "420km" else {}
     return s
 
@@ -198,18 +196,19 @@ def plot(d, s, out):
     ax.grid(alpha=0.3)
     save(fig, "altitude.png")
 
-    for name, p, title in (("detumble.png", DETUMBLE, "Detumble (cf. Fig. 20-22)"),
-                           ("slew.png", SLEW, "Slew to the burn attitude (cf. Fig. 27-29)"),
-                           ("tracking.png", BURN, "Burn-attitude tracking (cf. Fig. 43-44)")):
-        sel = (mode == DEORBIT) & (phase == p)
+    for name, p, title in (("detumble.png", DeorbitPhase.DETUMBLE, "Detumble (cf. Fig. 20-22)"),
+                           ("slew.png", DeorbitPhase.SLEW, "Slew to the burn attitude (cf. Fig. 27-29)"),
+                           ("tracking.png", DeorbitPhase.BURN, "Burn-attitude tracking (cf. Fig. 43-44)")):
+        sel = (mode == MissionMode.DEORBIT) & (phase == p)
         if not sel.any():
             continue
         tt = t[sel] - t[sel][0]
-        fig, axes = plt.subplots(3 if p == BURN else 2, 1, figsize=(8, 8 if p == BURN else 6), sharex=True)
+        burn = p == DeorbitPhase.BURN
+        fig, axes = plt.subplots(3 if burn else 2, 1, figsize=(8, 8 if burn else 6), sharex=True)
         for i in (1, 2, 3):
             axes[0].plot(tt, np.degrees(d[f"dynamics.omega_BN_B[{i}]"][sel]), label=f"omega_{'xyz'[i - 1]}")
         axes[0].set_ylabel("rate (deg/s)")
-        if p == SLEW:
+        if p == DeorbitPhase.SLEW:
             for i in (1, 2, 3, 4):
                 axes[1].plot(tt, d[f"dynamics.q_BN[{i}]"][sel], label=f"q{i}")
             axes[1].set_ylabel("quaternion")
@@ -217,7 +216,7 @@ def plot(d, s, out):
             for i in (1, 2, 3):
                 axes[1].plot(tt, np.degrees(d[f"dynamics.euler123[{i}]"][sel]), label=f"1-2-3 angle {i}")
             axes[1].set_ylabel("angle (deg)")
-        if p == BURN:
+        if p == DeorbitPhase.BURN:
             axes[2].plot(tt, np.degrees(d["tracking.attitude_error"][sel]), color="k", linewidth=0.3,
                          label="angle from the desired attitude")
             axes[2].set_ylabel("tracking error (deg)")
@@ -229,7 +228,7 @@ def plot(d, s, out):
         save(fig, name)
 
     # battery and data from the end of the grace period to a few days after the burn
-    i3 = _first(mode >= 3)
+    i3 = _first(mode >= MissionMode.AWAITING)
     if i3 is not None:
         t_end = (s.get("deorbit_start_days", 0) * DAY) + 3 * DAY
         sel = (t >= t[i3] - 3600.0) & (t <= t_end)

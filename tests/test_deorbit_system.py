@@ -9,7 +9,6 @@ import system_ssp
 from system_ssp import SSPError, SimulationError, deorbit_study
 from components.orbit import propulsion
 
-YEAR = 365.25 * 86400.0
 PARAMS = deorbit_study.PARAMETERS
 
 

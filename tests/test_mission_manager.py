@@ -8,9 +8,10 @@ import pytest
 
 from components.mission import host as host_model
 from components.mission import manager as mm
+from components.mission.power_bus import LOAD_NAMES
+from components.core.constants import DAY
 from fmu_helpers import check_declarations, instantiate
 
-DAY = 86400.0
 # Table 5 (W). GPS receiver + antenna = 1.366 W, Appendix I's GPS_pwr.
 TABLE5 = {"propulsion": 0.5, "horizon_sensor": 0.15, "sun_sensor": 0.115, "gyro": 0.018, "gps_receiver": 1.300,
           "gps_antenna": 0.066, "microprocessor_nominal": 0.0221, "microprocessor_quiescent": 9.24e-8,
@@ -367,7 +368,7 @@ def test_mission_fmu(build_one, tmp_path):
     path = build_one("neighbor_mission.py")
     deps = check_declarations(path)
     assert set(deps) == {"mode", "phase", "end_reason", "next_event_time", "time_in_mode", "time_in_phase",
-                         *mm.COMPONENTS, *mm.COMMANDS}
+                         *LOAD_NAMES, *mm.COMMANDS}
     assert all(d == [] for d in deps.values())  # state outputs: no direct feedthrough
     fmu, vr = instantiate(path, tmp_path, "mission", start_time=1000.0)
     fmu.setReal([vr["grace_period"]], [100.0])

@@ -8,6 +8,7 @@ import fmpy
 import pytest
 
 from components.mission import power
+from components.mission.power_bus import LOAD_NAMES
 from fmu_helpers import check_declarations, instantiate
 
 WH = 3600.0
@@ -38,7 +39,7 @@ def test_load_table_and_appendix_i_modes():
     table5 = {"propulsion": 0.5, "horizon_sensor": 0.15, "sun_sensor": 0.115, "gyro": 0.018,
               "gps_receiver": 1.300, "gps_antenna": 0.066, "microprocessor_nominal": 0.0221,
               "microprocessor_quiescent": 9.24e-8, "uhf_rx": 0.1815, "uhf_tx": 2.64}
-    assert set(power.LOADS) == set(table5) == set(P)
+    assert set(LOAD_NAMES) == set(table5) == set(P)
     for name, watts in table5.items():
         assert P[name] == pytest.approx(watts, rel=5e-3), name
     assert P["microprocessor_nominal"] == pytest.approx(0.022176, rel=1e-12)
@@ -51,8 +52,8 @@ def test_load_table_and_appendix_i_modes():
     assert ps.load_power(MONITOR_IDLE) == pytest.approx(9.24e-8, rel=1e-9)          # "De-orbit Maneuver"
     assert ps.load_power(MONITOR_CONTACT) == pytest.approx(4.21, abs=0.005)         # "Microprocessor Quiescent"
     assert ps.load_power(IDLE_CHECK) == pytest.approx(0.0221, abs=1e-4)             # "Downlink"
-    assert ps.load_power({n: False for n in power.LOADS}) == 0.0
-    assert ps.load_power(dict.fromkeys(power.LOADS, True)) == pytest.approx(sum(P.values()))
+    assert ps.load_power({n: False for n in LOAD_NAMES}) == 0.0
+    assert ps.load_power(dict.fromkeys(LOAD_NAMES, True)) == pytest.approx(sum(P.values()))
 
 
 def test_exact_over_any_step_with_empty_and_full_clamps():
@@ -196,7 +197,7 @@ def test_state_round_trip():
 def test_power_fmu(build_one, tmp_path):
     path = build_one("neighbor_power.py")
     deps = check_declarations(path)
-    assert deps["load_power"] == sorted(power.LOADS)
+    assert deps["load_power"] == sorted(LOAD_NAMES)
     assert {k: v for k, v in deps.items() if k != "load_power"} == {
         "energy": [], "state_of_charge": [], "energy_used": [], "empty": []}
     md = fmpy.read_model_description(str(path))
@@ -205,7 +206,7 @@ def test_power_fmu(build_one, tmp_path):
     assert var["capacity"].unit == "J" and float(var["capacity"].start) == 38880.0
     assert float(var["power_microprocessor_nominal"].start) == P["microprocessor_nominal"]
     assert var["solar_power"].causality == "input" and var["solar_power"].unit == "W"
-    assert all(var[n].type == "Boolean" and var[n].causality == "input" for n in power.LOADS)
+    assert all(var[n].type == "Boolean" and var[n].causality == "input" for n in LOAD_NAMES)
 
     fmu, vr = instantiate(path, tmp_path, "power", initialize=True)
     reals = [vr[n] for n in ("energy", "state_of_charge", "load_power", "energy_used")]

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 from components.orbit import circular
+from components.core import constants
 from components.environment import eclipse, sun
 from components.core import time_utils
 from fmu_helpers import check_declarations, instantiate
@@ -102,7 +103,7 @@ def test_sun_distance_extremes_and_motion():
 
 
 # ---- shadow -----------------------------------------------------------------------------------
-R_E = eclipse.EARTH_RADIUS
+R_E = constants.WGS84_A
 R_S = eclipse.SUN_RADIUS
 SUN_X = (AU, 0.0, 0.0)
 
@@ -210,7 +211,7 @@ def test_cylindrical_eclipse_fraction():
 # ---- orbit ------------------------------------------------------------------------------------
 def test_circular_orbit_is_two_body_circular_motion():
     o = circular.CircularOrbit(altitude=400e3, inclination=math.radians(51.6), raan=0.7, arg_latitude0=0.3)
-    mu, a = circular.MU_EARTH, R_E + 400e3
+    mu, a = constants.MU_EARTH_WGS84, R_E + 400e3
     assert o.period == pytest.approx(2 * math.pi * math.sqrt(a ** 3 / mu), rel=1e-14)
     assert o.period / 60.0 == pytest.approx(92.56, abs=0.005)  # thesis Eq. 67
     h_hat = np.array(o.normal())

@@ -7,6 +7,7 @@ import math
 import pytest
 
 from components.core import rotations
+from components.core import constants
 from components.attitude import deorbit_tracking as dtr, rigid_body, thrusters
 from fmu_helpers import check_declarations, instantiate
 
@@ -20,7 +21,7 @@ MP_THESIS = 4.75e-3  # kg, thesis 3.3.9
 
 
 def test_tracking_rate_eq_67_68():
-    T = dtr.orbit_period(dtr.R_EARTH + 400e3)
+    T = dtr.orbit_period(constants.R_EQ + 400e3)
     assert T / 60.0 == pytest.approx(92.56, abs=0.005)
     assert math.degrees(dtr.tracking_rate()) == pytest.approx(0.0648, abs=5e-5)
     assert dtr.default_omega_d() == (0.0, 2 * math.pi / T, 0.0)

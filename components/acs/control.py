@@ -82,8 +82,9 @@ uT at 420 km, torques of order 0.2 A.m2 x 30 uT = 6 uN.m):
 import math
 
 from ..core.checks import finite_parameters
+from .modes import AcsMode
 
-WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
+WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = AcsMode
 
 PARAMETER_DEFAULTS = {
     "Ix": 0.05, "Iy": 0.13, "Iz": 0.10,  # kg.m2, the 12 kg 0.3 x 0.1 x 0.2 m box

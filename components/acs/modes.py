@@ -64,14 +64,31 @@ Actuator permissions per mode (`PERMISSIONS`) follow the seed's mode description
 import math
 import re
 from dataclasses import dataclass, field
+from enum import IntEnum
 
 from ..core.checks import finite_parameters
 
-WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = range(10)
+
+class AcsMode(IntEnum):
+    """The ten modes of the seed's draft, in its numbering (the FMU output `mode`)."""
+    WAIT = 0
+    DETUMBLE = 1
+    SPINUP = 2
+    REORIENT = 3
+    DEPLOY_WHEEL = 4
+    ACQUIRE = 5
+    DEPLOY_PADDLES = 6
+    ORBIT_DAY = 7
+    ORBIT_NIGHT = 8
+    GROUND_COMMAND = 9
+
+
+# The decision tables below read best with bare names: one per mode, in value order.
+WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = AcsMode
 STARTUP = -1  # pseudo-mode before the first decision ("Control Mode: Startup")
 MODE_NAMES = ("Wait", "Detumble", "Spinup", "Reorient", "Deploy Wheel", "Acquire", "Deploy Paddles",
               "Orbit Day", "Orbit Night", "Ground Command")
-MODES = tuple(range(10))
+MODES = tuple(AcsMode)
 ANY = MODES
 MODE_TABLE = ", ".join(f"{i} {n}" for i, n in enumerate(MODE_NAMES))
 SAFE_MODE = SPINUP

@@ -39,11 +39,10 @@ inverse divides by the norm (attitude.inverse, as in the scripts).
 import math
 
 from ..core import rotations
+from ..core.constants import MU_EARTH, R_EQ
 from . import rigid_body
 from . import thruster_control as tc
 
-MU_EARTH = 398600.4415e9  # m^3/s^2, FreeFlyer Earth.Mu (thesis)
-R_EARTH = 6378136.3  # m, Earth equatorial radius used by the thesis (6378.1363 km)
 TRACKING_ALTITUDE = 400e3  # m, average altitude during the first de-orbit scenario (Eq. 67)
 TORQUE_FORMS = ("eq72", "script_literal")
 
@@ -56,7 +55,7 @@ def orbit_period(radius, mu=MU_EARTH):
     return 2.0 * math.pi * math.sqrt(radius ** 3 / mu)
 
 
-def tracking_rate(altitude=TRACKING_ALTITUDE, radius=R_EARTH, mu=MU_EARTH):
+def tracking_rate(altitude=TRACKING_ALTITUDE, radius=R_EQ, mu=MU_EARTH):
     """Eq. 68: one revolution per orbit period, rad/s (0.0648 deg/s at 400 km)."""
     return 2.0 * math.pi / orbit_period(radius + altitude, mu)
 

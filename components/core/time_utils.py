@@ -14,9 +14,9 @@ import datetime as _dt
 import math
 import re
 
+from .constants import DAY, DAYS_PER_CENTURY
+
 J2000_JD = 2451545.0  # 2000-01-01 12:00 (taken as UTC here, see the module docstring)
-SECONDS_PER_DAY = 86400.0
-DAYS_PER_CENTURY = 36525.0
 DEFAULT_EPOCH = "2023-01-01T00:00:00Z"
 
 _ISO_UTC = re.compile(r"(\d{4})-(\d{2})-(\d{2})T(\d{2}):(\d{2}):(\d{2})(\.\d{1,9})?(Z|\+00:00)")
@@ -47,17 +47,17 @@ def seconds_since_j2000(epoch):
     if isinstance(epoch, str):
         epoch = parse_epoch(epoch)
     delta = epoch - _J2000
-    return delta.days * SECONDS_PER_DAY + delta.seconds + delta.microseconds * 1e-6
+    return delta.days * DAY + delta.seconds + delta.microseconds * 1e-6
 
 
 def julian_date(epoch, t=0.0):
     """UTC Julian date of epoch + t seconds."""
-    return J2000_JD + (seconds_since_j2000(epoch) + float(t)) / SECONDS_PER_DAY
+    return J2000_JD + (seconds_since_j2000(epoch) + float(t)) / DAY
 
 
 def julian_centuries(epoch, t=0.0):
     """Julian centuries since J2000 of epoch + t seconds (UTC used for UT1/TDB, see above)."""
-    return (seconds_since_j2000(epoch) + float(t)) / (SECONDS_PER_DAY * DAYS_PER_CENTURY)
+    return (seconds_since_j2000(epoch) + float(t)) / (DAY * DAYS_PER_CENTURY)
 
 
 def check_time(t, name="t"):

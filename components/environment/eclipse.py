@@ -20,7 +20,8 @@ sphere of radius R_earth with no atmosphere (M&G's simplifications).
 """
 import math
 
-EARTH_RADIUS = 6378137.0  # m (WGS-84 equatorial)
+from ..core.constants import WGS84_A
+
 SUN_RADIUS = 696.0e6  # m
 DAY_THRESHOLD = 0.5
 
@@ -36,7 +37,7 @@ def _clip(x):
     return -1.0 if x < -1.0 else (1.0 if x > 1.0 else x)
 
 
-def disk_geometry(r, r_sun, earth_radius=EARTH_RADIUS, sun_radius=SUN_RADIUS):
+def disk_geometry(r, r_sun, earth_radius=WGS84_A, sun_radius=SUN_RADIUS):
     """(a, b, c) in rad: apparent radii of Sun and Earth and their separation seen from r."""
     d = (r_sun[0] - r[0], r_sun[1] - r[1], r_sun[2] - r[2])
     rn = math.sqrt(r[0] * r[0] + r[1] * r[1] + r[2] * r[2])
@@ -53,7 +54,7 @@ def disk_geometry(r, r_sun, earth_radius=EARTH_RADIUS, sun_radius=SUN_RADIUS):
     return a, b, c
 
 
-def sunlit_fraction(r, r_sun, earth_radius=EARTH_RADIUS, sun_radius=SUN_RADIUS):
+def sunlit_fraction(r, r_sun, earth_radius=WGS84_A, sun_radius=SUN_RADIUS):
     """Fraction of the Sun's disk visible from r, in [0, 1] (M&G Eq. 3.85-3.87)."""
     a, b, c = disk_geometry(r, r_sun, earth_radius, sun_radius)
     if c >= a + b:
@@ -74,7 +75,7 @@ class EarthShadow:
     umbra: fraction == 0; penumbra: 0 < fraction < 1 (the annular case counts as penumbra);
     orbit_day: fraction > day_threshold."""
 
-    def __init__(self, earth_radius=EARTH_RADIUS, sun_radius=SUN_RADIUS, day_threshold=DAY_THRESHOLD):
+    def __init__(self, earth_radius=WGS84_A, sun_radius=SUN_RADIUS, day_threshold=DAY_THRESHOLD):
         self.earth_radius = _positive("earth_radius", earth_radius)
         self.sun_radius = _positive("sun_radius", sun_radius)
         day_threshold = float(day_threshold)
@@ -104,7 +105,7 @@ def beta_angle(r, v, r_sun):
     return math.asin(_clip(sum(h[i] * r_sun[i] for i in range(3)) / (hn * sn)))
 
 
-def cylindrical_eclipse_fraction(altitude, beta, earth_radius=EARTH_RADIUS):
+def cylindrical_eclipse_fraction(altitude, beta, earth_radius=WGS84_A):
     """Fraction of a circular orbit in a cylindrical Earth shadow:
     (1/pi) acos(sqrt(h^2 + 2 R h) / ((R + h) cos beta)) for |beta| < asin(R / (R + h)), else 0."""
     R, h = earth_radius, altitude

@@ -18,14 +18,11 @@ coordinates by Bowring's method with two refinements (error well below 1 mm in L
 import math
 
 from .magnetic_field import gmst
+from ..core.constants import R_EQ, WGS84_A, WGS84_F
 from ..core.time_utils import DAYS_PER_CENTURY, J2000_JD
 
-WGS84_A = 6378137.0  # m
-WGS84_F = 1.0 / 298.257223563
 WGS84_B = WGS84_A * (1.0 - WGS84_F)
 WGS84_E2 = WGS84_F * (2.0 - WGS84_F)
-EARTH_RADIUS_EQ = 6378136.3  # m, the thesis' (FreeFlyer/EGM96) equatorial radius
-OMEGA_EARTH = 7.292115146706979e-5  # rad/s, Earth rotation rate (IERS)
 
 
 def gmst_of_jd(jd_utc):
@@ -78,4 +75,4 @@ def geodetic_from_inertial(r_N, jd_utc):
 def spherical_altitude(r_N):
     """|r| - 6378.1363 km (m)."""
     x, y, z = r_N
-    return math.sqrt(x * x + y * y + z * z) - EARTH_RADIUS_EQ
+    return math.sqrt(x * x + y * y + z * z) - R_EQ

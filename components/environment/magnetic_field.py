@@ -42,6 +42,7 @@ Output in tesla (nT * 1e-9).
 import math
 
 from ..core import rotations, time_utils
+from ..core.constants import DAY, DAYS_PER_CENTURY, DAYS_PER_JULIAN_YEAR
 
 # IGRF-13, epoch 2020.0 (nT) and secular variation 2020.0-2025.0 (nT/yr).
 G10, G11, H11 = -29404.8, -1450.9, 4652.5
@@ -49,7 +50,6 @@ DG10, DG11, DH11 = 5.7, 7.4, -25.9
 R_REF = 6371.2e3  # m, IGRF reference radius
 NT = 1e-9  # T per nT
 EPOCH_2020 = "2020-01-01T00:00:00Z"
-DAYS_PER_YEAR = 365.25
 TWO_PI = 2.0 * math.pi
 
 
@@ -57,7 +57,7 @@ def gmst(T):
     """Greenwich mean sidereal time in rad in [0, 2 pi), T = Julian centuries (UT1) since J2000
     (IAU 1982, Vallado Eq. 3-47)."""
     s = 67310.54841 + (876600.0 * 3600.0 + 8640184.812866) * T + 0.093104 * T * T - 6.2e-6 * T * T * T
-    return (s % 86400.0) / 86400.0 * TWO_PI
+    return (s % DAY) / DAY * TWO_PI
 
 
 def dipole_field(g, r):
@@ -108,11 +108,11 @@ class MagneticField:
     # ---- time ----------------------------------------------------------------------------
     def centuries(self, t=None):
         t = self.t if t is None else t
-        return (self._s_j2000 + t) / (time_utils.SECONDS_PER_DAY * time_utils.DAYS_PER_CENTURY)
+        return (self._s_j2000 + t) / (DAY * DAYS_PER_CENTURY)
 
     def decimal_year(self, t=None):
         t = self.t if t is None else t
-        return 2020.0 + (self._s_j2000 + t - self._s_2020) / (time_utils.SECONDS_PER_DAY * DAYS_PER_YEAR)
+        return 2020.0 + (self._s_j2000 + t - self._s_2020) / (DAY * DAYS_PER_JULIAN_YEAR)
 
     def gmst(self, t=None):
         return gmst(self.centuries(t))

@@ -19,6 +19,7 @@ AU = 149 597 870 700 m (IAU 2012).
 import math
 
 from ..core import time_utils
+from ..core.constants import DAY, DAYS_PER_CENTURY
 
 AU = 149_597_870_700.0  # m
 DEG = math.pi / 180.0
@@ -63,7 +64,7 @@ class SunEphemeris(time_utils.Clock):
 
     def centuries(self, t=None):
         t = self.t if t is None else t
-        return (self._s_j2000 + t) / (time_utils.SECONDS_PER_DAY * time_utils.DAYS_PER_CENTURY)
+        return (self._s_j2000 + t) / (DAY * DAYS_PER_CENTURY)
 
     def position(self, t=None):
         """r_SN_N in m at time t (default: the current time)."""

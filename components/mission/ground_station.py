@@ -29,6 +29,7 @@ import math
 
 from ..environment import geodesy
 from ..core import time_utils
+from ..core.constants import DAY, WGS84_A
 
 UIUC_LATITUDE = math.radians(40.1020)  # N
 UIUC_LONGITUDE = math.radians(-88.2272)  # 88.2272 W
@@ -38,7 +39,7 @@ UIUC_HEIGHT = 190.0  # m above WGS-84
 def earth_fixed_from_geodetic(lat, lon, h):
     """WGS-84 Earth-fixed position (m) of geodetic latitude, longitude (rad), height (m)."""
     sl, cl = math.sin(lat), math.cos(lat)
-    n = geodesy.WGS84_A / math.sqrt(1.0 - geodesy.WGS84_E2 * sl * sl)
+    n = WGS84_A / math.sqrt(1.0 - geodesy.WGS84_E2 * sl * sl)
     return ((n + h) * cl * math.cos(lon), (n + h) * cl * math.sin(lon), (n * (1.0 - geodesy.WGS84_E2) + h) * sl)
 
 
@@ -78,7 +79,7 @@ class GroundStation(time_utils.Clock):
         self._cache = (None, None)
 
     def gmst(self, t=None):
-        return geodesy.gmst_of_jd(self.jd0 + (self.t if t is None else float(t)) / time_utils.SECONDS_PER_DAY)
+        return geodesy.gmst_of_jd(self.jd0 + (self.t if t is None else float(t)) / DAY)
 
     def look(self, r_N, t=None):
         """(elevation rad, azimuth rad in [0, 2 pi), range m) of the N position r_N (m) at time t."""

@@ -13,9 +13,10 @@ import math
 import re
 
 from ..core import time_utils
+from ..core.constants import DAY
 
 NO_EVENT = 1e300
-DEFAULT_LOSS_TIME = 1825 * 86400.0
+DEFAULT_LOSS_TIME = 1825 * DAY
 
 
 def parse_times(text, name="heartbeat_return_times"):

@@ -57,28 +57,24 @@ Power states follow Appendix I where the thesis text and tables differ:
 """
 import math
 
-IDLE, GRACE, AWAITING, CONTACT, DEORBIT, MONITORING, END = 1, 2, 3, 4, 5, 6, 7
-MODE_NAMES = {IDLE: "idle", GRACE: "grace period", AWAITING: "awaiting final contact",
-              CONTACT: "final contact", DEORBIT: "de-orbit", MONITORING: "monitoring", END: "end"}
-PHASE_NONE, ATTITUDE_DETERMINATION, DETUMBLE, SLEW, BURN = 0, 1, 2, 3, 4
-PHASE_NAMES = {PHASE_NONE: "none", ATTITUDE_DETERMINATION: "attitude determination", DETUMBLE: "detumble",
-               SLEW: "slew", BURN: "burn"}
-END_NONE, END_BATTERY, END_REENTERED = 0, 1, 2
-MODE_TABLE = "; ".join(f"{k} {v}" for k, v in MODE_NAMES.items())
-PHASE_TABLE = "; ".join(f"{k} {v}" for k, v in PHASE_NAMES.items())
+from ..core.constants import DAY
+from .modes import MODE_TABLE, PHASE_TABLE, DeorbitPhase, EndReason, MissionMode
+from .power_bus import LOAD_NAMES
+
+# The mode logic below reads best with bare names: one per enum member, in value order.
+IDLE, GRACE, AWAITING, CONTACT, DEORBIT, MONITORING, END = MissionMode
+PHASE_NONE, ATTITUDE_DETERMINATION, DETUMBLE, SLEW, BURN = DeorbitPhase
+END_NONE, END_BATTERY, END_REENTERED = EndReason
 
 NO_EVENT = 1e300  # next_event_time when nothing is scheduled
 
-# The powered components (Table 5 rows; the power helper uses these names) and the other
-# Boolean outputs, in output order.
-COMPONENTS = ("microprocessor_nominal", "microprocessor_quiescent", "uhf_rx", "uhf_tx", "horizon_sensor",
-              "sun_sensor", "gyro", "gps_receiver", "gps_antenna", "propulsion")
+# The Boolean outputs besides the power-bus loads (components.mission.power_bus), in output order.
 COMMANDS = ("detumble_enable", "slew_enable", "tracking_enable", "burn_enable", "data_recording",
             "downlink_enable")
 
 PARAMETER_DEFAULTS = {
-    "grace_period": 30 * 86400.0,
-    "wake_period": 86400.0,
+    "grace_period": 30 * DAY,
+    "wake_period": DAY,
     "wake_duration": 5.0,
     "wake_offset": 0.0,
     "attitude_determination_duration": 600.0,
@@ -348,8 +344,8 @@ class MissionManager:
         return self.t - self.phase_entry if self.mode == DEORBIT else 0.0
 
     def powered(self):
-        """{component: on} for COMPONENTS and {command: on} for COMMANDS at the current state."""
-        on = dict.fromkeys(COMPONENTS + COMMANDS, False)
+        """{component: on} for the power-bus loads (LOAD_NAMES) and {command: on} for COMMANDS at the current state."""
+        on = dict.fromkeys(LOAD_NAMES + COMMANDS, False)
         mode, phase = self.mode, self.phase
         if mode == END:
             return on

@@ -4,19 +4,8 @@ one LG HG2 Li-ion cell drained by the components that are switched on.
 Battery: 3.0 Ah at 3.6 V = 10.8 Wh = 38880 J (`CELL_CAPACITY`, the `capacity` parameter).
 Energy on interfaces is in J (CONVENTIONS.md); 1 Wh = 3600 J.
 
-Loads (W), one on/off switch each (the names are the FMU's Boolean inputs):
-
-    microprocessor_nominal    0.022176   STM32L432KC run mode, Appendix I: 84 uA/MHz x 80 MHz x 3.3 V
-                                         (Table 5 lists it rounded, 0.0221 W)
-    microprocessor_quiescent  9.24e-8    standby 28 nA x 3.3 V (Table 5 and Appendix I)
-    uhf_rx                    0.1815     55 mA x 3.3 V
-    uhf_tx                    2.64       800 mA x 3.3 V
-    horizon_sensor            0.15
-    sun_sensor                0.115
-    gyro                      0.018
-    gps_receiver              1.300
-    gps_antenna               0.066      (Appendix I lumps receiver and antenna: GPS_pwr = 1.366 W)
-    propulsion                0.5
+Loads: one on/off switch each, named, described and powered (Table 5) in
+components.mission.power_bus (the names are the FMU's Boolean inputs).
 
 Sources and where they disagree (we follow Table 5 for the components and Appendix I, the code
 that produced Figure 46, for how they combine):
@@ -44,38 +33,10 @@ the solar power (if any); charge beyond the capacity is shed.
 """
 import math
 
+from .power_bus import DEFAULT_LOAD_POWER, LOAD_NAMES
+
 CELL_CAPACITY = 3.0 * 3.6 * 3600.0  # J: LG HG2, 3.0 Ah at 3.6 V = 10.8 Wh
 WH = 3600.0  # J per Wh
-
-LOADS = ("microprocessor_nominal", "microprocessor_quiescent", "uhf_rx", "uhf_tx", "horizon_sensor",
-         "sun_sensor", "gyro", "gps_receiver", "gps_antenna", "propulsion")
-
-DEFAULT_LOAD_POWER = {
-    "microprocessor_nominal": 84e-6 * 80.0 * 3.3,  # 0.022176 W (Table 5: 0.0221)
-    "microprocessor_quiescent": 28e-9 * 3.3,       # 9.24e-8 W
-    "uhf_rx": 55e-3 * 3.3,                         # 0.1815 W
-    "uhf_tx": 800e-3 * 3.3,                        # 2.64 W
-    "horizon_sensor": 0.15,
-    "sun_sensor": 0.115,
-    "gyro": 0.018,
-    "gps_receiver": 1.300,
-    "gps_antenna": 0.066,
-    "propulsion": 0.5,
-}
-
-LOAD_DESCRIPTIONS = {
-    "microprocessor_nominal": "STM32L432KC microprocessor in run mode (nominal)",
-    "microprocessor_quiescent": "STM32L432KC microprocessor in standby (quiescent; clock only)",
-    "uhf_rx": "UHF transceiver receiving",
-    "uhf_tx": "UHF transceiver transmitting",
-    "horizon_sensor": "Horizon sensor",
-    "sun_sensor": "Sun sensor",
-    "gyro": "Gyroscope",
-    "gps_receiver": "GPS receiver",
-    "gps_antenna": "GPS antenna",
-    "propulsion": "Propulsion system (valves and electronics)",
-}
-
 
 def _number(name, value, unit, low=0.0, high=math.inf):
     try:
@@ -101,7 +62,7 @@ class PowerSystem:
         self.powers = dict(DEFAULT_LOAD_POWER)
         for name, value in (load_power or {}).items():
             if name not in self.powers:
-                raise ValueError(f"unknown load {name!r}; loads are {', '.join(LOADS)}")
+                raise ValueError(f"unknown load {name!r}; loads are {', '.join(LOAD_NAMES)}")
             self.powers[name] = _number(f"power_{name}", value, "W")
         self.energy = soc0 * self.capacity
         self.energy_used = 0.0
@@ -115,7 +76,7 @@ class PowerSystem:
         total = 0.0
         for name, state in on.items():
             if name not in self.powers:
-                raise ValueError(f"unknown load {name!r}; loads are {', '.join(LOADS)}")
+                raise ValueError(f"unknown load {name!r}; loads are {', '.join(LOAD_NAMES)}")
             if state:
                 total += self.powers[name]
         return total

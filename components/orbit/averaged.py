@@ -61,16 +61,14 @@ the clock.
 import math
 
 import numpy as np
+from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
 from numba import njit
 
 from ..environment import geodesy
 from . import elements
 from ..core import time_utils
 
-MU_EARTH = elements.MU_EARTH
-R_EQ = elements.R_EQ
 J2 = elements.J2_EGM96
-OMEGA_EARTH = geodesy.OMEGA_EARTH
 TWO_PI = 2.0 * math.pi
 INC_MIN = 1e-4  # rad: the element set is singular for equatorial orbits
 
@@ -294,7 +292,7 @@ class OrbitAveraged:
     def __init__(self, density_model, epoch=time_utils.DEFAULT_EPOCH, sma0=R_EQ + 420e3, ecc0=0.0,
                  inc0=math.radians(51.6), raan0=0.0, argp0=0.0, ta0=0.0, Cd=2.2, area=0.02,
                  reentry_altitude=250e3, mu=MU_EARTH, j2=J2, r_eq=R_EQ, omega_atm=OMEGA_EARTH,
-                 quadrature_nodes=16, max_step=86400.0, max_da_step=1000.0, thrust_step=10.0, t0=0.0):
+                 quadrature_nodes=16, max_step=DAY, max_da_step=1000.0, thrust_step=10.0, t0=0.0):
         self.jd_epoch = time_utils.julian_date(epoch)  # validates the epoch string
         self.epoch = epoch
         self.mu = _finite("mu", mu, 0.0, lo_open=True, unit=" m3/s2")
@@ -333,7 +331,7 @@ class OrbitAveraged:
         self.y = np.array([a, e * math.cos(argp), e * math.sin(argp), inc, raan % TWO_PI, (argp + M) % TWO_PI])
         self.t = time_utils.check_time(t0, "start time")
         # seconds of the UTC day at t = 0, for steps that end on UTC midnights
-        self._day_offset = ((self.jd_epoch - 0.5) % 1.0) * 86400.0
+        self._day_offset = ((self.jd_epoch - 0.5) % 1.0) * DAY
         self.reentered = False
         self.reentry_time = None
         self.evaluations = 0  # drag-average evaluations (for the bench)
@@ -373,7 +371,7 @@ class OrbitAveraged:
         return self.sma * (1.0 + self.ecc) - R_EQ
 
     def jd(self, t=None):
-        return self.jd_epoch + (self.t if t is None else t) / 86400.0
+        return self.jd_epoch + (self.t if t is None else t) / DAY
 
     # ---- rates -----------------------------------------------------------------------------
     def drag_rates(self, y, t, mass):
@@ -452,7 +450,7 @@ class OrbitAveraged:
         t, y = self.t, self.y
         while not self.reentered and t_end - t > 1e-9 * max(1.0, abs(t_end)):
             h = min(t_end - t, self.max_step)
-            to_midnight = 86400.0 - (self._day_offset + t) % 86400.0
+            to_midnight = DAY - (self._day_offset + t) % DAY
             if to_midnight > 1e-3:
                 h = min(h, to_midnight)
             if thrust is not None:

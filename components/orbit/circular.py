@@ -13,14 +13,13 @@ State: the simulation time t only.
 import math
 
 from ..core import time_utils
+from ..core.constants import MU_EARTH_WGS84, WGS84_A
 
-MU_EARTH = 3.986004418e14  # m^3/s^2
-EARTH_RADIUS = 6378137.0  # m
 
 
 class CircularOrbit(time_utils.Clock):
     def __init__(self, altitude=420e3, inclination=math.radians(51.6), raan=0.0, arg_latitude0=0.0,
-                 mu=MU_EARTH, earth_radius=EARTH_RADIUS, t0=0.0):
+                 mu=MU_EARTH_WGS84, earth_radius=WGS84_A, t0=0.0):
         for name, value in (("mu", mu), ("earth_radius", earth_radius)):
             if not (math.isfinite(value) and value > 0):
                 raise ValueError(f"{name} = {value!r} must be a finite positive number")

@@ -45,9 +45,9 @@ from ..core import rotations, time_utils
 from ..environment import geodesy
 from ..core.checks import positive
 from ..environment.gravity import accel_zonal, zonal_coefficients
-from .elements import MU_EARTH, R_EQ, kepler_to_cartesian, osculating_ecc, osculating_sma
+from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
+from .elements import kepler_to_cartesian, osculating_ecc, osculating_sma
 
-OMEGA_EARTH = 7.292115e-5  # rad/s, rotation of the atmosphere with the Earth (issue's value)
 RTOL = 1e-11
 ATOL_POSITION = 1e-4  # m
 ATOL_VELOCITY = 1e-7  # m/s
@@ -74,10 +74,10 @@ def _zero_density(r_N, jd_utc, data):
 @njit(cache=True)
 def geodetic_altitude_nb(x, y, z):
     """Height above WGS-84 (m), Bowring's method as in components/environment/geodesy.py."""
-    a = geodesy.WGS84_A
+    a = WGS84_A
     b = geodesy.WGS84_B
     e2 = geodesy.WGS84_E2
-    f = geodesy.WGS84_F
+    f = WGS84_F
     p = math.sqrt(x * x + y * y)
     if p < 1e-9:
         return abs(z) - b
@@ -106,7 +106,7 @@ def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
     vz = y[5]
     ax, ay, az = accel_zonal(x, yy, z, fp[_MU], fp[_REQ], J, nmax)
     if fp[_DRAG] != 0.0:
-        rho = kernel(y[0:3], fp[_JD0] + t / 86400.0, kdata)
+        rho = kernel(y[0:3], fp[_JD0] + t / DAY, kdata)
         w = fp[_WE]
         vrx = vx + w * yy
         vry = vy - w * x
@@ -318,7 +318,7 @@ class CowellOrbit:
         fp[_DRAG] = 1.0 if self.drag else 0.0
         fp[_BC] = 0.5 * self.Cd * self.area / self.mass
         fp[_JD0] = self.jd0
-        fp[_WE] = OMEGA_EARTH
+        fp[_WE] = OMEGA_EARTH_WGS84  # the atmosphere co-rotates with the Earth
         if self.retrograde:
             fp[_TMAG] = math.sqrt(sum(f * f for f in self.F_B)) / self.mass
             fp[_RETRO] = 1.0
@@ -407,7 +407,7 @@ class CowellOrbit:
 
     # ---- outputs -------------------------------------------------------------------------
     def jd_state(self):
-        return self.jd0 + self.t_state / time_utils.SECONDS_PER_DAY
+        return self.jd0 + self.t_state / DAY
 
     def position(self):
         return self.y[:3].copy()
@@ -467,7 +467,7 @@ def _deriv_py(t, y, fp, J, nmax, dens, out):
     x, yy, z, vx, vy, vz = (float(c) for c in y)
     ax, ay, az = accel_zonal(x, yy, z, fp[_MU], fp[_REQ], J, nmax)
     if fp[_DRAG] != 0.0:
-        rho = dens.fn(np.array((x, yy, z)), fp[_JD0] + t / 86400.0)
+        rho = dens.fn(np.array((x, yy, z)), fp[_JD0] + t / DAY)
         w = fp[_WE]
         vrx, vry, vrz = vx + w * yy, vy - w * x, vz
         k = -fp[_BC] * rho * math.sqrt(vrx * vrx + vry * vry + vrz * vrz)

@@ -23,8 +23,8 @@ import math
 
 import numpy as np
 
-MU_EARTH = 398600.4415e9  # m^3/s^2, thesis Eq. 2 / EGM96
-R_EQ = 6378136.3  # m, EGM96 / thesis equatorial radius
+from ..core.constants import MU_EARTH, R_EQ
+
 J2_EGM96 = -math.sqrt(5.0) * -0.484165371736e-3  # = 1.0826266835531513e-3
 
 ECC_TOL = 1e-11  # below this an orbit is treated as circular

@@ -35,10 +35,9 @@ from the next step on it is zero.
 import math
 
 from ..core import checks
+from ..core.constants import MU_EARTH, R_EQ
 from ..core.checks import positive
 
-MU_EARTH = 398600.4415e9  # m^3/s^2, thesis Section 3.2
-EARTH_RADIUS_EQ = 6378136.3  # m, thesis Section 3.2
 G0 = 9.81  # m/s^2, thesis Eq. 3
 ISP = 42.0  # s, thesis Section 3.2 (MarCO thruster)
 THRUST_PER_THRUSTER = 0.025  # N
@@ -76,7 +75,7 @@ def delta_v_eq2(r1, r2, mu=MU_EARTH):
     return math.sqrt(mu / r1) * (math.sqrt(2.0 * r2 / (r1 + r2)) - 1.0)
 
 
-def deorbit_delta_v(altitude_initial, altitude_target, mu=MU_EARTH, earth_radius=EARTH_RADIUS_EQ):
+def deorbit_delta_v(altitude_initial, altitude_target, mu=MU_EARTH, earth_radius=R_EQ):
     """|dV| (m/s) of the single retrograde burn from a circular orbit at `altitude_initial` to a
     perigee at `altitude_target` (m above the 6378.1363 km equatorial radius), as Appendix A:
     DeltaV = -sqrt(mu/r1) (sqrt(2 r2/(r1+r2)) - 1). 420 -> 350 km: 19.84 m/s."""
@@ -123,7 +122,7 @@ def propellant_from_impulse(impulse, isp=ISP, g0=G0):
 
 
 def deorbit_scenario(altitude_initial, altitude_target, mass0=MASS0, thrust=N_THRUSTERS * THRUST_PER_THRUSTER,
-                     isp=ISP, g0=G0, mu=MU_EARTH, earth_radius=EARTH_RADIUS_EQ):
+                     isp=ISP, g0=G0, mu=MU_EARTH, earth_radius=R_EQ):
     """{'delta_v' m/s, 'propellant' kg, 'burn_time' s} of a thesis de-orbit scenario (Sec. 3.2)."""
     dv = deorbit_delta_v(altitude_initial, altitude_target, mu, earth_radius)
     mp = propellant_mass(dv, mass0, isp, g0)

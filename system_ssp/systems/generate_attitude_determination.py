@@ -30,13 +30,12 @@ sys.path.insert(0, str(HERE.parents[1]))
 
 from generate import vec, write_ssd, write_ssv  # noqa: E402
 
-from components.core import rotations  # noqa: E402
+from components.core import constants, rotations  # noqa: E402
 from components.sensing import triad  # noqa: E402
 
 NAME = "attitude_determination"
 AU = 1.495978707e11  # m
-R_EARTH = 6378137.0  # m, WGS-84 equatorial radius
-R_BN_N = [R_EARTH + 420e3, 0.0, 0.0]  # 420 km, the thesis' first de-orbit altitude
+R_BN_N = [constants.WGS84_A + 420e3, 0.0, 0.0]  # 420 km, the thesis' first de-orbit altitude
 
 
 def sun_position(jd):

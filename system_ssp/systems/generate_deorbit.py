@@ -39,8 +39,8 @@ from generate import write_ssd, write_ssv  # noqa: E402
 
 from components.orbit import propulsion  # noqa: E402
 from components.core import time_utils  # noqa: E402
+from components.core.constants import DAY, R_EQ, YEAR  # noqa: E402
 
-R_EQ = propulsion.EARTH_RADIUS_EQ
 KM = 1000.0
 # (initial altitude, target perigee altitude) in km, thesis Section 3.2
 SCENARIOS = {"420km": (420.0, 350.0), "475km": (475.0, 350.0), "525km": (525.0, 300.0)}
@@ -48,8 +48,8 @@ ORBIT = {"epoch": time_utils.DEFAULT_EPOCH, "sma0": R_EQ + 420.0 * KM, "ecc0": 0
          "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": 2.2, "area": 0.02, "reentry_altitude": 250.0 * KM,
          "density_model": "jacchia_roberts", "space_weather_file": "", "use_constant_space_weather": False}
 BURN_STEP = 0.5  # s, thesis Section 3.2
-COAST_STEP = {"deorbit": 3600.0, "deorbit_lifetime": 86400.0}
-STOP_TIME = 150.0 * 365.25 * 86400.0  # longer than the 97-year case
+COAST_STEP = {"deorbit": 3600.0, "deorbit_lifetime": DAY}
+STOP_TIME = 150.0 * YEAR  # longer than the 97-year case
 
 
 def scenario(h0_km, target_km, burn):

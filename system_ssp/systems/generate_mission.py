@@ -51,10 +51,11 @@ from generate import vec, write_ssd, write_ssv  # noqa: E402
 from components.environment import atmosphere  # noqa: E402
 from components.orbit import averaged, propulsion  # noqa: E402
 from components.core import time_utils  # noqa: E402
+from components.core.constants import DAY, R_EQ, YEAR  # noqa: E402
+from components.mission.modes import DeorbitPhase as Phase, MissionMode as Mode  # noqa: E402
+from components.mission.power_bus import LOAD_NAMES  # noqa: E402
 
-DAY = 86400.0
 KM = 1000.0
-R_EQ = propulsion.EARTH_RADIUS_EQ
 IDLE_DAYS = 1825.0  # 5 years (Appendix I: 1855 days of idle + grace)
 GRACE_DAYS = 30.0
 DEORBIT_EPOCH = time_utils.DEFAULT_EPOCH  # the thesis' start date for the de-orbit
@@ -150,9 +151,7 @@ def system(orbit_fmu):
              ("mission", "data_recording", "data", "data_recording", 0),
              ("mission", "downlink_enable", "data", "downlink_enable", 0),
              ("ground", "visible", "data", "ground_contact", 0)]
-    conns += [("mission", name, "power", name, 0) for name in
-              ("microprocessor_nominal", "microprocessor_quiescent", "uhf_rx", "uhf_tx", "horizon_sensor",
-               "sun_sensor", "gyro", "gps_receiver", "gps_antenna", "propulsion")]
+    conns += [("mission", name, "power", name, 0) for name in LOAD_NAMES]
     quiet = [c for c in BUS if c != "ground" and c != "data" and c != "propulsion"]
     return {
         "description": f"NEIGHBOR mission from deployment to re-entry ({orbit_fmu} orbit): operating modes, "
@@ -168,23 +167,23 @@ def system(orbit_fmu):
         # The rest follow the feedthrough edges (propulsion -> orbit, orbit -> ground,
         # controllers -> selector -> thrusters -> dynamics).
         "order": ALL,
-        "stop_time": 40.0 * 365.25 * DAY,
+        "stop_time": 40.0 * YEAR,
         "step_size": 3600.0,
         "schedule": {"modes": [
             ("detumble", 0.015, ALL_BUT("slew", "tracking"), 20,
-             [("mission", "mode", [5]), ("mission", "phase", [2])], SLOW),
+             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.DETUMBLE])], SLOW),
             ("slew", 0.015, ALL_BUT("detumble", "tracking"), 20,
-             [("mission", "mode", [5]), ("mission", "phase", [3])], SLOW),
+             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.SLEW])], SLOW),
             ("burn", 0.015, ALL_BUT("detumble", "slew"), 20,
-             [("mission", "mode", [5]), ("mission", "phase", [4])],
+             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.BURN])],
              dict(SLOW, mission=SLOW_EVERY, propulsion=SLOW_EVERY)),
-            ("determination", 1.0, BUS, 10, [("mission", "mode", [5])]),
-            ("contact", 1.0, BUS, 10, [("mission", "mode", [4])]),
-            ("awaiting_near", 5.0, BUS, 12, [("mission", "mode", [3]), ("ground", "near_contact", [1])]),
-            ("awaiting", FAR_STEP, BUS, 1, [("mission", "mode", [3])]),
-            ("monitoring_near", 10.0, MONITOR, 6, [("mission", "mode", [6]), ("ground", "near_contact", [1])]),
-            ("monitoring", FAR_STEP, MONITOR, 1, [("mission", "mode", [6])]),
-            ("decay", DAY, ["mission", "orbit"], 1, [("mission", "mode", [7])]),
+            ("determination", 1.0, BUS, 10, [("mission", "mode", [Mode.DEORBIT])]),
+            ("contact", 1.0, BUS, 10, [("mission", "mode", [Mode.CONTACT])]),
+            ("awaiting_near", 5.0, BUS, 12, [("mission", "mode", [Mode.AWAITING]), ("ground", "near_contact", [1])]),
+            ("awaiting", FAR_STEP, BUS, 1, [("mission", "mode", [Mode.AWAITING])]),
+            ("monitoring_near", 10.0, MONITOR, 6, [("mission", "mode", [Mode.MONITORING]), ("ground", "near_contact", [1])]),
+            ("monitoring", FAR_STEP, MONITOR, 1, [("mission", "mode", [Mode.MONITORING])]),
+            ("decay", DAY, ["mission", "orbit"], 1, [("mission", "mode", [Mode.END])]),
             ("idle", 6 * 3600.0, quiet, 4, [])],
             "events": [("mission", "next_event_time"), ("host", "next_event_time")]},
     }

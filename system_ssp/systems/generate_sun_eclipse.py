@@ -25,13 +25,14 @@ sys.path.insert(0, str(HERE.parents[1]))
 from generate import write_ssd, write_ssv  # noqa: E402
 
 from components.orbit import circular  # noqa: E402
+from components.core import constants  # noqa: E402
 from components.environment import eclipse, sun  # noqa: E402
 from components.core import time_utils  # noqa: E402
 
 EPOCH = time_utils.DEFAULT_EPOCH
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0,
-         "mu": circular.MU_EARTH, "earth_radius": circular.EARTH_RADIUS}
-SHADOW = {"earth_radius": eclipse.EARTH_RADIUS, "sun_radius": eclipse.SUN_RADIUS,
+         "mu": constants.MU_EARTH_WGS84, "earth_radius": constants.WGS84_A}
+SHADOW = {"earth_radius": constants.WGS84_A, "sun_radius": eclipse.SUN_RADIUS,
           "day_threshold": eclipse.DAY_THRESHOLD}
 PERIOD = circular.CircularOrbit(ORBIT["altitude"]).period  # 5576.5 s
 STEP = 10.0
@@ -41,10 +42,10 @@ def dawn_dusk():
     """700 km Sun-synchronous orbit (i = 98.19 deg from the J2 nodal rate) with its ascending
     node 90 deg east of the Sun's right ascension at the epoch: the orbit plane faces the Sun."""
     ra, _ = sun.right_ascension_declination(sun.SunEphemeris(EPOCH).position())
-    a = circular.EARTH_RADIUS + 700e3
+    a = constants.WGS84_A + 700e3
     j2 = 1.08262668e-3
     rate = 2.0 * math.pi / (365.2422 * 86400.0)  # required nodal rate (rad/s)
-    cos_i = -rate / (1.5 * j2 * (circular.EARTH_RADIUS / a) ** 2 * math.sqrt(circular.MU_EARTH / a ** 3))
+    cos_i = -rate / (1.5 * j2 * (constants.WGS84_A / a) ** 2 * math.sqrt(constants.MU_EARTH_WGS84 / a ** 3))
     return {"orbit.altitude": 700e3, "orbit.inclination": math.acos(cos_i),
             "orbit.raan": (ra + math.pi / 2) % (2 * math.pi), "orbit.arg_latitude0": 0.0}
 

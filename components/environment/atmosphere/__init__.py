@@ -34,6 +34,7 @@ Table 3.8 as in Orekit HarrisPriester).
 """
 
 from ...core import time_utils
+from ...core.constants import DAY
 from .. import geodesy
 from ..space_weather import SpaceWeather
 from .base import DensityModel, _as_position, earth_fixed, geodetic, geodetic_nb, gmst_nb, sun_position_au_nb
@@ -92,7 +93,7 @@ class AtmosphereAtEpoch:
                 raise ValueError(f"epoch = {epoch!r}: {exc}") from None
 
     def jd(self, t=None):
-        return self._jd_epoch + (self.t if t is None else float(t)) / 86400.0
+        return self._jd_epoch + (self.t if t is None else float(t)) / DAY
 
     def density(self, r_N):
         """kg/m^3 at the N position r_N (m) at the current time."""

@@ -43,6 +43,7 @@ import math
 import numpy as np
 from numba import njit
 
+from ...core.constants import R_EQ
 from ...core.time_utils import DAYS_PER_CENTURY, J2000_JD
 from .. import space_weather
 from .base import DensityModel, geodetic, sun_position_au_nb
@@ -52,7 +53,7 @@ TZERO = 183.0        # K at 90 km
 G_ZERO = 9.80665
 GAS_CON = 8.31432
 AVOGADRO = 6.022045e23
-POLAR_RADIUS = 6378.1363 * (1.0 - 0.0033527)  # km, GMAT's Earth
+POLAR_RADIUS = R_EQ / 1e3 * (1.0 - 0.0033527)  # km, GMAT's Earth (its flattening 0.0033527)
 SCALE_BELOW_90 = 5.382  # km, Vallado Table 8-4, 90 km band
 JD_1958 = 2436204.5     # 1958-01-01 0h UTC, origin of Jacchia's semi-annual time
 F107_REF_JD = 2448408.0  # GMAT's f107RefEpoch (A.1 MJD 18408): measurement time moved 17h -> 20h

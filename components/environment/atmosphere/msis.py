@@ -3,6 +3,7 @@ import math
 
 import numpy as np
 
+from ...core.constants import DAY
 from .. import geodesy
 from .base import DensityModel, _as_jd, _as_position
 
@@ -31,7 +32,7 @@ class MsisModel(DensityModel):
         sw = self.space_weather
         f107, f107a = sw.f107_previous_day(jd), sw.f107a(jd)
         aps = [sw.msis_ap(jd)]
-        date = np.datetime64("1970-01-01T00:00:00") + np.timedelta64(round((jd - 2440587.5) * 86400e6), "us")
+        date = np.datetime64("1970-01-01T00:00:00") + np.timedelta64(round((jd - 2440587.5) * DAY * 1e6), "us")
         out = pymsis.calculate(np.array([date]), np.array([math.degrees(lon)]), np.array([math.degrees(lat)]),
                                np.array([h / 1e3]), np.array([f107]), np.array([f107a]), np.array(aps),
                                version=2.1)
