@@ -30,13 +30,16 @@ import hashlib
 import importlib
 import inspect
 import json
-import os
 import re
 import sys
 import tempfile
 import zipfile
 from pathlib import Path
 from xml.etree import ElementTree as ET
+
+from system_ssp import __version__
+from system_ssp.atomic import atomic_write, write_text_atomic
+from system_ssp.ssp.units import BUILTIN, base_unit_attributes
 
 ROOT = Path(__file__).resolve().parent
 FMU_SOURCES = ROOT / "fmus"
@@ -45,41 +48,6 @@ COMPONENTS = ROOT / "components"
 SYSTEMS = ROOT / "system_ssp" / "systems"
 BUILD = ROOT / "build"
 STATE_FILE = BUILD / "build-state.json"
-
-SSD_NS = "http://ssp-standard.org/SSP1/SystemStructureDescription"
-
-# SI base-unit exponents (kg, m, s, A, K, mol, cd, rad) of the units our FMUs use.
-UNITS = {
-    "1": {},
-    "rad": {"rad": 1},
-    "rad/s": {"rad": 1, "s": -1},
-    "rad/s2": {"rad": 1, "s": -2},
-    "s": {"s": 1},
-    "kg": {"kg": 1},
-    "m": {"m": 1},
-    "m/s": {"m": 1, "s": -1},
-    "m/s2": {"m": 1, "s": -2},
-    "m3": {"m": 3},
-    "N": {"kg": 1, "m": 1, "s": -2},
-    "N.m": {"kg": 1, "m": 2, "s": -2},
-    "N.m.s": {"kg": 1, "m": 2, "s": -1},
-    "N.m.s2": {"kg": 1, "m": 2},
-    "kg.m2": {"kg": 1, "m": 2},
-    "kg/s": {"kg": 1, "s": -1},
-    "Pa": {"kg": 1, "m": -1, "s": -2},
-    "K": {"K": 1},
-    "J": {"kg": 1, "m": 2, "s": -2},
-    "W": {"kg": 1, "m": 2, "s": -3},
-    "byte": {},
-    "byte/s": {"s": -1},
-    "kg/m3": {"kg": 1, "m": -3},
-    "m2": {"m": 2},
-    "W/m2": {"kg": 1, "s": -3},
-    "Hz": {"s": -1},
-    "m3/s2": {"m": 3, "s": -2},
-    "A.m2": {"A": 1, "m": 2},
-    "T": {"kg": 1, "s": -2, "A": -1},
-}
 
 
 class BuildError(RuntimeError):
@@ -110,6 +78,7 @@ def _import_wrapper(script):
     module = importlib.import_module(script.stem)
     from neighbor_fmu_support import NeighborSlave
 
+    NeighborSlave.version = __version__  # the modelDescription's version: the product's
     classes = [c for _, c in inspect.getmembers(module, inspect.isclass)
                if issubclass(c, NeighborSlave) and c is not NeighborSlave and c.__module__ == module.__name__]
     if len(classes) != 1:
@@ -120,10 +89,10 @@ def _import_wrapper(script):
 def _unit_definitions(units_used):
     defs = ET.Element("UnitDefinitions")
     for name in sorted(units_used):
-        if name not in UNITS:
-            raise BuildError(f"unit {name!r} has no SI definition in build_fmus.UNITS")
+        if name not in BUILTIN:
+            raise BuildError(f"unit {name!r} has no SI definition in system_ssp.ssp.units.BUILTIN")
         unit = ET.SubElement(defs, "Unit", name=name)
-        ET.SubElement(unit, "BaseUnit", {k: str(v) for k, v in UNITS[name].items()})
+        ET.SubElement(unit, "BaseUnit", {k: str(v) for k, v in base_unit_attributes(BUILTIN[name]).items()})
     return defs
 
 
@@ -177,16 +146,8 @@ def complete_model_description(xml_bytes, meta, can_get_set_state, starts):
 
 def _atomic_zip(dest, write_entries):
     dest.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{dest.name}.", suffix=".tmp", dir=dest.parent)
-    os.close(fd)
-    try:
-        with zipfile.ZipFile(tmp, "w", zipfile.ZIP_DEFLATED) as zf:
-            write_entries(zf)
-        os.replace(tmp, dest)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.remove(tmp)
-        raise
+    with atomic_write(dest, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as zf:
+        write_entries(zf)
 
 
 def build_fmu(script, dest_dir):
@@ -237,7 +198,8 @@ def _system_files(ssd):
             source = el.get("source", "")
             m = re.fullmatch(r"resources/([A-Za-z0-9_]+\.fmu)", source)
             if not m:
-                raise BuildError(f"{ssd.name}: component {el.get('name')} source {source!r} must be resources/<Name>.fmu")
+                raise BuildError(f"{ssd.name}: component {el.get('name')} source {source!r} must be "
+                                 "resources/<Name>.fmu")
             fmus.append(m.group(1))
         elif tag in ("ParameterBinding", "ParameterMapping") and el.get("source"):
             refs.add(el.get("source"))
@@ -276,9 +238,7 @@ def _load_state():
 
 def _save_state(state):
     STATE_FILE.parent.mkdir(parents=True, exist_ok=True)
-    tmp = STATE_FILE.with_suffix(".tmp")
-    tmp.write_text(json.dumps(state, indent=1, sort_keys=True))
-    os.replace(tmp, STATE_FILE)
+    write_text_atomic(STATE_FILE, json.dumps(state, indent=1, sort_keys=True))
 
 
 def build_all(clean=False, verbose=True):
@@ -311,7 +271,8 @@ def build_all(clean=False, verbose=True):
     ssps = []
     for ssd in sorted(SYSTEMS.glob("*.ssd")):
         refs, used = _system_files(ssd)
-        digest = _digest([ssd] + [ssd.parent / r for r in refs] + [fmu_dir / f for f in used if (fmu_dir / f).is_file()])
+        inputs = [ssd] + [ssd.parent / r for r in refs] + [fmu_dir / f for f in used if (fmu_dir / f).is_file()]
+        digest = _digest(inputs)
         ssps.append(refresh(f"ssp:{ssd.stem}", digest, ssp_dir / f"{ssd.stem}.ssp",
                             lambda ssd=ssd: pack_ssp(ssd, fmu_dir, ssp_dir), "packing"))
     return fmus, ssps

@@ -1,4 +1,4 @@
-"""Benchmark the whole de-orbit lifetime study through the master (issue 3, section 6).
+"""Benchmark the whole de-orbit lifetime study through the master.
 
     python bench/bench_deorbit_study.py [--model averaged|cowell] [--density jacchia_roberts]
 
@@ -17,7 +17,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from system_ssp import deorbit_study  # noqa: E402
+from system_ssp.apps import deorbit_study  # noqa: E402
 
 
 def main():

@@ -22,8 +22,8 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import system_ssp  # noqa: E402
-from system_ssp import run as run_module  # noqa: E402
-from system_ssp import thesis  # noqa: E402
+from system_ssp.apps import thesis  # noqa: E402
+from system_ssp.master import instances  # noqa: E402
 
 SSP = ROOT / "build" / "ssp"
 
@@ -48,20 +48,22 @@ class CallTimer:
         return timed
 
     def install(self):
-        original = run_module.Run._prepare
-        timer = self
+        """Wrap every instance's FMI functions (the ones the master's prepared operations call)
+        as soon as the instances exist; returns a function that undoes it."""
+        original = instances.InstanceTable.instantiate
+        w = self.wrap
 
-        def prepare(run):
-            original(run)
-            w = timer.wrap
-            run.gets = [[(w(t[0]),) + t[1:] for t in lst] for lst in run.gets]
-            run.sets = [[(w(t[0]),) + t[1:] for t in lst] for lst in run.sets]
-            run.recs = [(w(t[0]),) + t[1:] for t in run.recs]
-            run.stop_ops = [(w(t[0]),) + t[1:] for t in run.stop_ops]
-            run.step_fns = [(w(f), c) for f, c in run.step_fns]
+        def instantiate(table):
+            original(table)
+            for inst in table.instances:
+                inst.fn = {name: w(fn) for name, fn in inst.fn.items()}
 
-        run_module.Run._prepare = prepare
-        return original
+        instances.InstanceTable.instantiate = instantiate
+
+        def uninstall():
+            instances.InstanceTable.instantiate = original
+
+        return uninstall
 
 
 def clock_cost():
@@ -103,13 +105,13 @@ def main():
 
         wrapper_cost, inside_cost = clock_cost()
         timer = CallTimer()
-        original = timer.install()
+        uninstall = timer.install()
         try:
             t0 = time.perf_counter()
             run_detumble(system, n, few)
             timed_wall = time.perf_counter() - t0
         finally:
-            run_module.Run._prepare = original
+            uninstall()
         calls_per_step = timer.calls / n
         # time inside the FMU calls, less what the timing itself adds inside the measured span
         floor = (timer.total - timer.calls * inside_cost) / n

@@ -1,4 +1,4 @@
-"""Benchmark the full NEIGHBOR mission run (issue 6, section 4).
+"""Benchmark the full NEIGHBOR mission run.
 
     python bench/bench_mission.py [--orbit averaged|cowell] [--scenario 420km]
 

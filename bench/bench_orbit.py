@@ -5,7 +5,7 @@ against a run with rtol 1e-13).
 
     python bench/bench_orbit.py [days]   (default 3 simulated days; msis: 0.25 day)
 
-Speed target (issue 3): Cowell with Jacchia-Roberts <= 60 s of wall time per simulated year.
+Speed target: Cowell with Jacchia-Roberts <= 60 s of wall time per simulated year.
 Compilation (numba, first step of each model) is reported separately and excluded from the rates.
 """
 import math
@@ -78,7 +78,8 @@ def main():
                                                                      cowell.ATOL_VELOCITY), (1e-12, 1e-5, 1e-8)):
         m = cowell.CowellOrbit(density_model=dm, rtol=rtol, atol_position=atr, atol_velocity=atv)
         wall, _ = timed_run(m, 1.0)
-        print(f"  rtol {rtol:g} atol {atr:g} m {atv:g} m/s: |dr| = {np.linalg.norm(m.position() - ref.position()):.2e} m, "
+        dr = np.linalg.norm(m.position() - ref.position())
+        print(f"  rtol {rtol:g} atol {atr:g} m {atv:g} m/s: |dr| = {dr:.2e} m, "
               f"{m.steps} steps, {wall:.3f} s")
 
 

@@ -1,13 +1,21 @@
-"""Command line: `python -m system_ssp run PATH ...`, `python -m system_ssp info PATH` and
-`python -m system_ssp thesis [--integrator euler|rk4]` (the thesis validation cases)."""
+"""Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
+`info`, `thesis`, `deorbit-study` and `mission`, and `--version`."""
 import argparse
+import os
 import sys
 
+from . import __version__
+from .apps import deorbit_study, mission, thesis
 from .errors import SSPError
+from .master import System
+
+APPS = {"thesis": thesis, "deorbit-study": deorbit_study, "mission": mission}
 
 
 def _parser():
-    ap = argparse.ArgumentParser(prog="python -m system_ssp", description="Run SSP 1.0 co-simulations.")
+    ap = argparse.ArgumentParser(prog="neighbor-cosim", description="Run SSP 1.0 co-simulations of FMI 2.0 FMUs "
+                                 "and the NEIGHBOR applications (python -m system_ssp is the same command).")
+    ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a system (.ssp or .ssd)")
     r.add_argument("path")
@@ -68,22 +76,13 @@ def _parse_multiples(items):
 
 def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] in (["thesis"], ["deorbit-study"], ["mission"]):
-        if argv[0] == "thesis":
-            from . import thesis as command
-        elif argv[0] == "mission":
-            from . import mission as command
-        else:
-            from . import deorbit_study as command
-
+    if argv[:1] and argv[0] in APPS:
         try:
-            return command.main(argv[1:])
+            return APPS[argv[0]].main(argv[1:])
         except SSPError as exc:
             print(f"error: {exc}", file=sys.stderr)
             return 2
     args = _parser().parse_args(argv)
-    from .master import System
-
     try:
         with System(args.path, validate=not args.no_validate) as system:
             if args.command == "info":
@@ -126,3 +125,14 @@ def main(argv=None):
     for k, v in shown:
         print(f"  {k} = {v!r}")
     return 0
+
+
+def console_main():
+    """Entry point of the `neighbor-cosim` command (and `python -m system_ssp`)."""
+    code = main()
+    # Leave without the interpreter's teardown: pythonfmu's native side can call a logger callback
+    # that Python already freed while the interpreter shuts down ("corrupted double-linked list",
+    # an abort after every result was written). Everything is written and flushed by now.
+    sys.stdout.flush()
+    sys.stderr.flush()
+    os._exit(code or 0)

@@ -16,15 +16,16 @@ so its printed time counts one step less (664 updates: 9.96 s here, 9.945 s by t
 clock; the thesis prints "about 9.97 s"). Propellant is Eq. 74 over the summed pair firing
 time.
 """
+import argparse
 import math
 from dataclasses import dataclass, field
 from pathlib import Path
 
 from components.core import rotations
 
-from .master import System
+from ..master import System
+from . import DEFAULT_SSP_DIR
 
-DEFAULT_SSP_DIR = Path(__file__).resolve().parents[1] / "build" / "ssp"
 
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
 # omega in deg/s as printed, durations in s, propellant in g.
@@ -153,9 +154,7 @@ def report(results, integrator):
 
 
 def main(argv=None):
-    import argparse
-
-    ap = argparse.ArgumentParser(prog="python -m system_ssp thesis", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="neighbor-cosim thesis", description=__doc__.split("\n\n")[0])
     ap.add_argument("--integrator", choices=["euler", "rk4"], default="euler")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--slew-stop-time", type=float, default=None,

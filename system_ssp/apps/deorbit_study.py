@@ -19,7 +19,6 @@ and altitude_<scenario>.png (semi-major-axis altitude a - R_eq vs time, like the
 import argparse
 import json
 import math
-import os
 from pathlib import Path
 import sys
 
@@ -27,12 +26,12 @@ from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
 
-from .errors import SSPError
-from .master import System, write_csv_atomic
+from ..atomic import atomic_write, write_text_atomic
+from ..errors import SSPError
+from ..master import System, write_csv_atomic
+from ..systems import PARAMETERS_DIR
+from . import DEFAULT_SSP_DIR
 
-ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
-PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
 KM = 1000.0
 SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
 # Section 3.2: (initial altitude km, target perigee km, delta-V m/s, propellant kg, burn min,
@@ -72,7 +71,7 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
         for name in scenarios:
             for burn in (True, False):
                 run = name + ("" if burn else "_no_burn")
-                ssv = PARAMETERS / f"deorbit_{run}.ssv"
+                ssv = PARAMETERS_DIR / f"deorbit_{run}.ssv"
                 r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
                                outputs=RECORD, progress=progress)
                 reentered = bool(r.final["orbit.reentered"])
@@ -89,22 +88,18 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
                              burn_time_library_min=lib["burn_time"] / 60.0,
                              thesis_delta_v_m_s=ref["delta_v"], thesis_propellant_kg=ref["propellant"],
                              thesis_burn_min=ref["burn_min"])
-                    i_end = int((r.data["propulsion.burning"]).nonzero()[0].max()) + 1 if r.data["propulsion.burning"].any() else 0
+                    burning = r.data["propulsion.burning"]
+                    i_end = int(burning.nonzero()[0].max()) + 1 if burning.any() else 0
                     s["perigee_after_burn_km"] = float(r.data["orbit.perigee_altitude"][i_end]) / KM
                 summary[run] = s
                 if out is not None:
                     write_csv_atomic(r.data, out / f"{run}.csv")
     if out is not None:
-        _write_atomic(out / "summary.json", json.dumps(summary, indent=1))
-        _write_atomic(out / "table.md", table(summary))
+        write_text_atomic(out / "summary.json", json.dumps(summary, indent=1))
+        write_text_atomic(out / "table.md", table(summary))
         plot(summary, out)
     return summary
 
-
-def _write_atomic(path, text):
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def table(summary):
@@ -140,11 +135,13 @@ def plot(summary, out):
         if name not in summary:
             continue
         fig, ax = plt.subplots(figsize=(8, 4.5))
-        for run, label, color in ((name + "_no_burn", "without NEIGHBOR", "tab:red"), (name, "with NEIGHBOR", "tab:blue")):
+        runs = ((name + "_no_burn", "without NEIGHBOR", "tab:red"), (name, "with NEIGHBOR", "tab:blue"))
+        for run, label, color in runs:
             data = np.genfromtxt(out / f"{run}.csv", delimiter=",", names=True, deletechars="")
             years = data["time"] / YEAR
             ax.plot(years, (data["orbit.sma"] - r_eq) / KM, color=color,
-                    label=f"{label}: {summary[run]['lifetime_years']:.2f} y (thesis {summary[run]['thesis_lifetime_years']:.2f} y)")
+                    label=f"{label}: {summary[run]['lifetime_years']:.2f} y "
+                          f"(thesis {summary[run]['thesis_lifetime_years']:.2f} y)")
             ax.fill_between(years, data["orbit.perigee_altitude"] / KM, (data["orbit.sma"] - r_eq) / KM, color=color,
                             alpha=0.15, linewidth=0)
         ax.axhline(250.0, color="k", linestyle=":", linewidth=1, label="re-entry, 250 km")
@@ -156,14 +153,13 @@ def plot(summary, out):
         ax.legend(loc="upper right", fontsize=8)
         ax.grid(alpha=0.3)
         fig.tight_layout()
-        tmp = out / f".altitude_{name}.png"
-        fig.savefig(tmp, dpi=110, format="png")
+        with atomic_write(out / f"altitude_{name}.png", "wb") as f:
+            fig.savefig(f, dpi=110, format="png")
         plt.close(fig)
-        os.replace(tmp, out / f"altitude_{name}.png")
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m system_ssp deorbit-study", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="neighbor-cosim deorbit-study", description=__doc__.split("\n\n")[0])
     ap.add_argument("--model", choices=list(SYSTEMS), default="averaged")
     ap.add_argument("--density", default="jacchia_roberts",
                     help="exponential | harris_priester | msis | jacchia_roberts (default)")

@@ -11,14 +11,14 @@ that component, for a binding on the root system they are `component.variable`.
 from collections import namedtuple
 from dataclasses import dataclass, field
 import math
-import os
 from pathlib import Path
 import urllib.parse
 
+import fmpy
 from lxml import etree
 
-from .errors import SSPError
-from .units import BASE_NAMES, Unit
+from ..errors import SSPError
+from .units import SI_BASE_UNITS, Unit
 
 NS_SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
 NS_SSC = "http://ssp-standard.org/SSP1/SystemStructureCommon"
@@ -46,8 +46,6 @@ _schemas = {}
 
 def _schema(kind):
     if kind not in _schemas:
-        import fmpy
-
         path = Path(fmpy.__file__).parent / "ssp" / "schema" / SCHEMA_FILES[kind]
         _schemas[kind] = etree.XMLSchema(etree.parse(str(path)))
     return _schemas[kind]
@@ -229,7 +227,7 @@ def parse_units(parent, namer):
         b = u.find("ssc:BaseUnit", NS)
         exps, factor, offset = (0,) * 8, 1.0, 0.0
         if b is not None:
-            exps = tuple(int(b.get(n, "0")) for n in BASE_NAMES)
+            exps = tuple(int(b.get(n, "0")) for n in SI_BASE_UNITS)
             factor = _float_attr(b, "factor", origin, 1.0)
             offset = _float_attr(b, "offset", origin, 0.0)
         units[u.get("name")] = Unit(u.get("name"), exps, factor, offset)
@@ -259,7 +257,8 @@ def _parse_transform(parent, origin):
                     mapping[conv(e.get("source"))] = conv(e.get("target"))
                 except ValueError:
                     raise SSPError(f"{origin}: bad MapEntry {e.get('source')!r} -> {e.get('target')!r}") from None
-            kind = {"BooleanMappingTransformation": "boolmap", "IntegerMappingTransformation": "intmap"}.get(tag, "enummap")
+            kind = {"BooleanMappingTransformation": "boolmap",
+                    "IntegerMappingTransformation": "intmap"}.get(tag, "enummap")
             return (kind, mapping)
     return None
 
@@ -450,17 +449,18 @@ def parse_master_annotation(el, namer, settings):
                                "(expected nc:Order, nc:StepMultiple, nc:StopCondition, nc:Schedule)")
 
 
+def _where(e, namer):
+    return f"{namer(e.getroottree().docinfo.URL)}:{e.sourceline}"
+
+
 def _parse_schedule(el, namer):
     """nc:Schedule: nc:Mode entries (each with nc:When conditions) and nc:NextEvent signals."""
-    def where(e):
-        return f"{namer(e.getroottree().docinfo.URL)}:{e.sourceline}"
-
-    sched = Schedule(origin=where(el))
+    sched = Schedule(origin=_where(el, namer))
     names = set()
     for child in el:
         if not isinstance(child.tag, str):
             continue
-        o = where(child)
+        o = _where(child, namer)
         if child.tag == _q("nc", "NextEvent"):
             comp, conn = child.get("component"), child.get("connector")
             if not comp or not conn:
@@ -469,52 +469,7 @@ def _parse_schedule(el, namer):
             continue
         if child.tag != _q("nc", "Mode"):
             raise SSPError(f"{o}: unknown element {child.tag} in nc:Schedule (expected nc:Mode, nc:NextEvent)")
-        unknown = set(child.attrib) - {"name", "stepSize", "active", "recordEvery", "every"}
-        if unknown:
-            raise SSPError(f"{o}: unknown attribute(s) on nc:Mode: {', '.join(sorted(unknown))}")
-        name = child.get("name")
-        if not name or name in names:
-            raise SSPError(f"{o}: nc:Mode needs a unique name=\"...\", got {name!r}")
-        names.add(name)
-        h = _float_attr(child, "stepSize", o)
-        if h is None or not (h > 0 and math.isfinite(h)):
-            raise SSPError(f"{o}: nc:Mode {name!r} stepSize must be a positive number, got {child.get('stepSize')!r}")
-        try:
-            every = int(child.get("recordEvery", "1"))
-        except ValueError:
-            every = 0
-        if every < 1:
-            raise SSPError(f"{o}: nc:Mode {name!r} recordEvery must be an integer >= 1, got {child.get('recordEvery')!r}")
-        active = child.get("active")
-        multiples = {}
-        for item in (child.get("every") or "").split():
-            comp, _, k = item.partition(":")
-            try:
-                k = int(k)
-            except ValueError:
-                k = 0
-            if not comp or k < 1:
-                raise SSPError(f"{o}: nc:Mode {name!r} every=\"{child.get('every')}\": expected "
-                               "\"component:k ...\" with integers k >= 1")
-            multiples[comp] = k
-        mode = ScheduleMode(name=name, step_size=h, active=None if active is None else active.split(),
-                            record_every=every, every=multiples, origin=o)
-        for w in child:
-            if not isinstance(w.tag, str):
-                continue
-            wo = where(w)
-            if w.tag != _q("nc", "When"):
-                raise SSPError(f"{wo}: unknown element {w.tag} in nc:Mode (expected nc:When)")
-            comp, conn, values = w.get("component"), w.get("connector"), w.get("values")
-            try:
-                vals = frozenset(int(v) for v in (values or "").split())
-            except ValueError:
-                vals = frozenset()
-            if not comp or not conn or not vals:
-                raise SSPError(f"{wo}: nc:When needs component=\"name\", connector=\"name\" and "
-                               "values=\"integers\" (Booleans: 0 or 1)")
-            mode.conditions.append((comp, conn, vals))
-        sched.modes.append(mode)
+        sched.modes.append(_parse_mode(child, o, namer, names))
     if not sched.modes:
         raise SSPError(f"{sched.origin}: nc:Schedule needs at least one nc:Mode")
     for m in sched.modes[:-1]:
@@ -522,6 +477,58 @@ def _parse_schedule(el, namer):
             raise SSPError(f"{m.origin}: nc:Mode {m.name!r} has no nc:When, so it always matches; only the "
                            "last mode may be unconditional (modes are tried in order)")
     return sched
+
+
+def _parse_mode(child, o, namer, names):
+    """One nc:Mode element (at `o`, file:line) with its nc:When conditions; `names`: the mode
+    names taken so far (this one is added)."""
+    unknown = set(child.attrib) - {"name", "stepSize", "active", "recordEvery", "every"}
+    if unknown:
+        raise SSPError(f"{o}: unknown attribute(s) on nc:Mode: {', '.join(sorted(unknown))}")
+    name = child.get("name")
+    if not name or name in names:
+        raise SSPError(f"{o}: nc:Mode needs a unique name=\"...\", got {name!r}")
+    names.add(name)
+    h = _float_attr(child, "stepSize", o)
+    if h is None or not (h > 0 and math.isfinite(h)):
+        raise SSPError(f"{o}: nc:Mode {name!r} stepSize must be a positive number, got {child.get('stepSize')!r}")
+    try:
+        every = int(child.get("recordEvery", "1"))
+    except ValueError:
+        every = 0
+    if every < 1:
+        raise SSPError(f"{o}: nc:Mode {name!r} recordEvery must be an integer >= 1, "
+                       f"got {child.get('recordEvery')!r}")
+    active = child.get("active")
+    multiples = {}
+    for item in (child.get("every") or "").split():
+        comp, _, k = item.partition(":")
+        try:
+            k = int(k)
+        except ValueError:
+            k = 0
+        if not comp or k < 1:
+            raise SSPError(f"{o}: nc:Mode {name!r} every=\"{child.get('every')}\": expected "
+                           "\"component:k ...\" with integers k >= 1")
+        multiples[comp] = k
+    mode = ScheduleMode(name=name, step_size=h, active=None if active is None else active.split(),
+                        record_every=every, every=multiples, origin=o)
+    for w in child:
+        if not isinstance(w.tag, str):
+            continue
+        wo = _where(w, namer)
+        if w.tag != _q("nc", "When"):
+            raise SSPError(f"{wo}: unknown element {w.tag} in nc:Mode (expected nc:When)")
+        comp, conn, values = w.get("component"), w.get("connector"), w.get("values")
+        try:
+            vals = frozenset(int(v) for v in (values or "").split())
+        except ValueError:
+            vals = frozenset()
+        if not comp or not conn or not vals:
+            raise SSPError(f"{wo}: nc:When needs component=\"name\", connector=\"name\" and "
+                           "values=\"integers\" (Booleans: 0 or 1)")
+        mode.conditions.append((comp, conn, vals))
+    return mode
 
 
 def parse_ssd(ssd_path, namer, validate=True):
@@ -590,9 +597,3 @@ def read_parameter_set_file(path, namer, validate=True):
     """A caller-supplied .ssv (names `component.variable`) -> [ParamValue]."""
     return parse_ssv(load_xml(path, "ssv", namer, validate), namer)
 
-
-def relpath_or_abs(p):
-    try:
-        return os.path.relpath(p)
-    except ValueError:
-        return str(p)

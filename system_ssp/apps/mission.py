@@ -1,11 +1,11 @@
 """The NEIGHBOR mission from deployment to re-entry, run through the master, with the thesis'
 figures and a summary beside the published numbers.
 
-    python -m system_ssp mission [--scenario 420km] [--orbit averaged|cowell] [--out results/mission]
+    neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell] [--out results/mission]
 
 Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
-minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter set (system_ssp/systems/parameters/
-neighbor_mission_<scenario>.ssv), and writes into --out:
+minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
+set (system_ssp/systems/parameters/neighbor_mission_<scenario>.ssv), and writes into --out:
 - timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode);
 - summary.json     every computed figure beside the thesis' (also printed as a table);
 - altitude.png (Fig. 11), detumble.png (Fig. 20-22), slew.png (Fig. 27-29), tracking.png
@@ -14,7 +14,6 @@ neighbor_mission_<scenario>.ssv), and writes into --out:
 """
 import argparse
 import json
-import os
 from pathlib import Path
 import sys
 
@@ -23,12 +22,12 @@ import numpy as np
 from components.core.constants import DAY, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
 
-from .errors import SSPError
-from .master import System, write_csv_atomic
+from ..atomic import atomic_write, write_text_atomic
+from ..errors import SSPError
+from ..master import System, write_csv_atomic
+from ..systems import PARAMETERS_DIR
+from . import DEFAULT_SSP_DIR
 
-ROOT = Path(__file__).resolve().parents[1]
-DEFAULT_SSP_DIR = ROOT / "build" / "ssp"
-PARAMETERS = Path(__file__).resolve().parent / "systems" / "parameters"
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
 WH = 3600.0
@@ -57,7 +56,7 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
     ssp = Path(ssp_dir) / f"{SYSTEMS[orbit]}.ssp"
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
-    ssv = PARAMETERS / f"neighbor_mission_{scenario}.ssv"
+    ssv = PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"
     with System(ssp) as system:
         r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
                        outputs=RECORD, profile=profile, progress=progress)
@@ -66,15 +65,10 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
         out = Path(out)
         out.mkdir(parents=True, exist_ok=True)
         write_csv_atomic(r.data, out / "timeseries.csv")
-        _write_atomic(out / "summary.json", json.dumps(s, indent=1))
+        write_text_atomic(out / "summary.json", json.dumps(s, indent=1))
         plot(r.data, s, out)
     return s, r
 
-
-def _write_atomic(path, text):
-    tmp = path.with_name(path.name + ".tmp")
-    tmp.write_text(text)
-    os.replace(tmp, path)
 
 
 def _first(mask):
@@ -178,10 +172,9 @@ def plot(d, s, out):
 
     def save(fig, name):
         fig.tight_layout()
-        tmp = out / f".{name}"
-        fig.savefig(tmp, dpi=110, format="png")
+        with atomic_write(out / name, "wb") as f:
+            fig.savefig(f, dpi=110, format="png")
         plt.close(fig)
-        os.replace(tmp, out / name)
 
     fig, ax = plt.subplots(figsize=(8, 4.5))
     ax.plot(t / YEAR, (d["orbit.sma"] - R_EQ) / 1e3, label="a - R_eq")
@@ -253,7 +246,7 @@ def plot(d, s, out):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="python -m system_ssp mission", description=__doc__.split("\n\n")[0])
+    ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
     ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
     ap.add_argument("--out", default="results/mission")

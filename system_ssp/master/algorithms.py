@@ -1,0 +1,296 @@
+"""The master algorithms, over one `InstanceTable`: fixed-step (Jacobi or Gauss-Seidel, with
+step multiples) and scheduled (Gauss-Seidel with mode-dependent steps, nc:Schedule).
+
+An algorithm fills a `StepInfo`: `start` after initialization, `advance` for each macro step,
+`finish` at the end; `finished` says when to stop; `refresh_for_record` brings the values a
+recorded row shows up to date."""
+import ctypes
+import math
+
+from ..errors import SimulationError
+from .connections import KIND
+from .instances import CTYPE, GET, StepFailed
+
+
+class FixedStepAlgorithm:
+    """Fixed communication step h, t_n = start + n h from an integer counter; the last step is
+    shortened to end exactly at the stop time.
+
+    - Jacobi: every component steps from the same input values (outputs of the previous
+      communication point), then every output is read; the inputs for the next step are set
+      after the observers saw the step (libcosim's fixed-step algorithm).
+    - Gauss-Seidel: components step in `plan.order`, each seeing the outputs of those already
+      stepped; then inputs are propagated once more in order (no doStep), so direct-feedthrough
+      outputs reflect t + h before recording and stop conditions.
+    - Step multiples k: a component steps only every k-th communication step, by k h."""
+
+    def __init__(self, table, plan):
+        self.table = table
+        self.plan = plan
+        self.order = list(plan.order)
+        self.mult = list(plan.multiples)
+        self.all_one = all(k == 1 for k in self.mult)
+        self.jacobi = plan.algorithm == "jacobi"
+        self.n = len(table.instances)
+        self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
+
+    def start(self, info):
+        self.table.t = info.t = self.plan.start
+        info.record_every = self.plan.record_every
+
+    def finished(self, info):
+        return info.fired is not None or info.steps >= self.plan.n_steps
+
+    def _transfer(self, k):
+        """Jacobi: set the inputs for step k of every component due then (and all at the end)."""
+        N, mult, setters = self.plan.n_steps, self.mult, self.table.setters
+        for ci in range(self.n):
+            if self.all_one or k % mult[ci] == 0 or k >= N:
+                setters[ci]()
+
+    def advance(self, info):
+        p, table = self.plan, self.table
+        start, stop, h, N = p.start, p.stop, p.step_size, p.n_steps
+        mult, all_one = self.mult, self.all_one
+        k = info.steps
+        t = start + k * h
+        table.t = t
+        if self.jacobi:
+            if k > 0:
+                self._transfer(k)
+            do_steps = table.do_steps
+            for ci in range(self.n):
+                mk = mult[ci]
+                if all_one or k % mk == 0:
+                    # The nominal step, not a difference of rounded times: models that integrate
+                    # with the step (the thesis' Euler scripts) must see exactly h every step.
+                    do_steps[ci](t, mk * h if k + mk < N else stop - t)
+            for get in table.getters:
+                get()
+        else:
+            steppers = self.steppers
+            for ci in self.order:
+                mk = mult[ci]
+                if all_one or k % mk == 0:
+                    steppers[ci](t, mk * h if k + mk < N else stop - t)
+            setters, getters, has_ft = table.setters, table.getters, table.has_ft
+            for ci in self.order:
+                setters[ci]()
+                if has_ft[ci]:
+                    getters[ci]()
+        info.steps = k + 1
+        info.t = table.t = start + info.steps * h if info.steps < N else stop
+        info.last = info.steps == N
+
+    def refresh_for_record(self):
+        pass
+
+    def finish(self, info):
+        if self.jacobi and info.steps > 0:
+            self._transfer(info.steps)
+
+    def statistics(self):
+        return None
+
+
+class _Mode:
+    """A schedule mode prepared for the loop."""
+    __slots__ = ("name", "h", "order", "record_every", "conditions", "mult", "refresh")
+
+    def __init__(self, name, h, order, record_every, conditions, mult, refresh):
+        self.name, self.h, self.order, self.record_every = name, h, order, record_every
+        self.conditions, self.mult, self.refresh = conditions, mult, refresh
+
+
+class _Signal:
+    """One scalar output read straight through the FMI functions (schedule conditions, events)."""
+    __slots__ = ("fn", "c", "vr", "buf", "ci", "name")
+
+    def __init__(self, table, ci, var, kind):
+        comps = table.system.comps
+        self.vr = (ctypes.c_uint * 1)(comps[ci].vars[var].valueReference)
+        self.buf = (CTYPE[kind] * 1)()
+        self.fn = table.instances[ci].fn[GET[kind]]
+        self.c = table.instances[ci].fmu.component
+        self.ci = ci
+        self.name = f"{comps[ci].name}.{var}"
+
+    def read(self):
+        s = self.fn(self.c, self.vr, 1, self.buf)
+        if s > 1:
+            raise StepFailed(self.ci, self.name, s)
+        return self.buf[0]
+
+
+class ScheduledAlgorithm:
+    """Gauss-Seidel with mode-dependent communication steps (nc:Schedule).
+
+    After initialization and after every macro step the algorithm reads the schedule's condition
+    signals and takes the first mode whose conditions all hold. The next macro step [t, t + h] is
+    that mode's step size, shortened so that it ends exactly on the earliest nc:NextEvent time
+    ahead (an FMU announcing e.g. a timer expiry) and on the stop time. Each component keeps its
+    own time t_c:
+    - active, every = 1: stepped from t_c to t + h (t_c = t, or a little before when it ran
+      ahead in an earlier mode; communication points stay contiguous);
+    - active, every = k > 1 (nc:Mode every="comp:k"): stepped when due (t_c <= t) from t_c to
+      t + k stepSize, i.e. ahead of the master by k stepSize with its inputs held from t (like
+      fixed-step multiples); until the master reaches t_c it is not stepped again;
+    - not active in the mode: suspended, not stepped, outputs held, inputs not set. When it
+      becomes active again its clock jumps to the current time: its next doStep starts there,
+      and the suspended span is skipped, not integrated (FMI 2.0 does not require contiguous
+      communication points; every component must declare canHandleVariableCommunicationStepSize).
+    After the steps, direct-feedthrough components whose outputs the schedule or a stop condition
+    watches, or that feed a component stepping before them, get their inputs again and their
+    outputs are read (so conditions, stop signals and the next steps see values at t + h); the
+    rest is brought up to date on recorded rows (every active component), and inputs are always
+    set right before a doStep. Rows are recorded every `recordEvery` macro steps of a mode, at
+    every mode change, at a stop condition and at the end."""
+
+    def __init__(self, table, plan):
+        self.table = table
+        self.plan = plan
+        sch = plan.schedule
+        comps = table.system.comps
+        n = self.n = len(table.instances)
+        for ci in range(n):
+            cs = comps[ci].md.coSimulation
+            if cs is not None and not cs.canHandleVariableCommunicationStepSize:
+                raise SimulationError(f"{sch.origin}: component {comps[ci].name!r} cannot handle a variable "
+                                      "communication step size, which nc:Schedule needs")
+        consumers = [set() for _ in range(n)]
+        producers = [set() for _ in range(n)]
+        for lk in table.system.links:
+            consumers[lk.src].add(lk.dst)
+            producers[lk.dst].add(lk.src)
+        watched = {ci for ci, _ in plan.stops} | {ci for ci, _ in sch.events}
+        watched |= {ci for m in sch.modes for ci, _, _ in m.conditions}
+        has_ft = table.has_ft
+
+        def refreshed(order):
+            """Feedthrough components whose outputs must be brought to t + h after the steps:
+            those watched by the schedule or a stop condition, those read by a component that
+            steps before them, and (transitively) their feedthrough producers. The others are
+            read fresh in the next step pass anyway."""
+            pos = {ci: k for k, ci in enumerate(order)}
+            need = {ci for ci in order if has_ft[ci]
+                    and (ci in watched or any(cj in pos and pos[cj] < pos[ci] for cj in consumers[ci]))}
+            grow = list(need)
+            while grow:
+                for cj in producers[grow.pop()]:
+                    if cj in pos and has_ft[cj] and cj not in need:
+                        need.add(cj)
+                        grow.append(cj)
+            return [ci for ci in order if ci in need]
+
+        self.modes = []
+        for m in sch.modes:
+            conds = [(_Signal(table, ci, var, KIND[comps[ci].vars[var].type]), vals) for ci, var, vals in m.conditions]
+            order = [ci for ci in plan.order if m.active[ci]]
+            self.modes.append(_Mode(m.name, m.step_size, order, m.record_every, conds, list(m.multiples),
+                                    refreshed(order)))
+        self.events = [_Signal(table, ci, var, "Real") for ci, var in sch.events]
+        self.cond_comps = sorted({sig.ci for m in self.modes for sig, _ in m.conditions})
+        self.prod = [sorted(producers[ci]) for ci in range(n)]
+        # Times closer than this are the same instant: a few ulps of the largest time in the run
+        # (1.5e-5 s at 40 years), far below any step, so that t + (t_event - t) lands on t_event.
+        self.tol = 64.0 * math.ulp(max(1.0, abs(plan.start), abs(plan.stop)))
+        self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
+        self.mode_time = {m.name: 0.0 for m in self.modes}
+        self.mode_steps = {m.name: 0 for m in self.modes}
+
+    def _pick(self):
+        for mode in self.modes:
+            if all(int(sig.read()) in vals for sig, vals in mode.conditions):
+                return mode
+        raise SimulationError(f"{self.plan.schedule.origin}: no nc:Mode matches at t={self.table.t:g} s ("
+                              + ", ".join(f"{sig.name}={int(sig.read())}" for mode in self.modes
+                                          for sig, _ in mode.conditions)
+                              + "); end the schedule with an unconditional nc:Mode")
+
+    def start(self, info):
+        start = self.plan.start
+        self.t = self.table.t = info.t = start
+        self.tc = [start] * self.n  # each component's own time
+        self.mode = self._pick()
+        self.next_mode = self.mode
+        self.active_order = self.mode.order
+        active = set(self.active_order)
+        self.suspended = [ci not in active for ci in range(self.n)]
+        self.ev_values = [sig.read() for sig in self.events]
+        info.record_every = self.mode.record_every
+
+    def finished(self, info):
+        return info.fired is not None or self.t >= self.plan.stop - self.tol
+
+    def advance(self, info):
+        table, tol, stop = self.table, self.tol, self.plan.stop
+        mode = self.mode = self.next_mode
+        order, mult, h_mode = mode.order, mode.mult, mode.h
+        self.active_order = order
+        t = self.t
+        h = h_mode
+        for te in self.ev_values:
+            if te > t + tol and te - t < h:
+                h = te - t
+        if stop - t < h + tol:
+            h = stop - t
+        t1 = t + h if stop - (t + h) > tol else stop
+        changed = [False] * self.n
+        tc, suspended, steppers = self.tc, self.suspended, self.steppers
+        for ci in order:
+            if suspended[ci]:
+                tc[ci] = t  # back from suspension: the clock jumps to now
+                suspended[ci] = False
+            t_c = tc[ci]
+            if t_c > t + tol:
+                continue  # ahead of the master (stepped with a multiple)
+            k = mult[ci]
+            end = t1 if k == 1 else min(t + k * h_mode, stop)
+            if end - t_c <= tol:
+                continue  # already at the end of this step (it ran ahead)
+            steppers[ci](t_c, end - t_c)
+            tc[ci] = end
+            changed[ci] = True
+        setters, getters, prod = table.setters, table.getters, self.prod
+        for ci in mode.refresh:
+            if changed[ci] or any(changed[cp] for cp in prod[ci]):
+                setters[ci]()
+                getters[ci]()
+                changed[ci] = True
+        self.t = table.t = t1
+        self.mode_time[mode.name] += h
+        self.mode_steps[mode.name] += 1
+        for j, sig in enumerate(self.events):
+            if changed[sig.ci]:
+                self.ev_values[j] = sig.read()
+        nxt = self._pick() if any(changed[ci] for ci in self.cond_comps) else mode
+        if nxt is not mode:
+            active_now = set(nxt.order)
+            for ci in range(self.n):
+                if ci not in active_now:
+                    suspended[ci] = True
+        self.next_mode = nxt
+        info.t = t1
+        info.steps += 1
+        info.changed = changed
+        info.mode_changed = nxt is not mode
+        info.record_every = mode.record_every
+        info.last = t1 >= stop
+
+    def refresh_for_record(self):
+        # every active component's inputs and feedthrough outputs as they stand now (the step
+        # loop refreshes only what the next steps need); rows are also recorded at each mode
+        # change, so a component suspended by the change holds its outputs at that time
+        setters, getters, has_ft = self.table.setters, self.table.getters, self.table.has_ft
+        for ci in self.active_order:
+            setters[ci]()
+            if has_ft[ci]:
+                getters[ci]()
+
+    def finish(self, info):
+        self.mode = self.next_mode
+        for ci in self.mode.order:
+            self.table.setters[ci]()
+
+    def statistics(self):
+        return {m: {"steps": self.mode_steps[m], "simulated_time": self.mode_time[m]} for m in self.mode_steps}

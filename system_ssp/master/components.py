@@ -1,0 +1,78 @@
+"""The static side of one component of a loaded system: its SSD declaration, its FMU's model
+description and the folder the FMU is extracted to."""
+from fmpy import extract, read_model_description
+
+from ..errors import SSPError
+from ..ssp.units import SI_BASE_UNITS, Unit
+from .names import near
+
+
+class ComponentInfo:
+    """Per System (not per run): one component's declaration, variables, units and output
+    dependencies."""
+
+    def __init__(self, index, decl, md, unzipdir):
+        self.index = index
+        self.name = decl.name
+        self.decl = decl
+        self.md = md
+        self.unzipdir = unzipdir
+        self.vars = {v.name: v for v in md.modelVariables}
+        self.unit_defs = {}
+        for u in md.unitDefinitions:
+            b = u.baseUnit
+            if b is None:
+                self.unit_defs[u.name] = Unit(u.name, (0,) * len(SI_BASE_UNITS), 1.0, 0.0)
+            else:
+                exps = tuple(int(getattr(b, n, 0) or 0) for n in SI_BASE_UNITS)
+                self.unit_defs[u.name] = Unit(u.name, exps, float(b.factor if b.factor is not None else 1.0),
+                                              float(b.offset if b.offset is not None else 0.0))
+        # output name -> set of input names it depends on directly (None = all inputs)
+        self.deps = {}
+        for unknown in md.outputs:
+            d = unknown.dependencies
+            self.deps[unknown.variable.name] = None if d is None else {v.name for v in d}
+        self.inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+
+    def fmu_unit(self, v):
+        if getattr(v, "unit", None):
+            return v.unit
+        dt = getattr(v, "declaredType", None)
+        return getattr(dt, "unit", None) if dt is not None else None
+
+    def depends_on_inputs(self, out_name, connected_inputs):
+        d = self.deps.get(out_name, None)
+        if out_name not in self.deps or d is None:
+            return bool(self.inputs)
+        return bool(d & connected_inputs) if connected_inputs is not None else bool(d)
+
+
+def load_components(desc, extract_root, namer, validate):
+    """[ComponentInfo] for the SSD's components: model descriptions read (and schema-checked
+    when `validate`), FMUs extracted under `extract_root`, connectors checked against the FMUs."""
+    comps = []
+    for i, decl in enumerate(desc.components):
+        if not decl.fmu_path.is_file():
+            raise SSPError(f"{decl.origin}: component {decl.name!r}: FMU file not found "
+                           f"(source={decl.source!r}, tried {namer(decl.fmu_path)}); the product's "
+                           "systems are packed with their FMUs by `python build_fmus.py` into build/ssp/")
+        try:
+            md = read_model_description(str(decl.fmu_path), validate=validate)
+        except Exception as exc:  # fmpy raises various exceptions for broken FMUs
+            raise SSPError(f"component {decl.name!r}: cannot read the model description of "
+                           f"{namer(decl.fmu_path)}: {exc}") from None
+        if md.fmiVersion != "2.0" or md.coSimulation is None:
+            raise SSPError(f"component {decl.name!r}: {namer(decl.fmu_path)} is not an FMI 2.0 "
+                           "co-simulation FMU")
+        unzipdir = extract(str(decl.fmu_path), unzipdir=str(extract_root / f"{i}_{decl.name}"))
+        info = ComponentInfo(i, decl, md, unzipdir)
+        for cname, conn in decl.connectors.items():
+            v = info.vars.get(cname)
+            if v is None:
+                raise SSPError(f"{conn.origin}: connector {cname!r} of component {decl.name!r} has no matching "
+                               f"variable in {namer(decl.fmu_path)}{near(cname, info.vars)}")
+            if conn.type and conn.type != v.type and not (conn.type == "Integer" and v.type == "Enumeration"):
+                raise SSPError(f"{conn.origin}: connector {decl.name}.{cname} is declared {conn.type} but the "
+                               f"FMU variable is {v.type}")
+        comps.append(info)
+    return comps

@@ -1,0 +1,225 @@
+"""Connections resolved against the FMUs: which output feeds which input, with the unit
+conversion and transformation folded into one affine map (or an Integer/Boolean mapping), and
+the direct-feedthrough graph that orders Gauss-Seidel steps."""
+from typing import NamedTuple, Optional
+
+from ..errors import SSPError
+from ..ssp.units import BUILTIN, conversion, describe
+from .graph import toposort
+from .names import near
+
+NUMERIC = ("Real", "Integer", "Boolean", "Enumeration")
+KIND = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean"}
+
+
+class Link(NamedTuple):
+    """One resolved connection: output `src_var` of component `src` feeds input `dst_var` of
+    `dst`; a Real value is mapped as factor * value + offset, an Integer/Boolean through
+    `mapping` (None: unchanged)."""
+    src: int
+    dst_var: str
+    src_var: str
+    dst: int
+    vtype: str  # "Real" | "Integer" | "Boolean"
+    factor: float
+    offset: float
+    mapping: Optional[dict]
+    label: str
+
+
+class UnitTable:
+    """Unit lookup for a system: ssd:Units, then the component's FMU UnitDefinitions, then the
+    product's table of common units, then any other FMU of the system."""
+
+    def __init__(self, desc, comps):
+        self.desc = desc
+        self.comps = comps
+
+    def unit(self, name, comp=None, extra=None, where=""):
+        if name is None:
+            return None
+        for table in (extra or {}, self.desc.units, comp.unit_defs if comp else {}, BUILTIN):
+            if name in table:
+                return table[name]
+        for c in self.comps:
+            if name in c.unit_defs:
+                return c.unit_defs[name]
+        raise SSPError(f"{where}: unit {name!r} has no definition (add it to ssd:Units)")
+
+    def convert(self, a, b, comp_a, comp_b, where):
+        """(factor, offset) from unit name a to unit name b; identity if either is unknown."""
+        if a is None or b is None or a == b:
+            return 1.0, 0.0
+        ua = self.unit(a, comp_a, where=where)
+        ub = self.unit(b, comp_b, where=where)
+        conv = conversion(ua, ub)
+        if conv is None:
+            raise SSPError(f"{where}: incompatible units {a!r} ({describe(ua)}) and {b!r} ({describe(ub)})")
+        return conv
+
+    @staticmethod
+    def end_units(comp, var):
+        """(unit of the FMU value, unit seen by the connection) for a component variable."""
+        v = comp.vars[var]
+        conn = comp.decl.connectors.get(var)
+        fu = comp.fmu_unit(v)
+        cu = conn.unit if conn is not None else None
+        return (fu or cu), (cu or fu)
+
+    def var_unit(self, comp, var):
+        return self.end_units(comp, var)[0]
+
+
+def _invert(tr, c):
+    if tr is None:
+        return None
+    if tr[0] == "linear":
+        if tr[1] == 0:
+            raise SSPError(f"{c.origin}: connection {c.label()}: LinearTransformation with factor 0 cannot be "
+                           "applied against the connection's start->end direction")
+        return ("linear", 1.0 / tr[1], -tr[2] / tr[1])
+    return (tr[0], {v: k for k, v in tr[1].items()})
+
+
+def resolve_connections(desc, comps, by_name, units):
+    """[Link] for the SSD's connections: each joins an output to an input (system connectors
+    resolved as pass-throughs), every input fed at most once."""
+    src_causal = ("output", "calculatedParameter", "parameter")
+
+    def end(element, connector, c):
+        """('comp', info, var) or ('sys', None, name) for one end of a connection."""
+        if element is None:
+            if connector not in desc.system_connectors:
+                raise SSPError(f"{c.origin}: connection {c.label()}: the system has no connector {connector!r}"
+                               f"{near(connector, desc.system_connectors)}")
+            return ("sys", None, connector)
+        comp = by_name.get(element)
+        if comp is None:
+            raise SSPError(f"{c.origin}: connection {c.label()}: no component named {element!r}"
+                           f"{near(element, by_name)}")
+        if connector not in comp.vars:
+            raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} has no variable "
+                           f"{connector!r}{near(connector, comp.vars)}")
+        return ("comp", comp, connector)
+
+    def role(e):
+        if e[0] == "sys":
+            return "sys"
+        caus = e[1].vars[e[2]].causality
+        return "src" if caus in src_causal else ("dst" if caus == "input" else caus)
+
+    def said(r):
+        return r if r not in ("src", "dst") else ("output" if r == "src" else "input")
+
+    half = []  # (src_end, dst_end, transform, suppress, connection)
+    for c in desc.connections:
+        a = end(c.start_element, c.start_connector, c)
+        b = end(c.end_element, c.end_connector, c)
+        ra, rb = role(a), role(b)
+        transform = c.transform
+        if ra in ("src", "sys") and rb in ("dst", "sys") and not (ra == "sys" and rb == "sys"):
+            src, dst = a, b
+        elif rb in ("src", "sys") and ra in ("dst", "sys") and not (ra == "sys" and rb == "sys"):
+            src, dst = b, a
+            transform = _invert(transform, c)
+        else:
+            raise SSPError(f"{c.origin}: connection {c.label()} must join an output to an input "
+                           f"(found {said(ra)} and {said(rb)})")
+        half.append((src, dst, transform, c.suppress_unit_conversion, c))
+
+    links = []
+    for src, dst, tr, sup, c in half:
+        if src[0] == "comp" and dst[0] == "comp":
+            links.append(_make_link(units, desc, src, dst, [(tr, sup, c)], c.label(), c.origin))
+        elif dst[0] == "sys":
+            # component output -> system connector -> component inputs
+            for src2, dst2, tr2, sup2, c2 in half:
+                if src2[0] == "sys" and src2[2] == dst[2] and dst2[0] == "comp":
+                    label = f"{c.label()} ; {c2.label()}"
+                    links.append(_make_link(units, desc, src, dst2, [(tr, sup, c), (tr2, sup2, c2)], label,
+                                            c2.origin, via=dst[2]))
+    seen = {}
+    for lk in links:
+        key = (lk.dst, lk.dst_var)
+        if key in seen:
+            raise SSPError(f"input {comps[lk.dst].name}.{lk.dst_var} is connected twice: {seen[key]} and {lk.label}")
+        seen[key] = lk.label
+    return links
+
+
+def _make_link(units, desc, src, dst, chain, label, origin, via=None):
+    sc, sv = src[1], src[2]
+    dc, dv = dst[1], dst[2]
+    where = f"{origin}: connection {label}"
+    st, dt = sc.vars[sv].type, dc.vars[dv].type
+    if KIND.get(st, st) != KIND.get(dt, dt):
+        raise SSPError(f"{where}: type mismatch: {sc.name}.{sv} is {st}, {dc.name}.{dv} is {dt}")
+    if st not in NUMERIC:
+        raise SSPError(f"{where}: connections of type {st} are not supported")
+    suppress = any(s for _, s, _ in chain)
+    factor, offset, mapping = 1.0, 0.0, None
+    if st == "Real":
+        s_fmu, s_conn = units.end_units(sc, sv)
+        d_fmu, d_conn = units.end_units(dc, dv)
+        steps = [(s_fmu, s_conn, sc, sc)]
+        if via is not None:
+            vu = desc.system_connectors[via].unit
+            steps.append((s_conn, vu or s_conn, sc, None))
+            s_conn = vu or s_conn
+        steps.append((s_conn, d_conn, sc, dc))
+        steps.append((d_conn, d_fmu, dc, dc))
+        # The connection's own transformation acts on connector values (start -> end units).
+        conv_total = (1.0, 0.0)
+        for i, (a, b, ca, cb) in enumerate(steps):
+            if suppress and i != 0 and i != len(steps) - 1:
+                continue
+            f, o = units.convert(a, b, ca, cb, where)
+            conv_total = (conv_total[0] * f, conv_total[1] * f + o)
+            if i == 0:
+                for tr, _, _ in chain:  # transformations in data-flow order, in source connector units
+                    if tr is not None:
+                        if tr[0] != "linear":
+                            raise SSPError(f"{where}: {tr[0]} transformation on a Real connection")
+                        conv_total = (conv_total[0] * tr[1], conv_total[1] * tr[1] + tr[2])
+        factor, offset = conv_total
+    else:
+        for tr, _, _ in chain:
+            if tr is None:
+                continue
+            if tr[0] == "linear":
+                raise SSPError(f"{where}: LinearTransformation on a {st} connection is not supported")
+            if mapping is None:
+                mapping = dict(tr[1])
+            else:
+                mapping = {k: tr[1].get(v, v) for k, v in mapping.items()}
+    return Link(sc.index, dv, sv, dc.index, KIND.get(st, st), factor, offset, mapping, label)
+
+
+class FeedthroughGraph:
+    """Which inputs are connected, which connected outputs depend directly on inputs, and the
+    component edges p -> c that such outputs create (Gauss-Seidel must step p before c)."""
+
+    def __init__(self, comps, links):
+        n = len(comps)
+        self.comps = comps
+        self.connected_inputs = [set() for _ in range(n)]
+        for lk in links:
+            self.connected_inputs[lk.dst].add(lk.dst_var)
+        self.edges = {}  # (p, c) -> [labels of the links that cause it]
+        self.feedthrough_outputs = [set() for _ in range(n)]
+        for lk in links:
+            p = comps[lk.src]
+            if p.depends_on_inputs(lk.src_var, self.connected_inputs[lk.src]):
+                self.feedthrough_outputs[lk.src].add(lk.src_var)
+                # a self-edge (a component feeding itself through feedthrough) is a loop too
+                self.edges.setdefault((lk.src, lk.dst), []).append(lk.label)
+
+    def order(self):
+        """Component indices in dependency order, ties by SSD order; SSPError names the
+        components of an algebraic loop."""
+        order, cycle = toposort(len(self.comps), self.edges)
+        if cycle:
+            names = " -> ".join(self.comps[i].name for i in cycle)
+            raise SSPError(f"algebraic loop (direct feedthrough cycle) between components: {names}; "
+                           "Gauss-Seidel needs an acyclic order: break the loop or use algorithm='jacobi'")
+        return order

@@ -1,0 +1,438 @@
+"""The FMU instances of one run and the operations the algorithms call on them.
+
+`InstanceTable` owns the instances (instantiation, initialization, freeing) and, per component,
+the prepared FMI calls that move values along the connections: connected outputs of all
+components live in one numpy buffer per type, so setting a component's inputs is one `np.take`
+(plus the affine map when a connection has one) and one fmi2Set* call, and reading its outputs
+is one fmi2Get* call per type straight into that buffer. The calls go to FMPy's loaded ctypes
+functions with value-reference arrays and value buffers built once per run.
+"""
+import ctypes
+
+from fmpy import calloc, free
+from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
+                       fmi2CallbackLoggerTYPE)
+from fmpy.logging import addLoggerProxy
+import numpy as np
+
+from ..errors import SimulationError, SSPError
+from .connections import KIND
+from .graph import toposort
+
+CTYPE = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_int}
+NPTYPE = {"Real": np.float64, "Integer": np.int32, "Boolean": np.int32}
+GET = {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean"}
+SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean"}
+STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
+
+
+class StepFailed(Exception):
+    """An FMI call returned error or fatal (turned into a SimulationError with the FMU's messages)."""
+
+    def __init__(self, ci, call, status):
+        super().__init__(ci, call, status)
+        self.ci, self.call, self.status = ci, call, status
+
+
+# pythonfmu keeps the logger of the instance created last and may call it after that instance is
+# gone (messages of other instances, teardown at exit): the callbacks must outlive every
+# instance, so they are kept for the life of the process.
+_CALLBACKS_KEPT = []
+
+
+class FmuInstance:
+    """One FMU instance plus the logger that collects its messages."""
+
+    def __init__(self, info, table):
+        self.info = info
+        self.name = info.name
+        self.messages = []  # (status label, category, message)
+        self.instantiated = False
+        self.initialized = False
+        self.failed = False
+        md = info.md
+
+        def logger(env, instance_name, status, category, message):
+            try:
+                text = message.decode("utf-8", "replace") if message else ""
+                cat = category.decode("utf-8", "replace") if category else ""
+                label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+                if status >= 1 or table.debug:
+                    # pythonfmu reports through the logger of the most recently instantiated
+                    # instance, so route by the instance name the FMU passes.
+                    name = instance_name.decode("utf-8", "replace") if instance_name else ""
+                    target = table.by_name.get(name, self)
+                    target.messages.append((label, cat, text))
+                    if len(target.messages) > 200:
+                        del target.messages[:100]
+            except Exception:  # never let a logging problem propagate into C
+                pass
+
+        self._logger = fmi2CallbackLoggerTYPE(logger)
+        cb = fmi2CallbackFunctions()
+        cb.logger = self._logger
+        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
+        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
+        try:
+            addLoggerProxy(ctypes.byref(cb))
+        except Exception:
+            pass
+        self.callbacks = cb
+        _CALLBACKS_KEPT.append((self._logger, cb))
+        self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=info.unzipdir,
+                             modelIdentifier=md.coSimulation.modelIdentifier, instanceName=info.name)
+        self.fn = self.fmu._functions
+
+    def take_messages(self):
+        msgs = self.messages
+        self.messages = []
+        return msgs
+
+
+class GetOp:
+    """fmi2Get* of a block of one component's connected outputs of one type, into the shared
+    buffer. `run()` makes the call (a closure over these fields: the hot loop's fast path)."""
+    __slots__ = ("fn", "c", "vr", "n", "buf", "ci", "call", "run")
+
+    def __init__(self, fn, c, vr, n, buf, ci, call):
+        self.fn, self.c, self.vr, self.n, self.buf, self.ci, self.call = fn, c, vr, n, buf, ci, call
+
+        def run():
+            s = fn(c, vr, n, buf)
+            if s > 1:
+                raise StepFailed(ci, call, s)
+
+        self.run = run
+
+
+class SetOp:
+    """fmi2Set* of one component's connected inputs of one type, gathered from the shared buffer
+    `G` at `idx`, mapped (affine `factor`/`offset`, or `post` for Integer/Boolean mappings); not
+    sent again when the bytes equal the ones last sent (FMU inputs keep their values, and a call
+    into a pythonfmu FMU costs about 10 us, which a byte comparison saves). `run()` does it."""
+    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "G", "idx", "factor", "offset", "post", "ci", "call", "run")
+
+    def __init__(self, fn, c, vr, n, buf, view, G, idx, factor, offset, post, ci, call):
+        self.fn, self.c, self.vr, self.n, self.buf, self.view = fn, c, vr, n, buf, view
+        self.G, self.idx, self.factor, self.offset, self.post = G, idx, factor, offset, post
+        self.ci, self.call = ci, call
+        take, multiply, add = np.take, np.multiply, np.add
+        last = [None]  # the bytes last sent
+
+        def run():
+            take(G, idx, out=view)
+            if factor is not None:
+                multiply(view, factor, out=view)
+                add(view, offset, out=view)
+            if post is not None:
+                post(view)
+            sent = view.tobytes()
+            if sent == last[0]:
+                return
+            s = fn(c, vr, n, buf)
+            if s > 1:
+                raise StepFailed(ci, call, s)
+            last[0] = sent
+
+        self.run = run
+
+
+def _sequence(runs):
+    """One function running `runs` in order (the common single-call case is the call itself)."""
+    if len(runs) == 1:
+        return runs[0]
+    if not runs:
+        return _nothing
+
+    def run_all():
+        for run in runs:
+            run()
+
+    return run_all
+
+
+def _nothing():
+    pass
+
+
+class ReadOp:
+    """fmi2Get* of a block of variables of one component and type (recording, stop conditions)."""
+    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "ci", "call", "names")
+
+    def __init__(self, instance, ci, kind, variables, vrefs, names):
+        m = len(vrefs)
+        self.fn = instance.fn[GET[kind]]
+        self.c = instance.fmu.component
+        self.vr = (ctypes.c_uint * m)(*vrefs)
+        self.n = m
+        self.buf = (CTYPE[kind] * m)()
+        self.view = np.ctypeslib.as_array(self.buf)
+        self.ci = ci
+        self.call = GET[kind]
+        self.names = names
+
+    def read(self):
+        """Read the block into self.view; StepFailed on error."""
+        s = self.fn(self.c, self.vr, self.n, self.buf)
+        if s > 1:
+            raise StepFailed(self.ci, self.call, s)
+        return self.view
+
+
+def read_ops(table, variables):
+    """ReadOps for [(component, variable)], grouped per component and type in sorted order;
+    returns (ops, [(name, kind)] in the ops' column order)."""
+    comps = table.system.comps
+    groups = {}
+    for ci, var in variables:
+        kind = KIND[comps[ci].vars[var].type]
+        groups.setdefault((ci, kind), []).append(var)
+    ops, columns = [], []
+    for (ci, kind), vars_ in sorted(groups.items()):
+        names = [f"{comps[ci].name}.{v}" for v in vars_]
+        ops.append(ReadOp(table.instances[ci], ci, kind, vars_, [comps[ci].vars[v].valueReference for v in vars_],
+                          names))
+        columns += [(name, kind) for name in names]
+    return ops, columns
+
+
+class InstanceTable:
+    """The run's FMU instances (SSD order) and the prepared value transfers between them."""
+
+    def __init__(self, system, plan):
+        self.system = system
+        self.plan = plan
+        self.debug = False
+        self.instances = []
+        self.by_name = {}
+        self.t = plan.start  # the time error messages name
+
+    # ---- errors -------------------------------------------------------------------------
+    def error(self, ci, call, exc=None, status=None):
+        """A SimulationError for a failed call of component ci, with the messages it logged."""
+        inst = self.instances[ci]
+        inst.failed = True
+        texts = []
+        for _, _, m in inst.take_messages():
+            if "PyObject_CallMethod\n" in m:  # pythonfmu: keep the Python exception text
+                m = m.split("PyObject_CallMethod\n", 1)[1]
+            if m and m not in texts:
+                texts.append(m.strip())
+        text = "; ".join(texts)
+        if status is not None:
+            what = f"returned status {STATUS[status] if 0 <= status < len(STATUS) else status}"
+        elif exc is not None and not texts:
+            what = f"failed ({exc})"
+        else:
+            what = "failed"
+        detail = f": {text}" if text else ""
+        return SimulationError(f"component {inst.name!r}: {call} {what} at t={self.t:g} s{detail}")
+
+    def call(self, ci, call, fn, *args):
+        """Call an fmpy method; wrap failures with the component's logged messages."""
+        try:
+            return fn(*args)
+        except SSPError:
+            raise
+        except Exception as exc:
+            raise self.error(ci, call, exc) from None
+
+    # ---- life cycle ---------------------------------------------------------------------
+    def instantiate(self):
+        """Instantiate every FMU, set up the experiment, enter initialization mode and set the
+        plan's parameters and start values (batched per component and type)."""
+        p = self.plan
+        for info in self.system.comps:
+            try:
+                inst = FmuInstance(info, self)
+            except Exception as exc:
+                raise SimulationError(f"component {info.name!r}: cannot load the FMU binary "
+                                      f"({self.system.namer(info.decl.fmu_path)}): {exc}") from None
+            self.instances.append(inst)
+            self.by_name[inst.name] = inst
+            ci = len(self.instances) - 1
+            self.call(ci, "fmi2Instantiate", inst.fmu.instantiate, False, inst.callbacks, True)
+            inst.instantiated = True
+        for ci, inst in enumerate(self.instances):
+            self.call(ci, "fmi2SetupExperiment", inst.fmu.setupExperiment, None, p.start, p.stop)
+            self.call(ci, "fmi2EnterInitializationMode", inst.fmu.enterInitializationMode)
+            inst.initialized = True
+        per = {}
+        for (ci, var), value in p.params.items():
+            v = self.system.comps[ci].vars[var]
+            per.setdefault((ci, v.type), ([], []))
+            per[(ci, v.type)][0].append(v.valueReference)
+            per[(ci, v.type)][1].append(value)
+        for (ci, vtype), (vrs, values) in sorted(per.items()):
+            fmu = self.instances[ci].fmu
+            setter = {"Real": fmu.setReal, "Integer": fmu.setInteger, "Enumeration": fmu.setInteger,
+                      "Boolean": fmu.setBoolean, "String": fmu.setString}[vtype]
+            self.call(ci, f"setting parameters/start values ({vtype})", setter, vrs, values)
+
+    def free(self):
+        for inst in self.instances:
+            if inst.failed:
+                # FMI 2.0: after an error/fatal status only fmi2FreeInstance may be called; a
+                # pythonfmu instance that raised is left alone (freeing it can crash at exit).
+                continue
+            try:
+                if inst.initialized:
+                    inst.fmu.terminate()
+            except Exception:
+                pass
+            try:
+                # fmi2FreeInstance only: unloading a pythonfmu library (dlclose) while the
+                # interpreter still holds objects created by it crashes the process at exit,
+                # so the library stays loaded (dlopen of the same file reuses it next run).
+                if inst.instantiated:
+                    inst.fmu.fmi2FreeInstance(inst.fmu.component)
+            except Exception:
+                pass
+        self.instances = []
+
+    def messages(self):
+        return {inst.name: list(inst.messages) for inst in self.instances if inst.messages}
+
+    # ---- prepared transfers -------------------------------------------------------------
+    def prepare(self):
+        """Build the shared output buffers, the GetOps and SetOps per component and the doStep
+        functions."""
+        sysm = self.system
+        comps = sysm.comps
+        n = len(comps)
+        slots = {"Real": {}, "Integer": {}, "Boolean": {}}  # (ci, var) -> position in the type's buffer
+        for lk in sysm.links:
+            slots[lk.vtype].setdefault((lk.src, lk.src_var), None)
+        self.G = {}
+        self.gets = [[] for _ in range(n)]
+        for kind, d in slots.items():
+            by_comp = {}
+            for (ci, var) in d:
+                by_comp.setdefault(ci, []).append(var)
+            G = np.zeros(max(sum(len(v) for v in by_comp.values()), 1), dtype=NPTYPE[kind])
+            self.G[kind] = G
+            pos = 0
+            for ci in sorted(by_comp):
+                vars_ = by_comp[ci]
+                m = len(vars_)
+                for j, var in enumerate(vars_):
+                    d[(ci, var)] = pos + j
+                vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
+                buf = (CTYPE[kind] * m).from_address(G.ctypes.data + pos * G.itemsize)
+                inst = self.instances[ci]
+                self.gets[ci].append(GetOp(inst.fn[GET[kind]], inst.fmu.component, vr, m, buf, ci, GET[kind]))
+                pos += m
+        self.sets = [[] for _ in range(n)]
+        by_dst = {}
+        for lk in sysm.links:
+            by_dst.setdefault((lk.dst, lk.vtype), []).append(lk)
+        for (ci, kind), lks in sorted(by_dst.items()):
+            m = len(lks)
+            vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
+            buf = (CTYPE[kind] * m)()
+            idx = np.array([slots[kind][(lk.src, lk.src_var)] for lk in lks], dtype=np.intp)
+            fac = np.array([lk.factor for lk in lks])
+            off = np.array([lk.offset for lk in lks])
+            affine = kind == "Real" and (np.any(fac != 1.0) or np.any(off != 0.0))
+            inst = self.instances[ci]
+            self.sets[ci].append(SetOp(inst.fn[SET[kind]], inst.fmu.component, vr, m, buf,
+                                       np.ctypeslib.as_array(buf), self.G[kind], idx, fac if affine else None,
+                                       off if affine else None, _mapper(kind, lks), ci, SET[kind]))
+        # the hot loop's calls, one function per component
+        self.getters = [_sequence([op.run for op in ops]) for ops in self.gets]
+        self.setters = [_sequence([op.run for op in ops]) for ops in self.sets]
+        self.do_steps = [self._do_step(ci) for ci in range(n)]
+        self.steppers = [self._stepper(ci) for ci in range(n)]
+        # components whose connected outputs change when their inputs are set
+        self.has_ft = [bool(sysm.graph.feedthrough_outputs[ci]) and bool(self.gets[ci]) for ci in range(n)]
+
+    def _do_step(self, ci):
+        """do_step(t, dt) of component ci: fmi2DoStep only."""
+        inst = self.instances[ci]
+        fn, c = inst.fn["fmi2DoStep"], inst.fmu.component
+
+        def do_step(t, dt):
+            s = fn(c, t, dt, 1)
+            if s > 1:
+                raise StepFailed(ci, "fmi2DoStep", s)
+
+        return do_step
+
+    def _stepper(self, ci):
+        """step(t, dt) of component ci: set its inputs, doStep, read its outputs."""
+        inst = self.instances[ci]
+        fn, c = inst.fn["fmi2DoStep"], inst.fmu.component
+        set_, get = self.setters[ci], self.getters[ci]
+
+        def step(t, dt):
+            set_()
+            s = fn(c, t, dt, 1)
+            if s > 1:
+                raise StepFailed(ci, "fmi2DoStep", s)
+            get()
+
+        return step
+
+    def get(self, ci):
+        """Read ci's connected outputs into the shared buffers."""
+        self.getters[ci]()
+
+    def set(self, ci):
+        """Set ci's connected inputs from the shared buffers (skipped when unchanged)."""
+        self.setters[ci]()
+
+    def initialize(self):
+        """Exchange values in dependency order inside initialization mode, leave it, exchange
+        again (an algebraic loop, possible with Jacobi only, is iterated n times)."""
+        n = len(self.instances)
+        for ci in range(n):
+            self.get(ci)
+        order, cycle = toposort(n, self.system.graph.edges)
+        passes = 1
+        if cycle:  # only reachable with Jacobi: iterate like a fixed-point exchange
+            order, passes = list(range(n)), n
+        for _ in range(passes):
+            for ci in order:
+                self.set(ci)
+                self.get(ci)
+        for ci, inst in enumerate(self.instances):
+            self.call(ci, "fmi2ExitInitializationMode", inst.fmu.exitInitializationMode)
+        for _ in range(passes):
+            for ci in order:
+                self.get(ci)
+                self.set(ci)
+        for ci in range(n):
+            self.get(ci)
+
+    def final(self):
+        """{'component.variable': value} of every input and output now."""
+        final = {}
+        for ci, inst in enumerate(self.instances):
+            groups = {}
+            for v in inst.info.md.modelVariables:
+                if v.causality in ("input", "output") and v.type in KIND:
+                    groups.setdefault(KIND[v.type], []).append(v)
+            for kind, vs in groups.items():
+                getter = {"Real": inst.fmu.getReal, "Integer": inst.fmu.getInteger,
+                          "Boolean": inst.fmu.getBoolean}[kind]
+                vals = self.call(ci, GET[kind], getter, [v.valueReference for v in vs])
+                for v, x in zip(vs, vals):
+                    final[f"{inst.name}.{v.name}"] = bool(x) if kind == "Boolean" else (
+                        int(x) if kind == "Integer" else float(x))
+        return final
+
+
+def _mapper(kind, links):
+    """In-place Integer/Boolean mapping of a SetOp's view, or None when no link maps."""
+    maps = [(j, lk.mapping) for j, lk in enumerate(links) if lk.mapping]
+    if not maps:
+        return None
+    if kind == "Boolean":
+        def post(view):
+            for j, mp in maps:
+                view[j] = int(mp.get(bool(view[j]), bool(view[j])))
+    else:
+        def post(view):
+            for j, mp in maps:
+                view[j] = mp.get(int(view[j]), int(view[j]))
+    return post

@@ -1,0 +1,191 @@
+"""What watches a run: recording, stop conditions, the progress bar and profiling.
+
+The execution calls every observer after initialization (`start`), once per macro step after the
+algorithm has stepped the components (`step`, in list order: stop conditions first, so that the
+recorder knows whether the run stops here), and at the end (`finish`). They share one `StepInfo`
+that the algorithm fills in."""
+import sys
+import time
+
+import numpy as np
+
+from .instances import read_ops
+
+RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_}
+
+
+class StepInfo:
+    """The state of the run after a macro step, written by the algorithm and the observers."""
+    __slots__ = ("t", "steps", "changed", "mode_changed", "record_every", "last", "fired")
+
+    def __init__(self, t, record_every):
+        self.t = t  # time reached
+        self.steps = 0  # macro steps taken
+        self.changed = None  # per component: stepped or refreshed in this step (None: all)
+        self.mode_changed = False  # the schedule picks another mode for the next step
+        self.record_every = record_every  # the current recording interval, in macro steps
+        self.last = False  # the stop time is reached
+        self.fired = None  # name of the stop signal that is true, once one is
+
+
+class Observer:
+    def start(self, info):
+        pass
+
+    def step(self, info):
+        pass
+
+    def finish(self, info):
+        pass
+
+
+class StopConditions(Observer):
+    """Stops the run at the first communication point where a stop signal (Boolean output) is
+    true; re-reads the signals only of components that changed in the step."""
+
+    def __init__(self, table, stops):
+        self.ops, _ = read_ops(table, stops)
+        self.comps = [op.ci for op in self.ops]
+
+    def check(self):
+        """Name of the first stop signal that is true, or None."""
+        for op in self.ops:
+            view = op.read()
+            for j in range(op.n):
+                if view[j]:
+                    return op.names[j]
+        return None
+
+    def start(self, info):
+        if self.ops:
+            info.fired = self.check()
+
+    def step(self, info):
+        if self.ops and (info.changed is None or any(info.changed[ci] for ci in self.comps)):
+            info.fired = self.check()
+
+
+class Recorder(Observer):
+    """Rows of the recorded variables: at the start, every `record_every` macro steps, whenever
+    the schedule changes mode, when a stop condition fires and at the end."""
+
+    def __init__(self, table, record, refresh, capacity=1024):
+        self.record_names = [f"{table.system.comps[ci].name}.{var}" for ci, var in record]
+        self.ops, columns = read_ops(table, record)
+        self.columns = dict(columns)
+        self.col_of = {name: j for j, (name, _) in enumerate(columns)}
+        self.refresh = refresh  # brings the values to record up to date (the algorithm's)
+        self.rows = np.zeros((max(capacity, 2), len(columns)))
+        self.times = np.zeros(len(self.rows))
+        self.count = 0
+        self.since = 0
+
+    def record(self, t):
+        if self.count == len(self.rows):
+            self.rows = np.concatenate([self.rows, np.zeros_like(self.rows)])
+            self.times = np.concatenate([self.times, np.zeros_like(self.times)])
+        self.refresh()
+        r = self.rows[self.count]
+        col = 0
+        for op in self.ops:
+            r[col:col + op.n] = op.read()
+            col += op.n
+        self.times[self.count] = t
+        self.count += 1
+        self.since = 0
+
+    def start(self, info):
+        self.record(info.t)
+
+    def step(self, info):
+        self.since += 1
+        if self.since >= info.record_every or info.mode_changed or info.fired is not None or info.last:
+            self.record(info.t)
+
+    def finish(self, info):
+        if self.times[self.count - 1] != info.t:
+            self.record(info.t)
+
+    def data(self):
+        """The rows as a numpy structured array: 'time', then the recorded variables in the
+        order asked for."""
+        n = self.count
+        dtype = [("time", np.float64)] + [(name, RESULT_DTYPE[self.columns[name]]) for name in self.record_names]
+        data = np.zeros(n, dtype=dtype)
+        data["time"] = self.times[:n]
+        for name in self.record_names:
+            col = self.rows[:n, self.col_of[name]]
+            data[name] = col.astype(RESULT_DTYPE[self.columns[name]]) if self.columns[name] != "Boolean" else col != 0
+        return data
+
+
+class ProgressBar(Observer):
+    """tqdm on stderr: communication steps of a fixed-step run (from 2000 steps on), simulated
+    seconds of a scheduled one."""
+
+    MIN_STEPS = 2000
+
+    def __init__(self, plan):
+        self.plan = plan
+        self.bar = None
+
+    def start(self, info):
+        try:
+            from tqdm import tqdm  # optional: no bar without it
+        except ImportError:
+            return
+        p = self.plan
+        if p.schedule is not None:
+            self.bar = tqdm(total=p.stop - p.start, file=sys.stderr, unit="s", leave=False, mininterval=0.5)
+        elif p.n_steps >= self.MIN_STEPS:
+            self.chunk = max(1, p.n_steps // 200)
+            self.bar = tqdm(total=p.n_steps, file=sys.stderr, unit="step", leave=False, mininterval=0.5)
+
+    def step(self, info):
+        bar = self.bar
+        if bar is None:
+            return
+        if self.plan.schedule is not None:
+            bar.update(info.t - self.plan.start - bar.n)
+        elif info.steps % self.chunk == 0:
+            bar.update(info.steps - bar.n)
+
+    def close(self):
+        if self.bar is not None:
+            self.bar.close()
+            self.bar = None
+
+    def finish(self, info):
+        self.close()
+
+
+class Profiler(Observer):
+    """Wall time per component (set + doStep + get in the stepping pass) and of the loop; the
+    master's share is the rest. Wraps the algorithm's per-component step functions."""
+
+    def __init__(self, algorithm, names):
+        self.names = names
+        self.spent = [0.0] * len(names)
+        perf = time.perf_counter
+        spent = self.spent
+
+        def timed(ci, step):
+            def step_timed(t, dt):
+                w0 = perf()
+                step(t, dt)
+                spent[ci] += perf() - w0
+            return step_timed
+
+        algorithm.steppers = [timed(ci, step) for ci, step in enumerate(algorithm.steppers)]
+        self.wall0 = 0.0
+        self.total = 0.0
+
+    def start(self, info):
+        self.wall0 = time.perf_counter()
+
+    def finish(self, info):
+        self.total = time.perf_counter() - self.wall0
+
+    def report(self):
+        return {"components": dict(zip(self.names, self.spent)), "loop": self.total,
+                "master": self.total - sum(self.spent)}

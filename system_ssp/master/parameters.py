@@ -1,0 +1,162 @@
+"""Parameter and start values: from the SSD's bindings, the caller's parameter sets and
+overrides, each checked against the FMU variable's type, finiteness and unit."""
+import math
+import numbers
+from pathlib import Path
+
+import numpy as np
+
+from ..errors import SSPError
+from ..ssp import reader
+from ..ssp.units import conversion, describe
+from .names import near, split_name
+
+
+def _bad(value, label, expected):
+    return SSPError(f"{label}: {value!r} is not a valid value: expected {expected}")
+
+
+def _real(value, label):
+    if isinstance(value, bool):
+        raise _bad(value, label, "a Real number")
+    if isinstance(value, str):
+        try:
+            value = float(value.strip())
+        except ValueError:
+            raise _bad(value, label, "a Real number") from None
+    elif isinstance(value, numbers.Real):
+        value = float(value)
+    else:
+        raise _bad(value, label, "a Real number")
+    if not math.isfinite(value):
+        raise SSPError(f"{label}: {value!r} is not a valid value: expected a finite Real number")
+    return value
+
+
+def _integer(value, label):
+    if isinstance(value, bool):
+        raise _bad(value, label, "an Integer")
+    if isinstance(value, str):
+        try:
+            value = int(value.strip())
+        except ValueError:
+            raise _bad(value, label, "an Integer") from None
+    elif isinstance(value, numbers.Integral):
+        value = int(value)
+    elif isinstance(value, numbers.Real) and math.isfinite(value) and float(value).is_integer():
+        value = int(value)
+    else:
+        raise _bad(value, label, "an Integer")
+    if not -2**31 <= value < 2**31:
+        raise SSPError(f"{label}: {value} is out of range for a 32-bit FMI Integer")
+    return value
+
+
+def _boolean(value, label):
+    if isinstance(value, (bool, np.bool_)):
+        return bool(value)
+    if isinstance(value, numbers.Integral) and value in (0, 1):
+        return bool(value)
+    if isinstance(value, str) and value.strip().lower() in ("true", "false", "1", "0"):
+        return value.strip().lower() in ("true", "1")
+    raise _bad(value, label, "a Boolean (true/false)")
+
+
+def _string(value, label):
+    if isinstance(value, str):
+        return value
+    raise _bad(value, label, "a String")
+
+
+_COERCE = {"Real": _real, "Integer": _integer, "Enumeration": _integer, "Boolean": _boolean, "String": _string}
+
+
+def coerce(value, vtype, label):
+    """Check and convert a caller/SSV value for an FMU variable of type `vtype`."""
+    if vtype not in _COERCE:
+        raise SSPError(f"{label}: variables of type {vtype} cannot be set")
+    return _COERCE[vtype](value, label)
+
+
+def settable(v):
+    """Whether a variable may get a value before initialization (FMI 2.0 start values)."""
+    if v.variability == "constant" or v.causality in ("independent", "calculatedParameter"):
+        return False
+    return v.causality in ("parameter", "input") or v.initial in ("exact", "approx")
+
+
+def resolve_parameter(system, comp, var, value, vtype=None, unit=None, units=None, origin="", label=None):
+    """Check one value for comp.var; returns the value converted to the FMU's type and unit."""
+    label = label or f"{comp.name}.{var}"
+    where = f"{origin}: {label}" if origin else label
+    v = comp.vars.get(var)
+    if v is None:
+        raise SSPError(f"{where}: component {comp.name!r} has no variable {var!r}{near(var, comp.vars)}")
+    if not settable(v):
+        raise SSPError(f"{where}: cannot be set (causality {v.causality}, variability {v.variability}, "
+                       f"initial {v.initial}); only parameters, inputs and variables with a start value can")
+    if v.type == "Enumeration" and isinstance(value, str) and vtype == "Enumeration":
+        items = {it.name: int(it.value) for it in getattr(v.declaredType, "items", [])}
+        if value not in items:
+            raise SSPError(f"{where}: {value!r} is not an item of enumeration {v.declaredType.name}")
+        value = items[value]
+    if vtype is not None and vtype != v.type:
+        ok = (vtype == "Integer" and v.type in ("Real", "Enumeration")) or (vtype == "Real" and v.type == "Integer"
+                                                                            and float(value).is_integer())
+        if not ok:
+            raise SSPError(f"{where}: value {value!r} of type {vtype} given, but the variable has type {v.type}")
+    value = coerce(value, v.type, where)
+    if unit is not None and v.type == "Real":
+        target = system.units.var_unit(comp, var)
+        if target is not None and target != unit:
+            su = system.units.unit(unit, comp, units, where)
+            tu = system.units.unit(target, comp, None, where)
+            conv = conversion(su, tu)
+            if conv is None:
+                raise SSPError(f"{where}: value in unit {unit!r} ({describe(su)}) cannot be converted to the "
+                               f"variable's unit {target!r} ({describe(tu)})")
+            value = conv[0] * value + conv[1]
+    return value
+
+
+def read_parameter_set(system, ps):
+    """A caller's parameter set: a path, or a name inside the .ssp (at its root or in resources/)."""
+    p = Path(ps)
+    if not p.is_file() and system.archive_root is not None:
+        cand = [system.archive_root / ps, system.archive_root / "resources" / ps]
+        p = next((c for c in cand if c.is_file()), p)
+    if not p.is_file():
+        where = f" (also looked inside {system.path})" if system.archive_root is not None else ""
+        raise SSPError(f"parameter set {ps!r}: file not found{where}")
+    return reader.read_parameter_set_file(p, system.namer, system.validate)
+
+
+def collect_parameters(system, parameter_sets=None, parameters=None):
+    """All start values for a run: {(comp index, var): value}, later sources overriding earlier:
+    the SSD's component bindings, the root system's bindings, `parameter_sets`, `parameters`."""
+    out = {}
+
+    def put(comp, var, pv):
+        out[(comp.index, var)] = resolve_parameter(system, comp, var, pv.value, pv.type, pv.unit, pv.units,
+                                                   pv.origin, f"{comp.name}.{var}")
+
+    for comp in system.comps:
+        for pv in comp.decl.parameters:
+            if pv.name not in comp.vars:
+                raise SSPError(f"{pv.origin}: parameter {pv.name!r} bound to component {comp.name!r}: no such "
+                               f"variable{near(pv.name, comp.vars)}")
+            put(comp, pv.name, pv)
+    for pv in system.desc.parameters:
+        comp, var = split_name(system.comps, pv.name, f"{pv.origin}: parameter")
+        put(comp, var, pv)
+    for ps in parameter_sets or []:
+        for pv in read_parameter_set(system, ps):
+            try:
+                comp, var = split_name(system.comps, pv.name, "parameter")
+            except SSPError as exc:
+                raise SSPError(f"{pv.origin}: {exc}") from None
+            put(comp, var, pv)
+    for name, value in (parameters or {}).items():
+        comp, var = split_name(system.comps, name, "parameter")
+        out[(comp.index, var)] = resolve_parameter(system, comp, var, value, None, None, None, "", name)
+    return out

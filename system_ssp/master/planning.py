@@ -1,0 +1,170 @@
+"""Turning `System.run`'s arguments and the SSD's master annotation into a `RunPlan`."""
+import math
+import numbers
+
+from ..errors import SSPError
+from ..ssp.reader import ANNOTATION_TYPE
+from .connections import KIND, NUMERIC
+from .names import near, split_name
+from .parameters import collect_parameters
+from .plan import ALGORITHMS, RunPlan, ScheduleMode, SchedulePlan
+
+
+def _order(system, order, algo):
+    names = [c.name for c in system.comps]
+    if order is None:
+        order = system.desc.master.order
+    if order is not None:
+        if isinstance(order, str):
+            order = order.replace(",", " ").split()
+        order = list(order)
+        unknown = [o for o in order if o not in system.by_name]
+        dup = sorted({o for o in order if order.count(o) > 1})
+        missing = [n for n in names if n not in order]
+        if unknown or dup or missing:
+            parts = []
+            if unknown:
+                parts.append("unknown " + ", ".join(f"{u!r}{near(u, names)}" for u in unknown))
+            if dup:
+                parts.append("listed more than once: " + ", ".join(dup))
+            if missing:
+                parts.append("missing: " + ", ".join(missing))
+            raise SSPError(f"component order {order}: must name every component exactly once ("
+                           + "; ".join(parts) + ")")
+        return [system.by_name[o].index for o in order]
+    if algo == "gauss-seidel":
+        return system.graph.order()
+    return list(range(len(system.comps)))
+
+
+def _multiples(system, step_multiples):
+    mult = [1] * len(system.comps)
+    sm = dict(system.desc.master.step_multiples)
+    sm.update(step_multiples or {})
+    for name, k in sm.items():
+        if name not in system.by_name:
+            raise SSPError(f"step multiple for unknown component {name!r}{near(name, system.by_name)}")
+        if isinstance(k, bool) or not isinstance(k, numbers.Integral) or k < 1:
+            raise SSPError(f"step multiple of {name!r} must be an integer >= 1, got {k!r}")
+        mult[system.by_name[name].index] = int(k)
+    return mult
+
+
+def _stops(system, stop_when):
+    stops = []
+    for s in (list(system.desc.master.stop_conditions) if stop_when is None else list(stop_when)):
+        comp, var = split_name(system.comps, s, "stop condition")
+        v = comp.vars[var]
+        if v.type != "Boolean":
+            raise SSPError(f"stop condition {s!r} must be a Boolean variable, it is {v.type}")
+        stops.append((comp.index, var))
+    return stops
+
+
+def _recorded(system, outputs):
+    if outputs is None:
+        return [(c.index, v.name) for c in system.comps for v in c.md.modelVariables
+                if v.causality in ("input", "output") and v.type in NUMERIC]
+    if isinstance(outputs, str):
+        outputs = [o for o in outputs.split(",") if o]
+    rec = []
+    for o in outputs:
+        comp, var = split_name(system.comps, o, "output")
+        if comp.vars[var].type not in NUMERIC:
+            raise SSPError(f"output {o!r}: variables of type {comp.vars[var].type} cannot be recorded")
+        if (comp.index, var) not in rec:
+            rec.append((comp.index, var))
+    return rec
+
+
+def make_plan(system, stop_time=None, step_size=None, start_time=None, parameters=None, parameter_sets=None,
+              outputs=None, algorithm=None, order=None, step_multiples=None, stop_when=None, record_every=1,
+              schedule=True, profile=False):
+    """A RunPlan from the arguments of System.run (None: the SSD's own settings)."""
+    d, m = system.desc, system.desc.master
+    start = start_time if start_time is not None else (d.start_time if d.start_time is not None else 0.0)
+    stop = stop_time if stop_time is not None else d.stop_time
+    h = step_size if step_size is not None else m.step_size
+    if stop is None:
+        raise SSPError(f"{d.display}: no stop time: pass stop_time (CLI --stop-time) or set "
+                       "ssd:DefaultExperiment stopTime")
+    if h is None:
+        raise SSPError(f"{d.display}: no step size: pass step_size (CLI --step-size) or give one in the "
+                       f"{ANNOTATION_TYPE} annotation (nc:Master stepSize)")
+    for label, x in (("start time", start), ("stop time", stop), ("step size", h)):
+        if isinstance(x, bool) or not isinstance(x, numbers.Real) or not math.isfinite(x):
+            raise SSPError(f"{label} must be a finite number, got {x!r}")
+    start, stop, h = float(start), float(stop), float(h)
+    if h <= 0:
+        raise SSPError(f"step size must be positive, got {h}")
+    if stop < start:
+        raise SSPError(f"stop time {stop} is before start time {start}")
+    algo = algorithm or m.algorithm or "gauss-seidel"
+    if algo not in ALGORITHMS:
+        raise SSPError(f"unknown algorithm {algo!r} (expected one of: {', '.join(ALGORITHMS)})")
+    order_idx = _order(system, order, algo)
+    mult = _multiples(system, step_multiples)
+    stops = _stops(system, stop_when)
+    rec = _recorded(system, outputs)
+    if isinstance(record_every, bool) or not isinstance(record_every, numbers.Integral) or record_every < 1:
+        raise SSPError(f"record_every must be an integer >= 1, got {record_every!r}")
+    n_float = (stop - start) / h
+    n_steps = int(round(n_float))
+    if abs(n_float - n_steps) > 1e-9 * max(1.0, n_float):
+        n_steps = int(math.ceil(n_float))
+    params = collect_parameters(system, parameter_sets, parameters)
+    sched = None
+    if schedule and m.schedule:
+        sched = _schedule(system, algo, mult)
+    return RunPlan(start=start, stop=stop, step_size=h, n_steps=n_steps, algorithm=algo, order=tuple(order_idx),
+                   multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
+                   record_every=int(record_every), profile=bool(profile), schedule=sched)
+
+
+def _schedule(system, algorithm, multiples):
+    """Resolve the SSD's nc:Schedule against the loaded FMUs (names, types, causality)."""
+    sched = system.desc.master.schedule
+    if algorithm != "gauss-seidel":
+        raise SSPError(f"{sched.origin}: nc:Schedule runs with gauss-seidel only, not {algorithm!r}")
+    if any(k != 1 for k in multiples):
+        raise SSPError(f"{sched.origin}: nc:Schedule sets its own steps; step multiples cannot be combined "
+                       "with it")
+    names = [c.name for c in system.comps]
+
+    def output(comp, conn, types, what, origin):
+        if comp not in system.by_name:
+            raise SSPError(f"{origin}: {what} names unknown component {comp!r}{near(comp, names)}")
+        c = system.by_name[comp]
+        if conn not in c.vars:
+            raise SSPError(f"{origin}: {what} names unknown variable {comp}.{conn}{near(conn, list(c.vars))}")
+        v = c.vars[conn]
+        if v.causality != "output" or v.type not in types:
+            raise SSPError(f"{origin}: {what} {comp}.{conn} must be an output of type "
+                           f"{' or '.join(types)} (it is a {v.causality} {v.type})")
+        return c.index, conn, KIND[v.type]
+
+    modes = []
+    for m in sched.modes:
+        if m.active is None:
+            active = [True] * len(system.comps)
+        else:
+            unknown = [a for a in m.active if a not in system.by_name]
+            if unknown:
+                raise SSPError(f"{m.origin}: nc:Mode {m.name!r} active lists unknown component(s) "
+                               + ", ".join(f"{u!r}{near(u, names)}" for u in unknown))
+            active = [c.name in m.active for c in system.comps]
+        conds = tuple(output(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}",
+                             m.origin)[:2] + (vals,) for c, v, vals in m.conditions)
+        mult = [1] * len(system.comps)
+        for comp, k in m.every.items():
+            if comp not in system.by_name:
+                raise SSPError(f"{m.origin}: nc:Mode {m.name!r} every names unknown component "
+                               f"{comp!r}{near(comp, names)}")
+            if not active[system.by_name[comp].index]:
+                raise SSPError(f"{m.origin}: nc:Mode {m.name!r} every names {comp!r}, which is not active "
+                               "in that mode")
+            mult[system.by_name[comp].index] = k
+        modes.append(ScheduleMode(name=m.name, step_size=m.step_size, active=tuple(active),
+                                  record_every=m.record_every, conditions=conds, multiples=tuple(mult)))
+    events = tuple(output(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events)
+    return SchedulePlan(modes=tuple(modes), events=events, origin=sched.origin)

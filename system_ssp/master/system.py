@@ -1,0 +1,151 @@
+"""A loaded SSP system: `System(path)` reads and checks it once; `run()` simulates it any
+number of times, each with fresh FMU instances."""
+from pathlib import Path
+import shutil
+import tempfile
+import time
+from typing import Iterable, Mapping, Optional, Sequence, Union
+import zipfile
+
+from ..errors import SSPError
+from ..ssp import reader
+from .components import load_components
+from .connections import FeedthroughGraph, UnitTable, resolve_connections
+from .execution import execute
+from .info import describe_system
+from .names import split_name
+from .parameters import collect_parameters
+from .planning import make_plan
+from .result import Result, write_csv_atomic
+
+PathLike = Union[str, Path]
+
+
+class System:
+    """A loaded SSP system. Call `run()` any number of times; each run uses fresh FMU instances.
+
+    `path` is a `.ssp` archive (SystemStructure.ssd at its root), a `.ssd` file (references
+    resolved relative to its folder) or a folder holding SystemStructure.ssd. Loading checks the
+    SSD, SSV and SSM files against the SSP 1.0 schemas (`validate`), reads every FMU's model
+    description, extracts the FMUs, resolves the connections with their unit conversions and
+    the direct-feedthrough graph. Use as a context manager (or call `close()`) to delete the
+    extracted files."""
+
+    def __init__(self, path: PathLike, validate: bool = True):
+        self._tmp = Path(tempfile.mkdtemp(prefix="system_ssp_"))
+        try:
+            self._load(Path(path), validate)
+        except BaseException:
+            self.close()
+            raise
+
+    def _load(self, path, validate):
+        self.path = path
+        self.validate = validate
+        self.archive_root = None
+        if not path.exists():
+            raise SSPError(f"{path}: file not found")
+        if path.is_dir():
+            ssd_path = path / "SystemStructure.ssd"
+            self.namer = reader.FileNamer()
+        elif path.suffix.lower() == ".ssp":
+            root = self._tmp / "ssp"
+            try:
+                with zipfile.ZipFile(path) as z:
+                    for n in z.namelist():
+                        target = (root / n).resolve()
+                        if not str(target).startswith(str(root.resolve())):
+                            raise SSPError(f"{path}: archive member {n!r} points outside the archive")
+                    z.extractall(root)
+            except zipfile.BadZipFile as exc:
+                raise SSPError(f"{path}: not a valid .ssp (zip) archive: {exc}") from None
+            ssd_path = root / "SystemStructure.ssd"
+            if not ssd_path.is_file():
+                raise SSPError(f"{path}: archive has no SystemStructure.ssd at its root")
+            self.namer = reader.FileNamer(root, str(path))
+            self.archive_root = root
+        else:
+            ssd_path = path
+            self.namer = reader.FileNamer()
+        self.desc = reader.parse_ssd(ssd_path, self.namer, validate)
+        if not self.desc.components:
+            raise SSPError(f"{self.desc.display}: the system has no components")
+        self.comps = load_components(self.desc, self._tmp / "fmu", self.namer, validate)
+        self.by_name = {c.name: c for c in self.comps}
+        self.units = UnitTable(self.desc, self.comps)
+        self.links = resolve_connections(self.desc, self.comps, self.by_name, self.units)
+        self.graph = FeedthroughGraph(self.comps, self.links)
+
+    # ---- queries ------------------------------------------------------------------------
+    def default_order(self) -> list:
+        """Component names in dependency order (feedthrough edges), ties by SSD order.
+
+        Raises SSPError naming the components of an algebraic loop."""
+        return [self.comps[i].name for i in self.graph.order()]
+
+    def split_name(self, name: str, what: str = "variable"):
+        """'component.variable' -> (ComponentInfo, variable name); SSPError with suggestions."""
+        return split_name(self.comps, name, what)
+
+    def var_unit(self, comp, var) -> Optional[str]:
+        return self.units.var_unit(comp, var)
+
+    def collect_parameters(self, parameter_sets=None, parameters=None) -> dict:
+        """All start values for a run: {(comp index, var): value}, later sources overriding earlier."""
+        return collect_parameters(self, parameter_sets, parameters)
+
+    def info(self) -> str:
+        """Human-readable description (components, connectors with units, bindings, experiment)."""
+        return describe_system(self)
+
+    # ---- running ------------------------------------------------------------------------
+    def run(self, stop_time: Optional[float] = None, step_size: Optional[float] = None,
+            start_time: Optional[float] = None, parameters: Optional[Mapping[str, object]] = None,
+            parameter_sets: Optional[Sequence[PathLike]] = None, outputs: Union[None, str, Iterable[str]] = None,
+            algorithm: Optional[str] = None, order: Union[None, str, Sequence[str]] = None,
+            step_multiples: Optional[Mapping[str, int]] = None, stop_when: Optional[Sequence[str]] = None,
+            output_file: Optional[PathLike] = None, progress: bool = False, record_every: int = 1,
+            schedule: bool = True, profile: bool = False) -> Result:
+        """Run one simulation with fresh FMU instances; see `system_ssp.simulate` for the
+        arguments. schedule=False runs a system that has an nc:Schedule with the fixed step."""
+        wall0 = time.perf_counter()
+        plan = make_plan(self, stop_time, step_size, start_time, parameters, parameter_sets, outputs, algorithm,
+                         order, step_multiples, stop_when, record_every, schedule, profile)
+        result = execute(self, plan, progress)
+        result.wall_time = time.perf_counter() - wall0
+        if output_file is not None:
+            write_csv_atomic(result.data, output_file)
+        return result
+
+    # ---- cleanup ------------------------------------------------------------------------
+    def close(self) -> None:
+        if getattr(self, "_tmp", None) is not None:
+            shutil.rmtree(self._tmp, ignore_errors=True)
+            self._tmp = None
+
+    def __enter__(self) -> "System":
+        return self
+
+    def __exit__(self, *exc) -> None:
+        self.close()
+
+    def __del__(self):
+        try:
+            self.close()
+        except Exception:
+            pass
+
+
+def simulate(path: PathLike, stop_time: Optional[float] = None, step_size: Optional[float] = None,
+             start_time: Optional[float] = None, parameters: Optional[Mapping[str, object]] = None,
+             parameter_sets: Optional[Sequence[PathLike]] = None, outputs: Union[None, str, Iterable[str]] = None,
+             algorithm: Optional[str] = None, order: Union[None, str, Sequence[str]] = None,
+             step_multiples: Optional[Mapping[str, int]] = None, stop_when: Optional[Sequence[str]] = None,
+             output_file: Optional[PathLike] = None, progress: bool = False, validate: bool = True,
+             record_every: int = 1, schedule: bool = True, profile: bool = False) -> Result:
+    """Load and run an SSP system; returns a `Result`. See the `system_ssp` package docstring."""
+    with System(path, validate=validate) as system:
+        return system.run(stop_time=stop_time, step_size=step_size, start_time=start_time, parameters=parameters,
+                          parameter_sets=parameter_sets, outputs=outputs, algorithm=algorithm, order=order,
+                          step_multiples=step_multiples, stop_when=stop_when, output_file=output_file,
+                          progress=progress, record_every=record_every, schedule=schedule, profile=profile)

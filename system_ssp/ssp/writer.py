@@ -1,0 +1,208 @@
+"""Writing SSP 1.0 systems (.ssd) and parameter sets (.ssv) from short Python descriptions.
+
+The product's system generators (system_ssp.systems.generators) describe each system as a spec
+(components, connections, parameter files, master settings, schedule) and write it with
+`SystemWriter`. Every component lists all its inputs, outputs and parameters as SSD connectors
+with the types and units of the built FMU (read from `fmu_dir`), connections are checked against
+those connectors, numbers are written with full precision (repr), and every file is written
+atomically. The output is byte-for-byte reproducible, which `python -m system_ssp.systems
+--check` relies on.
+"""
+from pathlib import Path
+from xml.sax.saxutils import quoteattr
+
+from fmpy import read_model_description
+
+from ..atomic import write_text_atomic
+from .reader import ANNOTATION_TYPE, NS_NC, NS_SSC, NS_SSD, NS_SSV
+from .units import SI_BASE_UNITS
+
+NS_OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+NS = f'xmlns:ssd="{NS_SSD}" xmlns:ssc="{NS_SSC}" xmlns:ssv="{NS_SSV}"'
+
+
+class GeneratorError(RuntimeError):
+    """A system spec that does not match the FMUs (unknown variable, wrong causality or type)."""
+
+
+def vec(name, values):
+    """{name[1]: v1, name[2]: v2, ...}: a vector parameter as FMI structured names."""
+    return {f"{name}[{i}]": v for i, v in enumerate(values, 1)}
+
+
+def typed_value(value):
+    if isinstance(value, bool):
+        return f'<ssv:Boolean value="{str(value).lower()}"/>'
+    if isinstance(value, int):
+        return f'<ssv:Integer value="{int(value)}"/>'
+    if isinstance(value, float):
+        return f'<ssv:Real value="{value!r}"/>'
+    return f"<ssv:String value={quoteattr(value)}/>"
+
+
+def ssv_text(name, description, params):
+    lines = ['<?xml version="1.0" encoding="UTF-8"?>',
+             f'<!-- {description} -->',
+             f'<ssv:ParameterSet xmlns:ssv="{NS_SSV}" version="1.0" name={quoteattr(name)}>',
+             "  <ssv:Parameters>"]
+    for key, value in params.items():
+        lines.append(f'    <ssv:Parameter name={quoteattr(key)}>{typed_value(value)}</ssv:Parameter>')
+    lines += ["  </ssv:Parameters>", "</ssv:ParameterSet>", ""]
+    return "\n".join(lines)
+
+
+def connector_xml(var):
+    if var.type == "Real":
+        t = f'<ssc:Real unit="{var.unit}"/>' if var.unit else "<ssc:Real/>"
+    else:
+        t = f"<ssc:{var.type}/>"
+    return f'        <ssd:Connector name={quoteattr(var.name)} kind="{var.causality}">{t}</ssd:Connector>'
+
+
+class SystemWriter:
+    """Writes systems into `directory` (`<name>.ssd`) and parameter sets into
+    `directory/parameters/`, with connectors read from the FMUs in `fmu_dir`."""
+
+    def __init__(self, directory, fmu_dir):
+        self.directory = Path(directory)
+        self.parameters = self.directory / "parameters"
+        self.fmu_dir = Path(fmu_dir)
+        self.written = []
+        self._fmus = {}
+
+    def fmu_variables(self, fmu_name):
+        """(model variables, {unit name: BaseUnit}) of build/fmus/<fmu_name>.fmu."""
+        if fmu_name not in self._fmus:
+            path = self.fmu_dir / f"{fmu_name}.fmu"
+            if not path.is_file():
+                raise GeneratorError(f"{path} not found: build the FMUs first (python build_fmus.py)")
+            md = read_model_description(str(path))
+            self._fmus[fmu_name] = (md.modelVariables, {u.name: u.baseUnit for u in md.unitDefinitions})
+        return self._fmus[fmu_name]
+
+    def _write(self, path, text):
+        path.parent.mkdir(parents=True, exist_ok=True)
+        write_text_atomic(path, text)
+        self.written.append(path)
+
+    def ssv(self, file_stem, description, params, name=None):
+        """Write parameters/<file_stem>.ssv (ssv:ParameterSet name `name`, default file_stem)."""
+        self._write(self.parameters / f"{file_stem}.ssv", ssv_text(name or file_stem, description, params))
+
+    def ssv_copy(self, source_stem, file_stem):
+        """parameters/<file_stem>.ssv with the content of parameters/<source_stem>.ssv (written
+        before): the same parameter set under another system's name."""
+        self._write(self.parameters / f"{file_stem}.ssv", (self.parameters / f"{source_stem}.ssv").read_text())
+
+    def ssd(self, name, spec):
+        """Write <name>.ssd from a spec: components as (instance, FMU model identifier, [parameter
+        files in parameters/, without .ssv]), connections as (source, output, destination, input,
+        n) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar, optional "stop"
+        Boolean outputs, "order", "stop_time", "step_size", and "schedule": {"modes": [(name,
+        step, active components or None, recordEvery, [(component, connector, [values])][,
+        {component: k}])], "events": [(component, connector)]} for an nc:Schedule (the optional
+        dict: components stepped every k-th step of the mode). libcosim applies only a
+        component's first ParameterBinding: put the one that matters first."""
+        self._write(self.directory / f"{name}.ssd", self.ssd_text(name, spec))
+
+    def ssd_text(self, name, spec):
+        all_units = {}
+        comp_vars = {}
+        out = ['<?xml version="1.0" encoding="UTF-8"?>',
+               # Namespace on the root: libcosim's parser takes xmlns attributes on inner
+               # elements for child elements.
+               f'<ssd:SystemStructureDescription {NS} xmlns:osp="{NS_OSP}" version="1.0" name="{name}">',
+               f'  <ssd:System name="{name}" description={quoteattr(spec["description"])}>',
+               "    <ssd:Elements>"]
+        for inst, fmu, concerns in spec["components"]:
+            variables, units = self.fmu_variables(fmu)
+            all_units.update(units)
+            comp_vars[inst] = {v.name: v for v in variables}
+            out.append(f'      <ssd:Component name="{inst}" type="application/x-fmu-sharedlibrary" '
+                       f'source="resources/{fmu}.fmu">')
+            out.append("        <ssd:Connectors>")
+            out += ["  " + connector_xml(v) for v in variables if v.causality in ("input", "output", "parameter")]
+            out.append("        </ssd:Connectors>")
+            bindings = [f'<ssd:ParameterBinding source="parameters/{c}.ssv"/>' for c in concerns]
+            if bindings:  # the schema refuses an empty ParameterBindings element
+                out.append("        <ssd:ParameterBindings>")
+                out += [f"          {b}" for b in bindings]
+                out.append("        </ssd:ParameterBindings>")
+            out.append("      </ssd:Component>")
+        out.append("    </ssd:Elements>")
+        out.append("    <ssd:Connections>")
+        for src, sname, dst, dname, n in spec["connections"]:
+            pairs = [(f"{sname}[{i}]", f"{dname}[{i}]") for i in range(1, n + 1)] if n else [(sname, dname)]
+            for a, b in pairs:
+                va, vb = comp_vars[src].get(a), comp_vars[dst].get(b)
+                if va is None or vb is None or va.causality != "output" or vb.causality != "input":
+                    raise GeneratorError(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
+                out.append(f'      <ssd:Connection startElement="{src}" startConnector="{a}" '
+                           f'endElement="{dst}" endConnector="{b}"/>')
+        out.append("    </ssd:Connections>")
+        dt = spec["step_size"]
+        for comp, var in spec.get("stop", []):
+            if comp_vars[comp][var].type != "Boolean" or comp_vars[comp][var].causality != "output":
+                raise GeneratorError(f"{name}: stop signal {comp}.{var} must be a Boolean output")
+        out += ["    <ssd:Annotations>",
+                f'      <ssc:Annotation type="{ANNOTATION_TYPE}">',
+                f'        <nc:Master xmlns:nc="{NS_NC}" stepSize="{dt!r}" algorithm="gauss-seidel">',
+                *([f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>'] if spec.get("order") else [])]
+        out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec.get("stop", [])]
+        if spec.get("schedule"):
+            out += _schedule_xml(name, spec["schedule"], comp_vars)
+        out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
+        out.append("  <ssd:Units>")
+        for uname in sorted(all_units):
+            bu = all_units[uname]
+            attrs = " ".join(f'{k}="{getattr(bu, k)}"' for k in SI_BASE_UNITS if bu is not None and getattr(bu, k))
+            out.append(f'    <ssc:Unit name="{uname}"><ssc:BaseUnit {attrs}/></ssc:Unit>')
+        out.append("  </ssd:Units>")
+        # libcosim takes its fixed step from this OSP annotation (our master reads its own).
+        out += [f'  <ssd:DefaultExperiment startTime="0.0" stopTime="{spec["stop_time"]!r}">',
+                "    <ssd:Annotations>",
+                '      <ssc:Annotation type="com.opensimulationplatform">',
+                '        <osp:Algorithm>',
+                f'          <osp:FixedStepAlgorithm baseStepSize="{dt!r}"/>',
+                "        </osp:Algorithm>",
+                "      </ssc:Annotation>",
+                "    </ssd:Annotations>",
+                "  </ssd:DefaultExperiment>"]
+        out += ["</ssd:SystemStructureDescription>", ""]
+        return "\n".join(out)
+
+
+def _schedule_xml(name, schedule, comp_vars):
+    """nc:Schedule lines, checked against the FMUs' variables."""
+    def check(comp, var, types):
+        v = comp_vars.get(comp, {}).get(var)
+        if v is None or v.causality != "output" or v.type not in types:
+            raise GeneratorError(f"{name}: schedule signal {comp}.{var} must be an output of type {' or '.join(types)}")
+
+    out = ["          <nc:Schedule>"]
+    for mode, step, active, every, when, *multiples in schedule["modes"]:
+        multiples = multiples[0] if multiples else {}
+        for comp in list(active or []) + list(multiples):
+            if comp not in comp_vars:
+                raise GeneratorError(f"{name}: schedule mode {mode} lists unknown component {comp}")
+        attrs = f'name="{mode}" stepSize="{step!r}"'
+        if active is not None:
+            attrs += f' active="{" ".join(active)}"'
+        if every != 1:
+            attrs += f' recordEvery="{every}"'
+        if multiples:
+            attrs += f' every="{" ".join(f"{c}:{k}" for c, k in multiples.items())}"'
+        if not when:
+            out.append(f"            <nc:Mode {attrs}/>")
+            continue
+        out.append(f"            <nc:Mode {attrs}>")
+        for comp, var, values in when:
+            check(comp, var, ("Integer", "Enumeration", "Boolean"))
+            out.append(f'              <nc:When component="{comp}" connector="{var}" '
+                       f'values="{" ".join(str(int(v)) for v in values)}"/>')
+        out.append("            </nc:Mode>")
+    for comp, var in schedule.get("events", []):
+        check(comp, var, ("Real",))
+        out.append(f'            <nc:NextEvent component="{comp}" connector="{var}"/>')
+    out.append("          </nc:Schedule>")
+    return out
