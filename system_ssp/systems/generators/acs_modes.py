@@ -6,7 +6,7 @@ pathlib.Path('build/fmus')) for n in ('circular_orbit', 'sun_ephemeris', 'earth_
 'paddles', 'optical_tracker', 'rigid_body')]"
     python system_ssp/systems/generate_acs_modes.py
 
-System (seed 002): the ACS mode manager (`modes`) commanding the per-mode control laws
+System (ACS mode specification): the ACS mode manager (`modes`) commanding the per-mode control laws
 (`control`) of a spacecraft with three torque coils (`coils`), a Y momentum wheel (`wheel`),
 deployable paddles (`paddles`) and a star-tracking optical system (`optical`); the truth:
 circular orbit (`orbit`), Sun (`sun`), Earth shadow (`shadow`), Sun heading in B (`sunline`),
@@ -15,7 +15,7 @@ mode manager's state values from the truth (stand-in for sensors and estimator).
 
 Step 1 s: the fastest dynamics are the tumble (2 deg/s per axis: 3.5 deg per step), the wheel
 transfer (10 s time constant) and the azimuth loop (0.05 rad/s natural frequency, omega_n h =
-0.05); the seed's shortest delays are 10 s (WMD, AMD, ODMD, GCMD) and the optical loss time 5 s.
+0.05); the specification's shortest delays are 10 s (WMD, AMD, ODMD, GCMD) and the optical loss time 5 s.
 
 Gauss-Seidel order: field, sunline, shadow, signals, optical, modes, paddles, control, coils,
 wheel, dynamics, orbit, sun. The state sources (dynamics, orbit, sun) come last, so everything
@@ -36,24 +36,20 @@ Parameter files:
   two day/night alternations (stop time 18000 s, step 5 s): Detumble/Spinup by 2620 s (dawn),
   Reorient falls back to Spinup at the first dusk (6125 s, Spinup col 5, tables), completes in
   the second daylight, Orbit Day at 9430 s, then Orbit Night/Day at 11705/13780/17280 s;
-- acs_modes_sun_facing.ssv  scenario for the long run with the seed's delays: RMD = 6000 s
+- acs_modes_sun_facing.ssv  scenario for the long run with the specification's delays: RMD = 6000 s
   exceeds the 5577 s period and Reorient falls back to Spinup at every night (Spinup col 5),
   so the deployment needs an eclipse-free orbit: see examples/acs_modes_long_run.py.
 - acs_modes_ground_command.ssv  scenario: the shortened one with a ground-command window.
 Default stop time: 6 orbits of the default orbit (33460 s), step 1 s.
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parents[1]))
 
-from generate import vec, write_ssd, write_ssv  # noqa: E402
+from components.orbit import circular
+from components.attitude import rigid_body
+from components.environment import sun
 
-from components.orbit import circular  # noqa: E402
-from components.attitude import rigid_body  # noqa: E402
+from ...ssp.writer import vec
 
 MASS, EDGES = 12.0, {"edge_a": 0.1, "edge_b": 0.2, "edge_c": 0.3}
 J = rigid_body.box_inertia(MASS, EDGES["edge_a"], EDGES["edge_b"], EDGES["edge_c"])
@@ -79,7 +75,8 @@ SHORT_STEP, SHORT_STOP = 5.0, 18000.0
 GROUND = {**SHORTENED, "signals.command_start": 12000.0, "signals.command_end": 12030.0}
 
 SYSTEM = {
-    "description": "Seed-002 ACS: mode manager, per-mode control laws, torque coils, Y momentum wheel, paddles, "
+    "description": "ACS of the mode specification: mode manager, per-mode control laws, torque coils, Y momentum "
+                   "wheel, paddles, "
                    "optical tracker, on a rigid body in a circular orbit with Sun, shadow and geomagnetic field",
     "components": [("orbit", "CircularOrbit", ["acs_modes_orbit"]),
                    ("sun", "SunEphemeris", []),
@@ -114,7 +111,8 @@ SYSTEM = {
         ("modes", "wheel_enabled", "control", "wheel_enabled", 0),
         ("modes", "time_in_mode", "control", "time_in_mode", 0),
         ("dynamics", "omega_BN_B", "control", "omega_BN_B", 3), ("field", "B_B", "control", "B_B", 3),
-        ("sunline", "sun_heading_B", "control", "sun_heading_B", 3), ("wheel", "wheel_rate", "control", "wheel_rate", 0),
+        ("sunline", "sun_heading_B", "control", "sun_heading_B", 3),
+        ("wheel", "wheel_rate", "control", "wheel_rate", 0),
         ("control", "dipole_cmd_B", "coils", "dipole_cmd_B", 3), ("field", "B_B", "coils", "B_B", 3),
         ("modes", "coils_enabled", "coils", "enabled", 0),
         ("control", "wheel_torque_cmd", "wheel", "torque_cmd", 0), ("modes", "wheel_enabled", "wheel", "enabled", 0),
@@ -130,35 +128,29 @@ SYSTEM = {
 
 
 def sun_facing():
-    """Long-run scenario with the seed's delays: an orbit whose plane faces the Sun at the epoch
+    """Long-run scenario with the specification's delays: an orbit whose plane faces the Sun at the epoch
     (node 90 deg east of the Sun, inclination chosen so the Sun is 75 deg from the plane at
     the epoch: no eclipse). The eclipse-free deployment is what RMD = 6000 s > period needs."""
-    from components.environment import sun
     ra, dec = sun.right_ascension_declination(sun.SunEphemeris().position())
     return {"orbit.raan": (ra + math.pi / 2) % (2 * math.pi), "orbit.inclination": math.radians(98.0)}
 
 
-def main():
-    p = HERE / "parameters"
-    write_ssv(p / "acs_modes_spacecraft.ssv", "acs_modes_spacecraft",
-              "12 kg host box (0.1 x 0.2 x 0.3 m) and rk4 integrator for dynamics", SPACECRAFT)
-    write_ssv(p / "acs_modes_control.ssv", "acs_modes_control",
-              "Inertias of the 12 kg host box for control: J = diag(0.05, 0.13, 0.10) kg.m2", CONTROL_INERTIA)
-    write_ssv(p / "acs_modes_signals.ssv", "acs_modes_signals", "Iy of the host box for H_d", SIGNALS)
-    write_ssv(p / "acs_modes_sunline.ssv", "acs_modes_sunline", "Sunline takes the attitude as q_BN", SUNLINE)
-    write_ssv(p / "acs_modes_orbit.ssv", "acs_modes_orbit", "Circular orbit 420 km, 51.6 deg (SI units)", ORBIT)
-    write_ssv(p / "acs_modes_initial_state.ssv", "acs_modes_initial_state",
-              "Tumbling start: 2 deg/s about each body axis, identity attitude", INITIAL)
-    write_ssv(p / "acs_modes_shortened.ssv", "acs_modes_shortened",
-              "Scenario: mode delays scaled down, 1 A.m2 coils, short paddle and tracker times (run with 5 s steps)",
-              SHORTENED)
-    write_ssv(p / "acs_modes_ground_command.ssv", "acs_modes_ground_command",
-              "Scenario: the shortened one with a ground command over [12000, 12030) s", GROUND)
-    write_ssv(p / "acs_modes_sun_facing.ssv", "acs_modes_sun_facing",
-              "Scenario: orbit plane facing the Sun at the epoch (no eclipse) for the seed's 6000 s RMD", sun_facing())
-    write_ssd("acs_modes", SYSTEM)
-    print(f"wrote acs_modes.ssd and 9 parameter sets in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+def generate(writer):
+    writer.ssv("acs_modes_spacecraft",
+               "12 kg host box (0.1 x 0.2 x 0.3 m) and rk4 integrator for dynamics", SPACECRAFT)
+    writer.ssv("acs_modes_control",
+               "Inertias of the 12 kg host box for control: J = diag(0.05, 0.13, 0.10) kg.m2", CONTROL_INERTIA)
+    writer.ssv("acs_modes_signals", "Iy of the host box for H_d", SIGNALS)
+    writer.ssv("acs_modes_sunline", "Sunline takes the attitude as q_BN", SUNLINE)
+    writer.ssv("acs_modes_orbit", "Circular orbit 420 km, 51.6 deg (SI units)", ORBIT)
+    writer.ssv("acs_modes_initial_state",
+               "Tumbling start: 2 deg/s about each body axis, identity attitude", INITIAL)
+    writer.ssv("acs_modes_shortened",
+               "Scenario: mode delays scaled down, 1 A.m2 coils, short paddle and tracker times (run with 5 s steps)",
+               SHORTENED)
+    writer.ssv("acs_modes_ground_command",
+               "Scenario: the shortened one with a ground command over [12000, 12030) s", GROUND)
+    writer.ssv("acs_modes_sun_facing",
+               "Scenario: orbit plane facing the Sun at the epoch (no eclipse) for the specification's 6000 s RMD",
+               sun_facing())
+    writer.ssd("acs_modes", SYSTEM)

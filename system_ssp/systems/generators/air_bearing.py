@@ -1,4 +1,4 @@
-"""Write the air-bearing testbed system (seed 001) and its parameter files.
+"""Write the air-bearing testbed system (the air-bearing note) and its parameter files.
 
     python system_ssp/systems/generate_air_bearing.py
 
@@ -12,10 +12,10 @@ published at t + h. (Other orders and Jacobi also work, with the rate one step l
 
 Parameter files (parameters/, one per concern):
 - air_bearing_initial_state.ssv  default initial state of `dynamics` (the slow-rotation case);
-- air_bearing_testbed.ssv        testbed inertia and integrator for `dynamics`. The seed gives no
+- air_bearing_testbed.ssv        testbed inertia and integrator for `dynamics`. The description gives no
   inertia; this is an illustrative table with its largest moment about the vertical b3
   (diag(0.08, 0.09, 0.12) kg m^2), so a spin about b3 is stable;
-- air_bearing_kinematics.ssv     tau = 40 deg (the seed's threshold), dcm_tol, rate options;
+- air_bearing_kinematics.ssv     tau = 40 deg (the description's threshold), dcm_tol, rate options;
 - scenarios (names `component.variable`, applied with parameter_sets=[...]):
   air_bearing_slow_rotation.ssv   spin 0.1 rad/s about b3 with small transverse rates; the tilt
                                   stays below 19 deg, inside tau;
@@ -23,13 +23,9 @@ Parameter files (parameters/, one per concern):
                                   passes tau = 40 deg at t = 8.73 s and is limited after that.
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
+from ...ssp.writer import vec
 
-from generate import vec, write_ssd, write_ssv  # noqa: E402
 
 STEP = 0.02
 TAU = math.radians(40.0)
@@ -49,7 +45,7 @@ SCENARIOS = {
 
 DCM = [(i, j) for i in (1, 2, 3) for j in (1, 2, 3)]
 SYSTEM = {
-    "description": "Spherical air-bearing testbed without IMU (seed 001): rigid body, quaternion to DCM, "
+    "description": "Spherical air-bearing testbed without IMU (the air-bearing note): rigid body, quaternion to DCM, "
                    "kinematics node (rate from the DCM stream, pitch/roll limited to tau)",
     "components": [("dynamics", "RigidBody", ["air_bearing_initial_state", "air_bearing_testbed"]),
                    ("to_dcm", "AttitudeToDcm", []),
@@ -62,20 +58,15 @@ SYSTEM = {
 }
 
 
-def main():
-    params = HERE / "parameters"
-    write_ssv(params / "air_bearing_initial_state.ssv", "air_bearing_initial_state",
-              "Default initial state of the air-bearing dynamics: " + SCENARIOS["air_bearing_slow_rotation"][0], SLOW)
-    write_ssv(params / "air_bearing_testbed.ssv", "air_bearing_testbed",
-              "Air-bearing testbed inertia (illustrative, largest moment about b3; the seed gives none) and "
-              "integrator", TESTBED)
-    write_ssv(params / "air_bearing_kinematics.ssv", "air_bearing_kinematics",
-              "Kinematics node: pitch/roll limit tau = 40 deg (seed 001), DCM tolerance, rate estimate", KINEMATICS)
+def generate(writer):
+    writer.ssv("air_bearing_initial_state",
+               "Default initial state of the air-bearing dynamics: " + SCENARIOS["air_bearing_slow_rotation"][0], SLOW)
+    writer.ssv("air_bearing_testbed",
+               "Air-bearing testbed inertia (illustrative, largest moment about b3; the description gives none) and "
+               "integrator", TESTBED)
+    writer.ssv("air_bearing_kinematics",
+               "Kinematics node: pitch/roll limit tau = 40 deg (the air-bearing note), DCM tolerance, rate estimate",
+               KINEMATICS)
     for name, (description, values) in SCENARIOS.items():
-        write_ssv(params / f"{name}.ssv", name, description, {f"dynamics.{k}": v for k, v in values.items()})
-    write_ssd("air_bearing", SYSTEM)
-    print(f"wrote air_bearing.ssd and {3 + len(SCENARIOS)} parameter sets in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+        writer.ssv(name, description, {f"dynamics.{k}": v for k, v in values.items()})
+    writer.ssd("air_bearing", SYSTEM)

@@ -21,17 +21,12 @@ Scenario files (component.variable names, applied with parameter_sets=[...]):
   with the true attitude (as if the last fix was at eclipse entry), gyro bias 1e-3 rad/s.
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parents[1]))
 
-from generate import vec, write_ssd, write_ssv  # noqa: E402
+from components.core import constants, rotations
+from components.sensing import triad
 
-from components.core import constants, rotations  # noqa: E402
-from components.sensing import triad  # noqa: E402
+from ...ssp.writer import vec
 
 NAME = "attitude_determination"
 AU = 1.495978707e11  # m
@@ -116,15 +111,9 @@ SYSTEM = {
 }
 
 
-def main():
-    params = HERE / "parameters"
+def generate(writer):
     for concern, (description, values) in FILES.items():
-        write_ssv(params / f"{NAME}_{concern}.ssv", f"{NAME}_{concern}", description, values)
+        writer.ssv(f"{NAME}_{concern}", description, values)
     for scenario, (description, values) in SCENARIOS.items():
-        write_ssv(params / f"{NAME}_{scenario}.ssv", f"{NAME}_{scenario}", description, values)
-    write_ssd(NAME, SYSTEM)
-    print(f"wrote {NAME}.ssd and {len(FILES) + len(SCENARIOS)} parameter sets in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+        writer.ssv(f"{NAME}_{scenario}", description, values)
+    writer.ssd(NAME, SYSTEM)

@@ -2,7 +2,7 @@
 
     python build_fmus.py && python system_ssp/systems/generate_deorbit.py
 
-Two systems with the same wiring, differing in one component (the fidelity swap of issue 3):
+Two systems with the same wiring, differing in one component (a fidelity swap):
 - `deorbit`:          orbit = Orbit (Cowell: J2..J6 zonal gravity, drag at every integrator
                       stage, adaptive DOP853 inside each communication step);
 - `deorbit_lifetime`: orbit = OrbitAveraged (mean elements, orbit-averaged drag, J2 secular
@@ -28,18 +28,11 @@ Scenario files (names component.variable), one per thesis case, with and without
   (the host alone, 12 kg).
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parents[1]))
 
-from generate import write_ssd, write_ssv  # noqa: E402
-
-from components.orbit import propulsion  # noqa: E402
-from components.core import time_utils  # noqa: E402
-from components.core.constants import DAY, R_EQ, YEAR  # noqa: E402
+from components.orbit import propulsion
+from components.core import time_utils
+from components.core.constants import DAY, R_EQ, YEAR
 
 KM = 1000.0
 # (initial altitude, target perigee altitude) in km, thesis Section 3.2
@@ -78,36 +71,30 @@ def system(orbit_fmu, coast_step):
     }
 
 
-def main():
-    params = HERE / "parameters"
+def generate(writer):
     orbit = dict(ORBIT, retrograde=True)
-    write_ssv(params / "deorbit_orbit.ssv", "deorbit_orbit",
-              "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
-              "space weather); retrograde thrust since no attitude is simulated", orbit)
-    write_ssv(params / "deorbit_atmosphere.ssv", "deorbit_atmosphere",
-              "Density signal: the same model and space weather as the orbit",
-              {k: ORBIT[k] for k in ("epoch", "density_model", "space_weather_file", "use_constant_space_weather")})
+    writer.ssv("deorbit_orbit",
+               "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
+               "space weather); retrograde thrust since no attitude is simulated", orbit)
+    writer.ssv("deorbit_atmosphere",
+               "Density signal: the same model and space weather as the orbit",
+               {k: ORBIT[k] for k in ("epoch", "density_model", "space_weather_file", "use_constant_space_weather")})
     dv = propulsion.deorbit_scenario(420.0 * KM, 350.0 * KM)
-    write_ssv(params / "deorbit_propulsion.ssv", "deorbit_propulsion",
-              "Main de-orbit thrusters (4 x 25 mN, Isp 42 s, g0 9.81; thesis Section 3.2, Appendix A), 12 kg, "
-              "the 420 km -> 350 km propellant budget (Eq. 2-3)",
-              {"thrust_per_thruster": propulsion.THRUST_PER_THRUSTER, "n_thrusters": propulsion.N_THRUSTERS,
+    writer.ssv("deorbit_propulsion",
+               "Main de-orbit thrusters (4 x 25 mN, Isp 42 s, g0 9.81; thesis Section 3.2, Appendix A), 12 kg, "
+               "the 420 km -> 350 km propellant budget (Eq. 2-3)",
+               {"thrust_per_thruster": propulsion.THRUST_PER_THRUSTER, "n_thrusters": propulsion.N_THRUSTERS,
                "isp": propulsion.ISP, "g0": propulsion.G0, "mass0": propulsion.MASS0,
                "propellant_budget": dv["propellant"]})
     for name, (h0, target) in SCENARIOS.items():
-        write_ssv(params / f"deorbit_{name}.ssv", f"deorbit_{name}",
-                  f"Thesis scenario {h0:g} km -> {target:g} km perigee, with the NEIGHBOR burn", scenario(h0, target, True))
-        write_ssv(params / f"deorbit_{name}_no_burn.ssv", f"deorbit_{name}_no_burn",
-                  f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, 12 kg)", scenario(h0, target, False))
+        writer.ssv(f"deorbit_{name}",
+                   f"Thesis scenario {h0:g} km -> {target:g} km perigee, with the NEIGHBOR burn",
+                   scenario(h0, target, True))
+        writer.ssv(f"deorbit_{name}_no_burn",
+                   f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, 12 kg)", scenario(h0, target, False))
     # deorbit_lifetime_*.ssv are the same scenario files under the lifetime system's name
     for name in SCENARIOS:
         for suffix in ("", "_no_burn"):
-            src = params / f"deorbit_{name}{suffix}.ssv"
-            (params / f"deorbit_lifetime_{name}{suffix}.ssv").write_text(src.read_text())
-    write_ssd("deorbit", system("Orbit", COAST_STEP["deorbit"]))
-    write_ssd("deorbit_lifetime", system("OrbitAveraged", COAST_STEP["deorbit_lifetime"]))
-    print(f"wrote deorbit.ssd, deorbit_lifetime.ssd and their parameter sets in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+            writer.ssv_copy(f"deorbit_{name}{suffix}", f"deorbit_lifetime_{name}{suffix}")
+    writer.ssd("deorbit", system("Orbit", COAST_STEP["deorbit"]))
+    writer.ssd("deorbit_lifetime", system("OrbitAveraged", COAST_STEP["deorbit_lifetime"]))

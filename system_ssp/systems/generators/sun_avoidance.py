@@ -19,18 +19,14 @@ Parameter files (parameters/):
 - sun_avoidance_slew_far_sun.ssv: the Sun far from the path (one eigenaxis segment).
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parents[1]))
 
-from generate import SPACECRAFT, vec, write_ssd, write_ssv  # noqa: E402
+from components.core import rotations
+from components.attitude import reference_tracking as rt
+from components.attitude import sun_avoidance as sa
 
-from components.core import rotations  # noqa: E402
-from components.attitude import reference_tracking as rt  # noqa: E402
-from components.attitude import sun_avoidance as sa  # noqa: E402
+from ...ssp.writer import vec
+from .maneuvers import SPACECRAFT
 
 NAME = "sun_avoidance_slew"
 BORESIGHT = (0.0, 0.0, 1.0)
@@ -102,23 +98,17 @@ def scenario(sun):
     return g
 
 
-def main():
-    params = HERE / "parameters"
-    write_ssv(params / f"{NAME}_guidance.ssv", f"{NAME}_guidance",
-              "SAS guidance: boresight, Sun, keep-out cone, attitudes, rate limits, inertia (near-Sun geometry)",
-              guidance_params(sun_near()))
-    write_ssv(params / f"{NAME}_tracker.ssv", f"{NAME}_tracker",
-              "Reference-tracking gains (wn = 1 rad/s, zeta = 0.9 on the NEIGHBOR box inertia), limits, tolerances",
-              TRACKER)
-    write_ssv(params / f"{NAME}_initial_state.ssv", f"{NAME}_initial_state",
-              "Initial state of the Sun-avoidance slew: at rest at the guidance's q0, rk4", INITIAL)
-    write_ssv(params / f"{NAME}_near_sun.ssv", f"{NAME}_near_sun",
-              "Sun 10 deg off the direct eigenaxis path (keep-out 30 deg): three-segment detour", scenario(sun_near()))
-    write_ssv(params / f"{NAME}_far_sun.ssv", f"{NAME}_far_sun",
-              "Sun opposite the direct path's midpoint: single eigenaxis slew", scenario(sun_far()))
-    write_ssd(NAME, SYSTEM)
-    print(f"wrote {NAME}.ssd and its parameter files in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+def generate(writer):
+    writer.ssv(f"{NAME}_guidance",
+               "SAS guidance: boresight, Sun, keep-out cone, attitudes, rate limits, inertia (near-Sun geometry)",
+               guidance_params(sun_near()))
+    writer.ssv(f"{NAME}_tracker",
+               "Reference-tracking gains (wn = 1 rad/s, zeta = 0.9 on the NEIGHBOR box inertia), limits, tolerances",
+               TRACKER)
+    writer.ssv(f"{NAME}_initial_state",
+               "Initial state of the Sun-avoidance slew: at rest at the guidance's q0, rk4", INITIAL)
+    writer.ssv(f"{NAME}_near_sun",
+               "Sun 10 deg off the direct eigenaxis path (keep-out 30 deg): three-segment detour", scenario(sun_near()))
+    writer.ssv(f"{NAME}_far_sun",
+               "Sun opposite the direct path's midpoint: single eigenaxis slew", scenario(sun_far()))
+    writer.ssd(NAME, SYSTEM)

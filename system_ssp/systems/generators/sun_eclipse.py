@@ -15,19 +15,12 @@ System: a circular orbit (`orbit`), the Sun ephemeris (`sun`) and the conical Ea
 Stop time: two orbits of the default orbit; communication step 10 s.
 """
 import math
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
-sys.path.insert(0, str(HERE.parents[1]))
 
-from generate import write_ssd, write_ssv  # noqa: E402
-
-from components.orbit import circular  # noqa: E402
-from components.core import constants  # noqa: E402
-from components.environment import eclipse, sun  # noqa: E402
-from components.core import time_utils  # noqa: E402
+from components.orbit import circular
+from components.core import constants
+from components.environment import eclipse, sun
+from components.core import time_utils
 
 EPOCH = time_utils.DEFAULT_EPOCH
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0,
@@ -64,20 +57,14 @@ SYSTEM = {
 }
 
 
-def main():
-    params = HERE / "parameters"
-    write_ssv(params / "sun_eclipse_orbit.ssv", "sun_eclipse_orbit",
-              "Circular orbit of the sun_eclipse system: 420 km, 51.6 deg, RAAN 0, u0 0 (SI units)", ORBIT)
-    write_ssv(params / "sun_eclipse_epoch.ssv", "sun_eclipse_epoch",
-              "Scenario epoch (simulation time 0), ISO 8601 UTC: the thesis' start date", {"epoch": EPOCH})
-    write_ssv(params / "sun_eclipse_shadow.ssv", "sun_eclipse_shadow",
-              "Earth and Sun radii (m) and the orbit-day threshold of the conical shadow", SHADOW)
-    write_ssv(params / "sun_eclipse_dawn_dusk.ssv", "sun_eclipse_dawn_dusk",
-              "Scenario: 700 km Sun-synchronous dawn-dusk orbit facing the Sun at the epoch (no eclipse)",
-              dawn_dusk())
-    write_ssd("sun_eclipse", SYSTEM)
-    print(f"wrote sun_eclipse.ssd and 4 parameter sets in {HERE}")
-
-
-if __name__ == "__main__":
-    main()
+def generate(writer):
+    writer.ssv("sun_eclipse_orbit",
+               "Circular orbit of the sun_eclipse system: 420 km, 51.6 deg, RAAN 0, u0 0 (SI units)", ORBIT)
+    writer.ssv("sun_eclipse_epoch",
+               "Scenario epoch (simulation time 0), ISO 8601 UTC: the thesis' start date", {"epoch": EPOCH})
+    writer.ssv("sun_eclipse_shadow",
+               "Earth and Sun radii (m) and the orbit-day threshold of the conical shadow", SHADOW)
+    writer.ssv("sun_eclipse_dawn_dusk",
+               "Scenario: 700 km Sun-synchronous dawn-dusk orbit facing the Sun at the epoch (no eclipse)",
+               dawn_dusk())
+    writer.ssd("sun_eclipse", SYSTEM)

@@ -1,4 +1,4 @@
-"""Write the sunline system (seed 004): a spinning rigid body feeding its attitude quaternion to
+"""Write the sunline system (the sunline module description): a spinning rigid body feeding its attitude quaternion to
 the sunline-ephemeris FMU, with fixed Sun and spacecraft positions.
 
     python -c "import build_fmus; from pathlib import Path; [build_fmus.build_fmu(Path(s), Path('build/fmus'))
@@ -15,16 +15,11 @@ Parameter files (system_ssp/systems/parameters/):
   the body x axis instead.
 `dynamics` also binds the shared spacecraft.ssv (host mass and box edges).
 """
-import sys
-from pathlib import Path
 
-HERE = Path(__file__).resolve().parent
-sys.path.insert(0, str(HERE))
 
-from generate import ROOT, vec, write_ssd, write_ssv  # noqa: E402
+from components.core import rotations
 
-sys.path.insert(0, str(ROOT))
-from components.core import rotations  # noqa: E402
+from ...ssp.writer import vec
 
 AU = 149597870700.0  # m
 # Sun about 1 au away, off every axis; spacecraft in a low Earth orbit position.
@@ -52,20 +47,12 @@ SYSTEM = {
 }
 
 
-def main(directory=HERE):
-    """Write sunline.ssd and its parameter files into `directory` (default: this folder)."""
-    params = directory / "parameters"
-    params.mkdir(exist_ok=True)
-    write_ssv(params / "sunline_ephemeris.ssv", "sunline_ephemeris",
-              "Sunline FMU: quaternion attitude input, fixed Sun and spacecraft positions in N (m)", EPHEMERIS)
-    write_ssv(params / "sunline_initial_state.ssv", "sunline_initial_state",
-              "Rigid body of the sunline system: rk4, initial attitude (1-2-3 Euler 0.3, -0.2, 0.5 rad), "
-              "spin 0.1 rad/s about body z", INITIAL_STATE)
+def generate(writer):
+    writer.ssv("sunline_ephemeris",
+               "Sunline FMU: quaternion attitude input, fixed Sun and spacecraft positions in N (m)", EPHEMERIS)
+    writer.ssv("sunline_initial_state",
+               "Rigid body of the sunline system: rk4, initial attitude (1-2-3 Euler 0.3, -0.2, 0.5 rad), "
+               "spin 0.1 rad/s about body z", INITIAL_STATE)
     for name, (description, values) in SCENARIOS.items():
-        write_ssv(params / f"{name}.ssv", name, description, values)
-    write_ssd("sunline", SYSTEM, directory)
-    print(f"wrote sunline.ssd and {2 + len(SCENARIOS)} parameter sets in {directory}")
-
-
-if __name__ == "__main__":
-    main()
+        writer.ssv(name, description, values)
+    writer.ssd("sunline", SYSTEM)
