@@ -1,17 +1,12 @@
 """Shared fixtures: the product's FMUs and SSPs, built (incrementally) once per session."""
 import os
-import sys
 from pathlib import Path
+import sys
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
 # pythonfmu's builder must come from the installed package: a pythonfmu FMU run in this process
 # puts its own bundled copy (without the binaries the builder packs) on the import path.
-import pythonfmu.builder  # noqa: E402,F401
 
 
 @pytest.fixture(scope="session")

@@ -5,6 +5,7 @@ import zipfile
 
 import fmpy
 import pytest
+
 from fmu_helpers import check_declarations, instantiate
 
 EXPECTED = {"RigidBody", "DetumbleController", "SlewController", "RcsThrusters"}

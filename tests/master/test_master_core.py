@@ -1,19 +1,16 @@
 """Tests of the co-simulation master (system_ssp) on small fixture FMUs."""
 import os
-from pathlib import Path
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from master_fixtures import helpers as h  # noqa: E402
+from master_fixtures import helpers as h
+from paths import REPO
+import system_ssp
+from system_ssp import SimulationError, SSPError
 
-import system_ssp  # noqa: E402
-from system_ssp import SSPError, SimulationError  # noqa: E402
-
-REPO = Path(__file__).resolve().parent.parent
 USES = {"integ.fmu": "integrator", "gain.fmu": "gain", "thr.fmu": "threshold"}
 INLINE_X0 = ('<ssd:ParameterBinding><ssd:ParameterValues><ssv:ParameterSet version="1.0" name="p"><ssv:Parameters>'
              '<ssv:Parameter name="x0"><ssv:Real value="1"/></ssv:Parameter></ssv:Parameters></ssv:ParameterSet>'

@@ -1,19 +1,17 @@
 """Our Jacobi algorithm against libcosim's fixed-step algorithm (libcosim runs in a subprocess)."""
 import json
-from pathlib import Path
 import subprocess
 import sys
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from master_fixtures import helpers as h  # noqa: E402
-
-import system_ssp  # noqa: E402
+from master_fixtures import helpers as h
+from paths import MASTER_FIXTURES
+import system_ssp
 
 pytest.importorskip("libcosimpy")
-HELPER = Path(__file__).resolve().parent / "master_fixtures" / "libcosim_run.py"
+HELPER = MASTER_FIXTURES / "libcosim_run.py"
 
 
 @pytest.fixture(scope="session")

@@ -1,15 +1,11 @@
 """Mode-dependent communication steps (nc:Schedule) on small fixture FMUs."""
-from pathlib import Path
-import sys
 
 import numpy as np
 import pytest
 
-sys.path.insert(0, str(Path(__file__).resolve().parent))
-from master_fixtures import helpers as h  # noqa: E402
-
-import system_ssp  # noqa: E402
-from system_ssp import SSPError  # noqa: E402
+from master_fixtures import helpers as h
+import system_ssp
+from system_ssp import SSPError
 
 USES = {"integ.fmu": "integrator", "gain.fmu": "gain", "timer.fmu": "timer"}
 X0 = ('<ssd:ParameterBinding><ssd:ParameterValues><ssv:ParameterSet version="1.0" name="p"><ssv:Parameters>'
@@ -27,7 +23,10 @@ def fmus(tmp_path_factory):
     return h.build_fixture_fmus(tmp_path_factory.mktemp("master_fmus"))
 
 
-def scheduled_system(folder, fmus, schedule=SCHEDULE.format(every=1), expiry=0.35):
+EVERY_STEP = SCHEDULE.format(every=1)
+
+
+def scheduled_system(folder, fmus, schedule=EVERY_STEP, expiry=0.35):
     """integ.x -> gain.u -> gain.y -> integ.u (x' = x), and a timer that expires at `expiry`."""
     ann = ('<ssd:Annotations><ssc:Annotation type="org.neighbor-cosim.master">'
            f'<nc:Master xmlns:nc="https://neighbor-cosim.org/ssp/master" stepSize="0.1">{schedule}</nc:Master>'

@@ -1,4 +1,4 @@
-"""The acs_modes system (seed 002) run through the master: the shortened scenario reaches every
+"""The acs_modes system (ACS mode specification) run through the master: the shortened scenario reaches every
 nominal mode in order and then alternates Orbit Day / Orbit Night with the eclipses; a ground
 command takes it to Ground Command (9) and, GCMD after the command, back to Detumble (1)."""
 import numpy as np

@@ -1,15 +1,17 @@
-"""The de-orbit systems through the master (issue 3, section 5): the burn, the fidelity swap,
+"""The de-orbit systems through the master: the burn, the fidelity swap,
 the thesis' compliance conclusions and bad input."""
 import math
 
 import numpy as np
 import pytest
 
-import system_ssp
-from system_ssp import SSPError, SimulationError, deorbit_study
 from components.orbit import propulsion
+import system_ssp
+from system_ssp import SimulationError, SSPError
+from system_ssp.apps import deorbit_study
+from system_ssp.systems import PARAMETERS_DIR
 
-PARAMS = deorbit_study.PARAMETERS
+PARAMS = PARAMETERS_DIR
 
 
 @pytest.fixture(scope="module")

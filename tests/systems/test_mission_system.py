@@ -1,10 +1,11 @@
-"""The NEIGHBOR mission from deployment to re-entry through the master (issue 6): one run of
+"""The NEIGHBOR mission from deployment to re-entry through the master: one run of
 the 420 km scenario (orbit-averaged orbit; about 2 minutes), checked against the thesis."""
 import json
 
 import pytest
 
-from system_ssp import SSPError, SimulationError, System, mission
+from system_ssp import SimulationError, SSPError, System
+from system_ssp.apps import mission
 
 THESIS = mission.THESIS
 

@@ -2,18 +2,16 @@
 with libcosim, and clear errors for bad input."""
 import json
 import math
+from pathlib import Path
 import subprocess
 import sys
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from paths import MASTER_FIXTURES, REPO
 import system_ssp
-from system_ssp import thesis
-
-HERE = Path(__file__).resolve().parent
-ROOT = HERE.parent
+from system_ssp.apps import thesis
 
 
 @pytest.fixture(scope="module")
@@ -51,8 +49,8 @@ def test_euler_durations_and_slew_case3_totals(euler_cases):
 
 def test_slew_case_files_start_from_the_cosimulated_detumble_end(euler_cases, ssp_paths):
     """The slew .ssv files carry the full-precision detumble end state (see generate.py)."""
-    import zipfile
     from xml.etree import ElementTree as ET
+    import zipfile
 
     with zipfile.ZipFile(ssp_paths["slew"]) as zf:
         for case, det in (("slew_case1", "detumble_case1"), ("slew_case2", "detumble_case2"),
@@ -91,7 +89,7 @@ def test_jacobi_on_detumble_matches_libcosim(ssp_paths, tmp_path):
              "detumble.torque_cmd_B[3]", "thrusters.propellant_mass"]
     n, h = 400, 0.015
     out = tmp_path / "lc.json"
-    proc = subprocess.run([sys.executable, str(HERE / "master_fixtures" / "libcosim_run.py"),
+    proc = subprocess.run([sys.executable, str(MASTER_FIXTURES / "libcosim_run.py"),
                            str(ssp_paths["detumble"]), str(h), str(n), str(out), *names],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
@@ -105,7 +103,7 @@ def test_jacobi_on_detumble_matches_libcosim(ssp_paths, tmp_path):
 
 def cli(*args):
     return subprocess.run([sys.executable, "-m", "system_ssp", *args], capture_output=True, text=True,
-                          cwd=ROOT, timeout=120)
+                          cwd=REPO, timeout=120)
 
 
 def test_cli_runs_a_case_and_writes_csv(ssp_paths, tmp_path):
@@ -143,13 +141,13 @@ def test_cli_rejects_bad_system_files(ssp_paths, tmp_path):
     bad.write_text("<ssd:SystemStructureDescription")
     p = cli("run", str(bad))
     assert p.returncode != 0 and "bad.ssd" in p.stderr and "line" in p.stderr
-    src = (ROOT / "system_ssp" / "systems" / "detumble.ssd").read_text()
+    src = (REPO / "system_ssp" / "systems" / "detumble.ssd").read_text()
     invalid = tmp_path / "invalid.ssd"
     invalid.write_text(src.replace("<ssd:Elements>", "<ssd:Elements><ssd:Bogus/>"))
     p = cli("run", str(invalid))
     assert p.returncode != 0 and "invalid.ssd" in p.stderr and "Bogus" in p.stderr
     # the unpacked SSD without its FMUs next to it
-    p = cli("run", str(ROOT / "system_ssp" / "systems" / "detumble.ssd"))
+    p = cli("run", str(REPO / "system_ssp" / "systems" / "detumble.ssd"))
     assert p.returncode != 0 and "DetumbleController.fmu" in p.stderr and "'detumble'" in p.stderr
     assert "build_fmus.py" in p.stderr
 
@@ -172,3 +170,16 @@ def test_initialization_exchanges_values_in_dependency_order(ssp_paths):
     assert [row[f"detumble.thrust_flag[{i}]"] for i in (1, 2, 3)] == [-1, -1, -1]
     assert row["thrusters.torque_B[1]"] == -row["thrusters.torque_level[1]"] < 0
     assert row["dynamics.torque_B[3]"] == row["thrusters.torque_B[3]"]
+
+
+def test_console_command_version_and_help():
+    """The console command installed by pyproject's [project.scripts]."""
+    exe = Path(sys.executable).parent / "neighbor-cosim"
+    version = subprocess.run([str(exe), "--version"], capture_output=True, text=True, timeout=120)
+    assert version.returncode == 0 and version.stdout.strip() == f"neighbor-cosim {system_ssp.__version__}"
+    helptext = subprocess.run([str(exe), "--help"], capture_output=True, text=True, timeout=120)
+    assert helptext.returncode == 0
+    for sub in ("run", "info", "thesis", "deorbit-study", "mission"):
+        assert sub in helptext.stdout
+    mission_help = subprocess.run([str(exe), "mission", "--help"], capture_output=True, text=True, timeout=120)
+    assert mission_help.returncode == 0 and "--scenario" in mission_help.stdout

@@ -1,17 +1,19 @@
-"""Control laws of the seed-002 ACS (components.acs.control), its signals, paddles and optical
+"""Control laws of the ACS of the mode specification (components.acs.control), its signals, paddles and optical
 tracker, and their FMUs."""
 import math
-import sys
-from pathlib import Path
 
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-from components.acs import control as ac  # noqa: E402
-from components.acs import signals, magnetorquer, momentum_wheel, optical_tracker, paddles  # noqa: E402
-from components.attitude import rigid_body  # noqa: E402
+from components.acs import control as ac
+from components.acs import (
+    magnetorquer,
+    momentum_wheel,
+    optical_tracker,
+    paddles,
+    signals,
+)
+from components.attitude import rigid_body
+from paths import REPO
 
 J = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3)
 B0 = (2.0e-5, -1.0e-5, 3.0e-5)
@@ -81,7 +83,8 @@ def test_reorient_holds_elevation_until_duration():
     tau_before = c._momentum_torque(H, s, math.copysign(c.p["reorient_hold_elevation"], s[1]))
     tau_after = c._momentum_torque(H, s, 0.0)
     assert sum(a * b for a, b in zip(s, tau_before)) > 0 > sum(a * b for a, b in zip(s, tau_after))
-    assert c.command(ac.REORIENT, True, True, w, B0, s, 0.0, 50.0) != c.command(ac.REORIENT, True, True, w, B0, s, 0.0, 150.0)
+    assert (c.command(ac.REORIENT, True, True, w, B0, s, 0.0, 50.0)
+            != c.command(ac.REORIENT, True, True, w, B0, s, 0.0, 150.0))
 
 
 def test_deploy_wheel_transfers_momentum_to_wheel_with_coils_off():
@@ -175,7 +178,7 @@ def acs_fmu_dir(tmp_path_factory):
     import build_fmus
     d = tmp_path_factory.mktemp("acs_fmus")
     for n in FMUS:
-        build_fmus.build_fmu(ROOT / "fmus" / f"neighbor_{n}.py", d)
+        build_fmus.build_fmu(REPO / "fmus" / f"neighbor_{n}.py", d)
     return d
 
 
@@ -219,5 +222,6 @@ def test_fine_modes_use_their_own_precession_gain():
     B, s, w = (2e-5, 1e-5, -3e-5), (0.3, 0.2, 0.93), (0.0, 0.0, 0.0)
     wr = 0.13 * ac.PARAMETER_DEFAULTS["spin_rate"] / 2e-5
     a = ac.AcsControl({"k_precession_fine": 1e-3}).command(ac.ORBIT_DAY, True, True, w, B, s, wr)[0]
-    b = ac.AcsControl({"k_precession_fine": 2e-3, "k_precession": 7e-3}).command(ac.ORBIT_DAY, True, True, w, B, s, wr)[0]
+    b = ac.AcsControl({"k_precession_fine": 2e-3, "k_precession": 7e-3}).command(ac.ORBIT_DAY, True, True, w, B, s,
+                                                                                wr)[0]
     assert all(abs(2 * x - y) < 1e-9 for x, y in zip(a, b))

@@ -1,27 +1,22 @@
-"""ACS mode manager of seed 002 (components/acs/modes.py) and its FMU (AcsModeManager)."""
+"""ACS mode manager of the ACS mode specification (components/acs/modes.py) and its FMU (AcsModeManager)."""
 import itertools
 import math
-import sys
-from pathlib import Path
 
 import fmpy
-import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
-
-from components.acs import modes as am  # noqa: E402
+from components.acs import modes as am
+from paths import REPO
 
 P = am.PARAMETER_DEFAULTS
 W, DT, SU, RE, DW, AC, DP, OD, ON, GC = range(10)
 ALL = tuple(range(10))
 
-# Hand-written from the seed (not from RULES): per table (= target mode), the current modes
+# Hand-written from the specification (not from RULES): per table (= target mode), the current modes
 # each column applies from, in column order. GC col 2/3 are our added columns (A6, A4).
 EXPECTED_FROM = {
     W: [("startup",), ALL, (W,)],
@@ -454,7 +449,7 @@ def test_state_round_trip_is_json():
 def acs_fmu(tmp_path_factory):
     import build_fmus
 
-    return build_fmus.build_fmu(ROOT / "fmus" / "neighbor_acs_mode_manager.py", tmp_path_factory.mktemp("acs_fmu"))
+    return build_fmus.build_fmu(REPO / "fmus" / "neighbor_acs_mode_manager.py", tmp_path_factory.mktemp("acs_fmu"))
 
 
 def test_fmu_valid_units_and_no_feedthrough(acs_fmu):

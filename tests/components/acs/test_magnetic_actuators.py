@@ -2,19 +2,18 @@
 wheel terms: the components against closed forms and published values, each FMU through FMPy
 (validation, standalone simulation, state get/set), and wheel + body co-simulated through FMPy."""
 import math
-from pathlib import Path
 
 import fmpy
 import numpy as np
 import pytest
 
-from components.core import rotations, time_utils
-from components.environment import magnetic_field as mf
 from components.acs import magnetorquer, momentum_wheel
 from components.attitude.rigid_body import RigidBody, box_inertia
+from components.core import rotations, time_utils
+from components.environment import magnetic_field as mf
 from fmu_helpers import check_declarations, instantiate
+from paths import REPO
 
-ROOT = Path(__file__).resolve().parents[1]
 WRAPPERS = {"MagneticField": "neighbor_magnetic_field.py", "TorqueCoils": "neighbor_torque_coils.py",
             "MomentumWheel": "neighbor_momentum_wheel.py", "RigidBody": "neighbor_rigid_body.py"}
 DEG = math.pi / 180.0
@@ -309,7 +308,7 @@ def ma_fmus(tmp_path_factory):
     import build_fmus
 
     dest = tmp_path_factory.mktemp("magnetic_actuator_fmus")
-    return {name: build_fmus.build_fmu(ROOT / "fmus" / script, dest) for name, script in WRAPPERS.items()}
+    return {name: build_fmus.build_fmu(REPO / "fmus" / script, dest) for name, script in WRAPPERS.items()}
 
 
 def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):

@@ -4,12 +4,12 @@ import math
 import numpy as np
 import pytest
 
-from components.core import rotations as att
 from components.attitude.detumble import DetumbleController
 from components.attitude.rigid_body import RigidBody, box_inertia, check_inertia
 from components.attitude.slew import SlewController
 from components.attitude.thruster_control import pair_torques, quantize
 from components.attitude.thrusters import ThrusterPairs
+from components.core import rotations as att
 
 DT = 0.015
 J = box_inertia(12.0, 0.1, 0.2, 0.3)

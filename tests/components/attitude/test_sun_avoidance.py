@@ -1,21 +1,16 @@
 """Sun-avoidance slew: guidance geometry and profiles, tracking controller, FMUs, system."""
 import math
-import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-sys.path.insert(0, str(ROOT / "system_ssp" / "systems"))
-
-from components.core import rotations as at  # noqa: E402
-from components.attitude import reference_tracking as rt  # noqa: E402
-from components.attitude import rigid_body  # noqa: E402
-from components.attitude import sun_avoidance as sa  # noqa: E402
-
-import generate_sas as gen  # noqa: E402
+from components.attitude import reference_tracking as rt
+from components.attitude import rigid_body
+from components.attitude import sun_avoidance as sa
+from components.core import rotations as at
+from paths import REPO
+from system_ssp.systems.generators import sun_avoidance as gen
 
 J_BOX = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3).tolist()
 EPS, MARGIN = gen.EPSILON, gen.MARGIN
@@ -260,9 +255,9 @@ def sas_build(tmp_path_factory):
     import build_fmus
 
     d = tmp_path_factory.mktemp("sas_fmus")
-    fmus = {Path(s).stem: build_fmus.build_fmu(ROOT / "fmus" / f"{s}.py", d)
+    fmus = {Path(s).stem: build_fmus.build_fmu(REPO / "fmus" / f"{s}.py", d)
             for s in ("neighbor_sas_guidance", "neighbor_reference_tracking", "neighbor_rigid_body")}
-    ssp = build_fmus.pack_ssp(ROOT / "system_ssp" / "systems" / "sun_avoidance_slew.ssd", d, d)
+    ssp = build_fmus.pack_ssp(REPO / "system_ssp" / "systems" / "sun_avoidance_slew.ssd", d, d)
     return fmus, ssp
 
 

@@ -6,9 +6,9 @@ import math
 
 import pytest
 
-from components.core import rotations
-from components.core import constants
-from components.attitude import deorbit_tracking as dtr, rigid_body, thrusters
+from components.attitude import deorbit_tracking as dtr
+from components.attitude import rigid_body, thrusters
+from components.core import constants, rotations
 from fmu_helpers import check_declarations, instantiate
 
 J_BOX = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3)  # Appendix A
@@ -235,7 +235,7 @@ def test_fmu_rejects_bad_gain(build_one):
                          ({"k": 0.0}, ["k = 0.0", "positive"])]:
         messages = []
 
-        def log(component, instance, status, category, message):
+        def log(component, instance, status, category, message, messages=messages):
             messages.append(message.decode() if isinstance(message, bytes) else message)
 
         with pytest.raises(FMICallException):

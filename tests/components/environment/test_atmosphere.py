@@ -3,17 +3,17 @@ Montenbruck and Gill Table 3.8 (Harris-Priester), pymsis called directly (NRLMSI
 117 GMAT Jacchia-Roberts test vectors; numba kernels equal the Python densities; densities fall
 with altitude; errors name what is wrong; the Atmosphere FMU through FMPy."""
 import math
-from pathlib import Path
 
 import numpy as np
 import pytest
 
+from components.core import time_utils
 from components.environment import atmosphere, geodesy, space_weather, sun
 from components.environment.atmosphere import jacchia_roberts
-from components.core import time_utils
 from fmu_helpers import check_declarations, instantiate
+from paths import DATA, REPO
 
-GMAT_VECTORS = Path(__file__).resolve().parent / "data" / "jacchia_roberts_gmat_test_2011.csv"
+GMAT_VECTORS = DATA / "jacchia_roberts_gmat_test_2011.csv"
 R_EQ = geodesy.WGS84_A
 JD_2023 = time_utils.julian_date(time_utils.DEFAULT_EPOCH)
 # FMU instances and the support module stay referenced until the process ends (conftest leaves
@@ -190,7 +190,7 @@ def test_jacchia_roberts_constant_indices_and_solar_activity():
 def test_kernel_equals_python(models, name):
     m = models[name]
     rng = np.random.default_rng(3)
-    for k in range(20):
+    for _ in range(20):
         u = rng.normal(size=3)
         r = u / np.linalg.norm(u) * (R_EQ + rng.uniform(100e3, 1500e3))
         t = JD_2023 + rng.uniform(0.0, 400.0)
@@ -231,7 +231,7 @@ def _support_module():
     in for the copy an FMU bundles (pythonfmu loads that one by its module name)."""
     import importlib.util
 
-    path = Path(__file__).resolve().parents[1] / "fmus" / "neighbor_fmu_support.py"
+    path = REPO / "fmus" / "neighbor_fmu_support.py"
     spec = importlib.util.spec_from_file_location("_atmosphere_test_fmu_support", path)
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
@@ -251,7 +251,8 @@ def test_fmu_support_atmosphere_model(tmp_path):
     assert c.indices(JD_2023)[:2] == (100.0, 150.0)
     for change, match in (({"density_model": "jr"}, "density_model = 'jr' is unknown"),
                           ({"hp_exponent": 1.0}, "hp_exponent"),
-                          ({"space_weather_file": str(tmp_path / "none.txt")}, "space_weather_file = .* does not exist"),
+                          ({"space_weather_file": str(tmp_path / "none.txt")},
+                           "space_weather_file = .* does not exist"),
                           ({"use_constant_space_weather": True, "ap": 500.0}, "ap = 500")):
         with pytest.raises(ValueError, match=match):
             atmosphere_model(dict(values, **change))

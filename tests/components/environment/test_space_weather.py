@@ -9,9 +9,10 @@ import pytest
 
 from components.environment import space_weather as sw_mod
 from components.environment.space_weather import ConstantSpaceWeather, SpaceWeather
+from paths import SHARED
 
 # the team's shared reference data, beside the repository (as in CI)
-SHARED_FILE = Path(__file__).resolve().parents[2] / "shared" / "data" / "space_weather" / "SW-All_CSSI_2026-08-22.txt"
+SHARED_FILE = SHARED / "data" / "space_weather" / "SW-All_CSSI_2026-08-22.txt"
 
 
 def jd(y, m, d, hour=0.0):
@@ -141,7 +142,8 @@ def test_parse_errors_name_file_and_line(tmp_path):
     with pytest.raises(ValueError, match="NUM_OBSERVED_POINTS says 9730 but the section has 9729"):
         SpaceWeather.from_file(_write(tmp_path, bad))
     # a small valid file: three observed days
-    small = good[:begin - 1] + ["NUM_OBSERVED_POINTS 3", "BEGIN OBSERVED"] + good[begin + 1:begin + 4] + ["END OBSERVED"]
+    small = (good[:begin - 1] + ["NUM_OBSERVED_POINTS 3", "BEGIN OBSERVED"] + good[begin + 1:begin + 4]
+             + ["END OBSERVED"])
     s = SpaceWeather.from_file(_write(tmp_path, small))
     assert s.first_jd == jd(2000, 1, 1) and s.last_jd == jd(2000, 1, 3)
     assert s.f107(jd(2000, 1, 9)) == 133.1 and s.past_end(jd(2000, 1, 9))

@@ -2,19 +2,17 @@
 values and closed-form geometry, each FMU through FMPy, and the sun_eclipse system through
 the master (eclipse timing against the cylindrical-shadow estimate)."""
 import math
-from pathlib import Path
 
 import fmpy
 import numpy as np
 import pytest
 
-from components.orbit import circular
-from components.core import constants
+from components.core import constants, time_utils
 from components.environment import eclipse, sun
-from components.core import time_utils
+from components.orbit import circular
 from fmu_helpers import check_declarations, instantiate
+from paths import REPO
 
-ROOT = Path(__file__).resolve().parents[1]
 WRAPPERS = {"SunEphemeris": "neighbor_sun_ephemeris.py", "EarthShadow": "neighbor_earth_shadow.py",
             "CircularOrbit": "neighbor_circular_orbit.py"}
 AU = 149597870700.0
@@ -268,7 +266,7 @@ def se_fmus(tmp_path_factory):
     import build_fmus
 
     dest = tmp_path_factory.mktemp("sun_eclipse_fmus")
-    return {name: build_fmus.build_fmu(ROOT / "fmus" / script, dest) for name, script in WRAPPERS.items()}
+    return {name: build_fmus.build_fmu(REPO / "fmus" / script, dest) for name, script in WRAPPERS.items()}
 
 
 @pytest.fixture(scope="session")
@@ -276,7 +274,7 @@ def se_ssp(se_fmus, tmp_path_factory):
     import build_fmus
 
     dest = tmp_path_factory.mktemp("sun_eclipse_ssp")
-    return build_fmus.pack_ssp(ROOT / "system_ssp" / "systems" / "sun_eclipse.ssd", se_fmus["SunEphemeris"].parent,
+    return build_fmus.pack_ssp(REPO / "system_ssp" / "systems" / "sun_eclipse.ssd", se_fmus["SunEphemeris"].parent,
                                dest)
 
 
@@ -441,13 +439,9 @@ def test_system_default_step_and_dawn_dusk_scenario(se_ssp):
 def test_generated_files_are_current():
     """The committed .ssv files equal what the generator writes now (the SSD needs built FMUs,
     the parameter files do not)."""
-    import importlib.util
+    from system_ssp.systems.generators import sun_eclipse as gen
 
-    spec = importlib.util.spec_from_file_location("generate_sun_eclipse",
-                                                  ROOT / "system_ssp" / "systems" / "generate_sun_eclipse.py")
-    gen = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(gen)
-    params = ROOT / "system_ssp" / "systems" / "parameters"
+    params = REPO / "system_ssp" / "systems" / "parameters"
     for name, values in (("sun_eclipse_orbit", gen.ORBIT), ("sun_eclipse_shadow", gen.SHADOW),
                          ("sun_eclipse_dawn_dusk", gen.dawn_dusk()), ("sun_eclipse_epoch", {"epoch": gen.EPOCH})):
         text = (params / f"{name}.ssv").read_text()

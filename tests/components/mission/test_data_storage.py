@@ -1,4 +1,4 @@
-"""NEIGHBOR data storage and downlink (seed 003 section 3.6, Table 7, Figure 47, Appendix I):
+"""NEIGHBOR data storage and downlink (NEIGHBOR thesis section 3.6, Table 7, Figure 47, Appendix I):
 the Table 7 rate, exact stepping with net rates and clamps, the thesis' de-orbit data profile
 (below 0.1 MB, downlinked within two contacts), overflow counting, errors, and the
 `DataStorage` FMU through FMPy."""

@@ -7,10 +7,10 @@ import math
 import numpy as np
 import pytest
 
-from components.orbit import circular
 from components.core import constants
 from components.environment import geodesy
 from components.mission import ground_station as gsm
+from components.orbit import circular
 from fmu_helpers import check_declarations, instantiate
 
 SIDEREAL_DAY = 86164.0905  # s

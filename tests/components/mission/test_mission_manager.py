@@ -6,10 +6,10 @@ import math
 
 import pytest
 
+from components.core.constants import DAY
 from components.mission import host as host_model
 from components.mission import manager as mm
 from components.mission.power_bus import LOAD_NAMES
-from components.core.constants import DAY
 from fmu_helpers import check_declarations, instantiate
 
 # Table 5 (W). GPS receiver + antenna = 1.366 W, Appendix I's GPS_pwr.

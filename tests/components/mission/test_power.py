@@ -1,4 +1,4 @@
-"""NEIGHBOR power supply (seed 003 section 3.5, Tables 5-6, Figure 46, Appendix I): the load
+"""NEIGHBOR power supply (NEIGHBOR thesis section 3.5, Tables 5-6, Figure 46, Appendix I): the load
 table, exact integration at any step size, the thesis' 420 km energy budget (2.2 Wh for the
 de-orbit sequence, 79.65 % and 8.6 Wh after the burn, empty about two weeks into monitoring),
 parameter errors, and the `Power` FMU through FMPy."""

@@ -6,10 +6,10 @@ import math
 import numpy as np
 import pytest
 
+from components.core import constants, rotations
 from components.environment import atmosphere, geodesy, gravity
-from components.core import constants
-from components.core import rotations
-from components.orbit import cowell, elements as oe
+from components.orbit import cowell
+from components.orbit import elements as oe
 from fmu_helpers import check_declarations, instantiate
 
 R = oe.R_EQ
@@ -97,7 +97,8 @@ def test_zonal_gravity_is_the_gradient_of_the_potential():
         r = np.array(r)
         a = gravity.acceleration(r)
         h = 1.0
-        grad = [(gravity.potential_zonal(*(r + h * e), MU, R, J, 6) - gravity.potential_zonal(*(r - h * e), MU, R, J, 6))
+        grad = [(gravity.potential_zonal(*(r + h * e), MU, R, J, 6)
+                 - gravity.potential_zonal(*(r - h * e), MU, R, J, 6))
                 / (2 * h) for e in np.eye(3)]
         np.testing.assert_allclose(a, grad, atol=5e-8)
     # J2 closed form
@@ -154,14 +155,16 @@ def test_drag_lowers_sma_by_the_eq_1_amount(exponential):
         r = np.array(o0["r_BN_N"])
         v_rel = v - np.cross([0, 0, constants.OMEGA_EARTH_WGS84], r)
         # da/dt = 2 a^2 / mu (v . a_drag)
-        adot = 2 * o0["sma"] ** 2 / MU * (v @ (-0.5 * o0["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel))
+        drag = -0.5 * o0["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel
+        adot = 2 * o0["sma"] ** 2 / MU * (v @ drag)
         m.advance_to(300.0 * k)
         ref.advance_to(300.0 * k)
         o1 = m.outputs()
         v = np.array(o1["v_BN_N"])
         r = np.array(o1["r_BN_N"])
         v_rel = v - np.cross([0, 0, constants.OMEGA_EARTH_WGS84], r)
-        adot1 = 2 * o1["sma"] ** 2 / MU * (v @ (-0.5 * o1["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel))
+        drag1 = -0.5 * o1["density"] * 2.2 * 0.02 / 12.0 * np.linalg.norm(v_rel) * v_rel
+        adot1 = 2 * o1["sma"] ** 2 / MU * (v @ drag1)
         expected += 0.5 * (adot + adot1) * 300.0
     da = m.outputs()["sma"] - ref.outputs()["sma"]
     assert expected < -100.0  # about -0.3 km/day at 300 km

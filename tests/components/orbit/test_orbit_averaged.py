@@ -5,13 +5,13 @@ cross-check of the mean decay with components.orbit."""
 import math
 
 import fmpy
+from numba import njit
 import numpy as np
 import pytest
-from numba import njit
 
 from components.environment import atmosphere
-from components.orbit import elements, propulsion
 from components.orbit import averaged as oa
+from components.orbit import elements, propulsion
 from fmu_helpers import check_declarations, instantiate
 
 MU, R_EQ, J2 = oa.MU_EARTH, oa.R_EQ, oa.J2

@@ -5,8 +5,8 @@ import math
 import fmpy
 import pytest
 
-from components.orbit import propulsion as p
 from components.core import constants
+from components.orbit import propulsion as p
 from fmu_helpers import check_declarations, instantiate
 
 REL = 0.005  # the brief's 0.5 %
@@ -77,8 +77,8 @@ def test_feed_lines_match_table_4():
     assert f["inner_radius"] * 1e3 == pytest.approx(2.4, abs=0.005)
     assert f["outer_radius"] * 1e3 == pytest.approx(3.18, rel=REL)
     assert len(f["lengths"]) == 16
-    for i, (l, vm, m, vo) in enumerate(TABLE4):
-        assert f["lengths"][i] * 1e2 == pytest.approx(l, abs=0.005), i
+    for i, (length, vm, m, vo) in enumerate(TABLE4):
+        assert f["lengths"][i] * 1e2 == pytest.approx(length, abs=0.005), i
         assert f["material_volumes"][i] * 1e6 == pytest.approx(vm, abs=0.005), i
         assert f["masses"][i] * 1e3 == pytest.approx(m, abs=0.005), i
         assert f["outer_volumes"][i] * 1e6 == pytest.approx(vo, abs=0.005), i

@@ -1,22 +1,21 @@
-"""Air-bearing testbed kinematics (seed 001): the component, the AirBearingKinematics and
+"""Air-bearing testbed kinematics (the air-bearing note): the component, the AirBearingKinematics and
 AttitudeToDcm FMUs through FMPy, and the air_bearing system through the master."""
 import json
 import math
-from pathlib import Path
 
 import fmpy
-import numpy as np
-import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
 from hypothesis import given, settings
 from hypothesis import strategies as st
+import numpy as np
+import pytest
 from scipy.linalg import expm
 
-from components.sensing import air_bearing as ab
 from components.core import rotations
+from components.sensing import air_bearing as ab
+from paths import REPO
 
-ROOT = Path(__file__).resolve().parents[1]
 TAU = math.radians(40.0)
 DCM_NAMES = [f"dcm_BN[{i},{j}]" for i in (1, 2, 3) for j in (1, 2, 3)]
 
@@ -67,7 +66,7 @@ def test_conventions_yaw_pitch_roll_and_quaternions():
 def test_atan2_extraction_covers_roll_beyond_90_deg_unlike_the_seed():
     psi, theta, phi = 0.4, 0.3, math.radians(120.0)
     c = R321(psi, theta, phi)
-    # the seed: phi = asin(R23 / cos(theta)) gives 60 deg, and the angles no longer give C back
+    # the description: phi = asin(R23 / cos(theta)) gives 60 deg, and the angles no longer give C back
     seed_phi = math.asin(c[1, 2] / math.cos(math.asin(-c[0, 2])))
     assert math.degrees(seed_phi) == pytest.approx(60.0, abs=1e-9)
     assert np.abs(R321(psi, theta, seed_phi) - c).max() > 0.5
@@ -106,7 +105,7 @@ def test_gimbal_lock_puts_the_combined_angle_into_yaw(sign):
 @pytest.mark.parametrize("angles, expected, limited", [
     ((100.0, 50.0, -60.0), (100.0, 40.0, -40.0), True),
     ((-170.0, -45.0, 10.0), (-170.0, -40.0, 10.0), True),
-    ((20.0, 5.0, 170.0), (20.0, 5.0, 40.0), True),   # upside down: the seed's asin would read 10 deg
+    ((20.0, 5.0, 170.0), (20.0, 5.0, 40.0), True),   # upside down: the description's asin would read 10 deg
     ((30.0, 30.0, -20.0), (30.0, 30.0, -20.0), False),
     ((-60.0, 40.0, -40.0), (-60.0, 40.0, -40.0), False),  # exactly at tau: not limited
 ])
@@ -153,7 +152,7 @@ def test_log_map_rate_is_exact_for_a_constant_rate(w, h):
         model.step(const_rate_dcm(c0, w, k * h), k * h, h)
         est = model.evaluate(const_rate_dcm(c0, w, (k + 1) * h))["omega_BN_B"]
         np.testing.assert_allclose(est, w, rtol=0, atol=1e-9)
-    # the seed's finite difference gives sin(|w| h)/h along the axis
+    # the description's finite difference gives sin(|w| h)/h along the axis
     fd = ab.rate_finite_difference(const_rate_dcm(c0, w, h), c0, h)
     n = np.linalg.norm(w)
     np.testing.assert_allclose(fd, np.asarray(w) / n * math.sin(n * h) / h, atol=1e-12)
@@ -208,7 +207,7 @@ def test_rate_estimate_converges_for_a_varying_rate(method, order_mid):
 
 
 def test_history_uses_the_thresholded_dcm():
-    """Roll at a constant rate through tau: with the seed's re-propagation the rate is that of
+    """Roll at a constant rate through tau: with the description's re-propagation the rate is that of
     the thresholded attitude (zero roll rate once clamped) and the stored previous DCM is the
     thresholded one; with rate_from_thresholded=False it is the measured rate throughout."""
     w, h = (0.08, 0.0, 0.0), 0.05
@@ -307,7 +306,7 @@ def ab_fmus(tmp_path_factory):
 
     d = tmp_path_factory.mktemp("air_bearing_fmus")
     for script in ("neighbor_air_bearing.py", "neighbor_attitude_to_dcm.py", "neighbor_rigid_body.py"):
-        build_fmus.build_fmu(ROOT / "fmus" / script, d)
+        build_fmus.build_fmu(REPO / "fmus" / script, d)
     return d
 
 
@@ -315,7 +314,7 @@ def ab_fmus(tmp_path_factory):
 def ab_ssp(ab_fmus, tmp_path_factory):
     import build_fmus
 
-    return build_fmus.pack_ssp(ROOT / "system_ssp" / "systems" / "air_bearing.ssd", ab_fmus,
+    return build_fmus.pack_ssp(REPO / "system_ssp" / "systems" / "air_bearing.ssd", ab_fmus,
                                tmp_path_factory.mktemp("air_bearing_ssp"))
 
 

@@ -3,27 +3,23 @@ components directly, each FMU through FMPy, and the attitude_determination syste
 the master."""
 import json
 import math
-import sys
-from pathlib import Path
 
 import fmpy
-import numpy as np
-import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
+import numpy as np
+import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-sys.path.insert(0, str(ROOT))
-
-import build_fmus  # noqa: E402
-import system_ssp  # noqa: E402
-from components.core import rotations  # noqa: E402
-from components.attitude import rigid_body  # noqa: E402
-from components.sensing import sensors, triad  # noqa: E402
+import build_fmus
+from components.attitude import rigid_body
+from components.core import rotations
+from components.sensing import sensors, triad
+from paths import REPO
+import system_ssp
 
 WRAPPERS = {"HorizonSensor": "neighbor_horizon_sensor", "SunSensor": "neighbor_sun_sensor", "Gyro": "neighbor_gyro",
             "GpsReceiver": "neighbor_gps", "AttitudeDetermination": "neighbor_attitude_determination"}
-SSD = ROOT / "system_ssp" / "systems" / "attitude_determination.ssd"
+SSD = REPO / "system_ssp" / "systems" / "attitude_determination.ssd"
 DEG = math.pi / 180.0
 R_LEO = (6798137.0, 0.0, 0.0)
 
@@ -304,8 +300,8 @@ def ad_fmus(tmp_path_factory):
     """Our five FMUs and RigidBody, built into a tmp dir, and each extracted once (the
     extracted directories stay for the session)."""
     d = tmp_path_factory.mktemp("ad_fmus")
-    paths = {name: build_fmus.build_fmu(ROOT / "fmus" / f"{mod}.py", d) for name, mod in WRAPPERS.items()}
-    paths["RigidBody"] = build_fmus.build_fmu(ROOT / "fmus" / "neighbor_rigid_body.py", d)
+    paths = {name: build_fmus.build_fmu(REPO / "fmus" / f"{mod}.py", d) for name, mod in WRAPPERS.items()}
+    paths["RigidBody"] = build_fmus.build_fmu(REPO / "fmus" / "neighbor_rigid_body.py", d)
     unzipped = {name: fmpy.extract(str(p), unzipdir=str(d / f"x_{name}")) for name, p in paths.items()}
     return paths, unzipped
 

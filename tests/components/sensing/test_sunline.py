@@ -1,27 +1,18 @@
-"""Seed 004: MRP conversions (components.core.mrp), the sunline-ephemeris model, its FMU
+"""The sunline module description: MRP conversions (components.core.mrp), the sunline-ephemeris model, its FMU
 `SunlineEphemeris` through FMPy, and the `sunline` system through the master."""
 import math
-import sys
-from pathlib import Path
 
 import fmpy
-import numpy as np
-import pytest
 from fmpy.fmi2 import FMU2Slave
 from fmpy.validation import validate_fmu
+import numpy as np
+import pytest
 
-ROOT = Path(__file__).resolve().parents[1]
-if str(ROOT) not in sys.path:
-    sys.path.insert(0, str(ROOT))
+from components.core import mrp, rotations
+from components.sensing import sunline
+from paths import REPO, SYSTEMS
+from system_ssp.systems.generators import sunline as g
 
-from components.core import rotations, mrp  # noqa: E402
-from components.sensing import sunline  # noqa: E402
-
-SYSTEMS = ROOT / "system_ssp" / "systems"
-if str(SYSTEMS) not in sys.path:
-    sys.path.insert(0, str(SYSTEMS))  # generate.py, generate_sunline.py
-
-import generate_sunline as g  # noqa: E402
 AXES = [(1.0, 0.0, 0.0), (0.0, 1.0, 0.0), (0.0, 0.0, 1.0), (-1.0, 0.0, 0.0), (0.0, -1.0, 0.0), (0.0, 0.0, -1.0)]
 TAN_PI_8 = math.sqrt(2.0) - 1.0  # |sigma| of a 90 deg rotation: tan(90 deg / 4)
 
@@ -115,8 +106,8 @@ def _rotated_x90(d):
 @pytest.mark.parametrize("r_sc", AXES)
 @pytest.mark.parametrize("rotation", ["none", "z90", "x90"])
 def test_seed_cases_sun_at_origin(r_sc, rotation):
-    """Seed 004 test: Sun at [0,0,0], spacecraft on each unit axis, zero attitude and 90 deg
-    rotations about z (the seed's case) and x; expected vectors to 1e-12."""
+    """The module description's unit test: Sun at [0,0,0], spacecraft on each unit axis, zero attitude and 90 deg
+    rotations about z (the module description's case) and x; expected vectors to 1e-12."""
     d_N = tuple(-x for x in r_sc)
     axis, expected = {"none": ((0.0, 0.0, 1.0), d_N), "z90": ((0.0, 0.0, 1.0), _rotated_z90(d_N)),
                       "x90": ((1.0, 0.0, 0.0), _rotated_x90(d_N))}[rotation]
@@ -193,7 +184,7 @@ def sunline_fmus(tmp_path_factory):
     import build_fmus
 
     d = tmp_path_factory.mktemp("sunline_fmus")
-    return {p.stem: p for p in (build_fmus.build_fmu(ROOT / "fmus" / f"neighbor_{m}.py", d)
+    return {p.stem: p for p in (build_fmus.build_fmu(REPO / "fmus" / f"neighbor_{m}.py", d)
                                 for m in ("sunline", "rigid_body"))}
 
 
@@ -238,7 +229,7 @@ def test_fmu_refuses_bad_parameter_and_coinciding_positions(sunline_fmus):
                          ({"r_SN_N[1]": 0.0}, ["r_SN_N", "r_BN_N", "coincide"])]:
         messages = []
 
-        def log(component, instance, status, category, message):
+        def log(component, instance, status, category, message, messages=messages):
             messages.append(message.decode() if isinstance(message, bytes) else message)
 
         with pytest.raises(FMICallException):
@@ -286,11 +277,10 @@ def sunline_ssp(sunline_fmus, tmp_path_factory):
     return build_fmus.pack_ssp(SYSTEMS / "sunline.ssd", fmu_dir, tmp_path_factory.mktemp("sunline_ssp"))
 
 
-def test_generated_system_files_are_up_to_date(sunline_fmus, tmp_path, monkeypatch):
-    import generate
+def test_generated_system_files_are_up_to_date(sunline_fmus, tmp_path):
+    from system_ssp.ssp.writer import SystemWriter
 
-    monkeypatch.setattr(generate, "FMU_DIR", sunline_fmus["SunlineEphemeris"].parent)
-    g.main(tmp_path)
+    g.generate(SystemWriter(tmp_path, sunline_fmus["SunlineEphemeris"].parent))
     assert (tmp_path / "sunline.ssd").read_text() == (SYSTEMS / "sunline.ssd").read_text()
     for p in (tmp_path / "parameters").glob("*.ssv"):
         assert p.read_text() == (SYSTEMS / "parameters" / p.name).read_text(), p.name

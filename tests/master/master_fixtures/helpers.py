@@ -7,7 +7,7 @@ import sys
 import zipfile
 
 HERE = Path(__file__).resolve().parent
-REPO = HERE.parent.parent
+REPO = HERE.parents[2]
 PY = sys.executable
 SCRIPTS = {"gain": "mf_gain.py", "integrator": "mf_integrator.py", "threshold": "mf_threshold.py",
            "timer": "mf_timer.py"}
@@ -78,7 +78,8 @@ def connection(a, b, inner=""):
 def ssd_text(elements, connections="", units="", experiment="", system_extra="", name="test", system_head=""):
     conns = f"<ssd:Connections>{connections}</ssd:Connections>" if connections else ""
     return (SSD_HEAD.format(name=name)
-            + f'<ssd:System name="root">{system_head}<ssd:Elements>{elements}</ssd:Elements>{conns}{system_extra}</ssd:System>\n'
+            + f'<ssd:System name="root">{system_head}<ssd:Elements>{elements}</ssd:Elements>{conns}'
+            + f'{system_extra}</ssd:System>\n'
             + (f"<ssd:Units>{units}</ssd:Units>\n" if units else "")
             + experiment
             + "</ssd:SystemStructureDescription>\n")
