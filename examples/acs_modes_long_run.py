@@ -1,11 +1,11 @@
-"""Long run of the seed-002 ACS modes system with the seed's mode delays (RMD 6000 s, ...).
+"""Long run of the ACS of the mode specification modes system with the specification's mode delays (RMD 6000 s, ...).
 
     python build_fmus.py            # builds build/ssp/acs_modes.ssp
     python examples/acs_modes_long_run.py [stop_time] [step]
 
 Scenario: acs_modes_sun_facing.ssv, a 420 km orbit at 98 deg inclination whose node is 90 deg
 east of the Sun at the epoch (the Sun 75 deg from the orbit plane): no eclipse. Why: with the
-seed's RMD = 6000 s longer than the 5577 s period of a 420 km orbit, Reorient always meets a
+specification's RMD = 6000 s longer than the 5577 s period of a 420 km orbit, Reorient always meets a
 night before RMD and the tables send it back to Spinup (Spinup col 5), so the deployment never
 completes in an orbit with eclipses. Without eclipses there is no Orbit Night either: the run
 ends holding Orbit Day (7). The default 0.2 A.m2 coils and a 2 s step (the 1 s of the system's
@@ -63,7 +63,7 @@ def main(stop=36000.0, step=2.0):
     ax[3].legend(loc="upper right")
     for a in ax:
         a.grid(True, alpha=0.3)
-    fig.suptitle("Seed-002 ACS modes, seed delays, eclipse-free (sun-facing) orbit")
+    fig.suptitle("ACS of the mode specification modes, seed delays, eclipse-free (sun-facing) orbit")
     fig.tight_layout()
     out = ROOT / "results" / "acs_modes_long_run.png"
     out.parent.mkdir(exist_ok=True)

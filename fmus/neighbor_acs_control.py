@@ -1,4 +1,4 @@
-"""FMU `AcsControl` (instance `control`): the per-mode control laws of the seed-002 ACS.
+"""FMU `AcsControl` (instance `control`): the per-mode control laws of the ACS of the mode specification.
 
 Wraps components.acs.control.AcsControl (the laws and their equations are in its docstring):
 mode and permissions from the mode manager, body rate, field, Sun heading, wheel rate and time
@@ -16,13 +16,14 @@ PARAMETERS = (
     ("Iy", "kg.m2", "Spacecraft inertia about Y, the spin axis (> 0)"),
     ("Iz", "kg.m2", "Spacecraft inertia about Z (> 0)"),
     ("J_w", "kg.m2", "Momentum-wheel inertia about Y (> 0)"),
-    ("spin_rate", "rad/s", "Desired spin rate about +Y, H_d = Iy spin_rate (> 0; seed 5 deg/s)"),
+    ("spin_rate", "rad/s", "Desired spin rate about +Y, H_d = Iy spin_rate (> 0; the specification's 5 deg/s)"),
     ("k_detumble", "N.m.s", "Detumble gain: m_y = k (omega x B)_y / |B|^2 (> 0)"),
     ("k_nutation", "N.m.s", "Nutation damping gain of the Y coil in Spinup/Reorient (> 0)"),
     ("k_momentum", "Hz", "Momentum gain (1/s): tau_d = k (H_d - H) (> 0)"),
     ("k_precession", "Hz", "Precession gain (1/s) on the Sun's Y component in Reorient (> 0)"),
     ("k_precession_fine", "Hz", "Precession gain (1/s) on the Sun's Y component in Acquire/Orbit Day/Night (> 0)"),
-    ("precession_taper", "N.m.s", "Momentum error below which precession has full gain, tapered to 0 at twice it (> 0)"),
+    ("precession_taper", "N.m.s",
+     "Momentum error below which precession has full gain, tapered to 0 at twice it (> 0)"),
     ("K_azimuth", "rad/s2", "Azimuth stiffness (1/s2 per rad) of the wheel loop (> 0)"),
     ("D_azimuth", "Hz", "Azimuth damping (1/s) of the wheel loop (> 0)"),
     ("max_slew_rate", "rad/s", "Largest body rate about Y the azimuth loop asks (> 0)"),
@@ -36,7 +37,8 @@ SUN = [f"sun_heading_B[{i}]" for i in (1, 2, 3)]
 
 
 class AcsControl(NeighborSlave):
-    description = ("ACS control laws per mode (seed 002): magnetic dipole commands for the three torque coils "
+    description = ("ACS control laws per mode (ACS mode specification): magnetic dipole commands for the three "
+                   "torque coils "
                    "and the torque command of the Y momentum wheel")
 
     def __init__(self, **kwargs):

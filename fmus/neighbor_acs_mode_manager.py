@@ -1,6 +1,6 @@
-"""FMU `AcsModeManager` (instance `modes`): the ten-mode ACS mode manager of seed 002.
+"""FMU `AcsModeManager` (instance `modes`): the ten-mode ACS mode manager of the ACS mode specification.
 
-Wraps components.acs.modes.AcsModeManager: the seed's decision tables as data, evaluated at
+Wraps components.acs.modes.AcsModeManager: the specification's decision tables as data, evaluated at
 each communication point with the inputs present there (do_step(t, h) decides at t; the mode
 holds over [t, t + h]). Every output is state (mode, time in mode, permissions of the mode), so
 no output depends directly on an input. The model keeps the time: the start time at
@@ -48,7 +48,8 @@ INPUTS = (
 
 
 class AcsModeManager(NeighborSlave):
-    description = ("ACS mode manager (seed 002): ten modes decided from the seed's decision tables at each "
+    description = ("ACS mode manager (ACS mode specification): ten modes decided from the specification's "
+                   "decision tables at each "
                    "communication point, with mode delays for hysteresis; falls back to Spinup when uncertain")
 
     def __init__(self, **kwargs):
@@ -74,7 +75,7 @@ class AcsModeManager(NeighborSlave):
         self.output("rule_table", lambda: -1 if self.model.rule is None else self.model.rule[0], None,
                     "Mode whose table holds the rule of the last decision (-1: uncertain fallback)", int)
         self.output("rule_column", lambda: 0 if self.model.rule is None else self.model.rule[1], None,
-                    "1-based column of that rule in the seed's table (0: uncertain fallback)", int)
+                    "1-based column of that rule in the specification's table (0: uncertain fallback)", int)
 
     def build_model(self):
         params = {name: self.values[name] for name, _, _ in PARAMETERS}

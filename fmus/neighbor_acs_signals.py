@@ -18,14 +18,16 @@ S_IN = [f"sun_heading_B[{i}]" for i in (1, 2, 3)]
 
 
 class AcsSignals(NeighborSlave):
-    description = ("State values of the seed-002 ACS mode manager from the truth (momentum errors, Sun "
+    description = ("State values of the ACS mode manager (ACS mode specification) from the truth (momentum "
+                   "errors, Sun "
                    "elevation/azimuth sines, body rate) and a scripted ground-command window")
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         d = signals.PARAMETER_DEFAULTS
         self.parameter("Iy", d["Iy"], "kg.m2", "Spacecraft inertia about Y for H_d = Iy spin_rate (> 0)")
-        self.parameter("spin_rate", d["spin_rate"], "rad/s", "Desired spin rate about +Y (> 0; seed 5 deg/s)")
+        self.parameter("spin_rate", d["spin_rate"], "rad/s",
+                       "Desired spin rate about +Y (> 0; the specification's 5 deg/s)")
         self.parameter("command_start", d["command_start"], "s", "Ground command true from this time")
         self.parameter("command_end", d["command_end"], "s",
                        "Ground command true until this time (exclusive; <= command_start: never)")

@@ -1,8 +1,8 @@
 """FMU `AirBearingKinematics` (instance `kinematics`): attitude thresholding for a spherical
-air-bearing testbed without an IMU (seed 001).
+air-bearing testbed without an IMU (the air-bearing note).
 
 Wraps components.sensing.air_bearing.AirBearingKinematics. Input: the DCM stream dcm_BN[i,j] ([BN],
-N components to B components, like components.core.rotations.attitude_matrix; the seed's R = R^N_B
+N components to B components, like components.core.rotations.attitude_matrix; the description's R = R^N_B
 (B to N) is its transpose). Outputs: the attitude rebuilt from 3-2-1 Euler angles with pitch
 and roll limited to +-tau, the angular velocity estimated from consecutive DCMs, the limited
 angles and a `limited` flag. All outputs depend directly on the DCM input (the rate through
@@ -25,7 +25,8 @@ DCM_INPUTS = [f"dcm_BN[{i},{j}]" for i in (1, 2, 3) for j in (1, 2, 3)]
 
 
 class AirBearingKinematics(NeighborSlave):
-    description = ("Air-bearing testbed kinematics without an IMU (seed 001): angular velocity from the DCM "
+    description = ("Air-bearing testbed kinematics without an IMU (the air-bearing note): angular velocity from "
+                   "the DCM "
                    "stream, 3-2-1 Euler angles, pitch and roll limited to +-tau, DCM and quaternion rebuilt "
                    "from the limited angles")
 
@@ -37,7 +38,7 @@ class AirBearingKinematics(NeighborSlave):
                        "Largest accepted max|C C^T - I| of the input dcm_BN, in (0, 0.1]; beyond it is an error")
         self.parameter("rate_method", "log_map", None,
                        "'log_map': omega = log(C_k C_prev^T)/h, exact for a constant rate; 'finite_difference': "
-                       "the seed's [omega x] = -(C_k - C_prev)/h C_k^T (skew part)", str)
+                       "the description's [omega x] = -(C_k - C_prev)/h C_k^T (skew part)", str)
         self.parameter("rate_from_thresholded", True, None,
                        "True (seed): omega is the rate of the thresholded DCM stream (the thresholded DCM is "
                        "the previous DCM of the next estimate); false: rate of the raw input DCMs", bool)
@@ -45,7 +46,7 @@ class AirBearingKinematics(NeighborSlave):
             for j in range(1, 4):
                 self.input(f"dcm_BN[{i},{j}]", 1.0 if i == j else 0.0, "1",
                            f"Input DCM [BN] element ({i},{j}): maps N components to B components "
-                           "(transpose of the seed's R^N_B)")
+                           "(transpose of the description's R^N_B)")
 
         self.output_array("q_BN", 4, lambda: self._out()["q_BN"], "1",
                           "Thresholded attitude quaternion of B relative to N, scalar last (sign continuous)",

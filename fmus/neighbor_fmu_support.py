@@ -55,7 +55,7 @@ class ParameterError(ValueError):
 class NeighborSlave(Fmi2Slave):
     author = "neighbor-cosim"
     license = "MIT"
-    version = "0.1.0"
+    version = "0.2.0"  # build_fmus.py sets the product version (system_ssp.__version__)
     # A wrapper whose get_state/set_state capture the whole model sets this True.
     can_get_and_set_state = True
 

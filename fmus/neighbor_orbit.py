@@ -45,7 +45,8 @@ class Orbit(NeighborSlave):
         self.output("ecc", out("ecc"), "1", "Osculating eccentricity")
         self.output("perigee_altitude", out("perigee_altitude"), "m", "Osculating a (1 - e) - 6378136.3 m")
         self.output("apogee_altitude", out("apogee_altitude"), "m", "Osculating a (1 + e) - 6378136.3 m")
-        self.output("density", out("density"), "kg/m3", "Atmospheric density at the current position and time (0 when drag is false)")
+        self.output("density", out("density"), "kg/m3",
+                    "Atmospheric density at the current position and time (0 when drag is false)")
         self.output("reentered", out("reentered"), None,
                     "Latched true once the geodetic altitude is below reentry_altitude; the model then holds "
                     "its state", bool)

@@ -1,4 +1,4 @@
-"""FMU `Paddles` (instance `paddles`): deployable solar paddles (seed 002).
+"""FMU `Paddles` (instance `paddles`): deployable solar paddles (ACS mode specification).
 
 Wraps components.acs.paddles.Paddles: deployment progresses while `deploy` is true and latches
 deployed after deployment_time. Outputs are states (no direct dependencies).

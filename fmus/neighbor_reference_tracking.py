@@ -50,7 +50,8 @@ class ReferenceTrackingController(NeighborSlave):
                           "Commanded body torque: continuous, clipped to +-max_torque (quantize false), or "
                           "+-max_torque / 0 (quantize true)", depends_on=deps)
         self.output_array("thrust_flag", 3, lambda: cmd()[1], None,
-                          "Sign of the commanded torque per axis: 1 positive, -1 negative, 0 none", int, depends_on=deps)
+                          "Sign of the commanded torque per axis: 1 positive, -1 negative, 0 none", int,
+                          depends_on=deps)
         done_deps = Q_INPUTS + RATE_INPUTS + QREF_INPUTS + WREF_INPUTS + ["guidance_done"]
         self.output("done", lambda: self.feedthrough(self._done), None,
                     "Guidance done and attitude error <= angle_tol and every rate error <= rate_tol", bool,

@@ -26,7 +26,8 @@ class RigidBody(NeighborSlave):
         super().__init__(**kwargs)
         self.inertia_parameters("Spacecraft mass for the box inertia (Eq. 4)")
         self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
-                             "Initial attitude quaternion q_BN, scalar last (rk4 normalizes it, euler keeps it as given like the thesis scripts; zero norm is an error)")
+                             "Initial attitude quaternion q_BN, scalar last (rk4 normalizes it, euler keeps it "
+                             "as given like the thesis scripts; zero norm is an error)")
         self.parameter_array("omega0", [0.0, 0.0, 0.0], "rad/s", "Initial angular velocity omega_BN_B")
         self.parameter("integrator", "rk4", None,
                        "'euler': one explicit Euler step per communication step, no normalization (thesis "

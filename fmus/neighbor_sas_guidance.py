@@ -23,7 +23,8 @@ class SunAvoidanceGuidance(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.parameter_array("boresight_B", [0.0, 0.0, 1.0], "1", "Body-fixed boresight direction P in B (non-zero; normalized)")
+        self.parameter_array("boresight_B", [0.0, 0.0, 1.0], "1",
+                             "Body-fixed boresight direction P in B (non-zero; normalized)")
         self.parameter_array("sun_N", [1.0, 0.0, 0.0], "1", "Sun direction S in N (non-zero; normalized)")
         self.parameter("epsilon", math.radians(30.0), "rad", "Sun keep-out cone half-angle, in (0, pi/2)")
         self.parameter("margin", math.radians(5.0), "rad",
@@ -52,7 +53,8 @@ class SunAvoidanceGuidance(NeighborSlave):
         self.output("sun_angle", lambda: ref()["sun_angle"], "rad", "Angle between the reference boresight and the Sun")
         self.output("min_sun_angle", lambda: self.model.min_angle, "rad",
                     "Smallest boresight-to-Sun angle of the whole planned path (exact swept-arc test)")
-        self.output("done", lambda: ref()["done"], None, "The reference profile has ended (final attitude, at rest)", bool)
+        self.output("done", lambda: ref()["done"], None, "The reference profile has ended (final attitude, at rest)",
+                    bool)
         self.output("duration", lambda: self.model.duration, "s", "Planned total duration (sum of segment durations)")
         self.output_array("segment_angle", MAX_SEGMENTS, lambda: self._per_segment(lambda s: s.angle), "rad",
                           "Eigenaxis rotation angle of each segment (0 for unused segments)")

@@ -1,4 +1,4 @@
-"""FMU `SunlineEphemeris` (instance `sunline`): Sun heading in B from ephemeris (seed 004).
+"""FMU `SunlineEphemeris` (instance `sunline`): Sun heading in B from ephemeris (the sunline module description).
 
 Wraps components.sensing.sunline.SunlineEphemeris: d_N = (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N|,
 d_B = [BN(sigma_BN)] d_N, or A(q_BN) d_N with attitude_input = "quaternion". Stateless; both

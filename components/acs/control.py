@@ -1,4 +1,4 @@
-"""Per-mode control laws of the seed-002 ACS (magnetic torque coils on X, Y, Z and a momentum
+"""Per-mode control laws of the ACS of the mode specification (magnetic torque coils on X, Y, Z and a momentum
 wheel on Y), commanded by the mode manager (components.acs.modes).
 
 Inputs (all in B): mode, coils_enabled / wheel_enabled (the mode manager's permissions), the body
@@ -8,7 +8,7 @@ wheel motor torque command tau_w (N.m, on the wheel about +Y; the body feels -ta
 
 Notation: J = diag(Ix, Iy, Iz) the spacecraft inertia, J_w the wheel inertia, H = J omega +
 J_w Omega y_hat the total angular momentum in B, H_d = Iy w_s y_hat the desired spin momentum
-(w_s = 5 deg/s, the seed's Spinup rate), Sun elevation sin(el) = s_y (from the X-Z plane),
+(w_s = 5 deg/s, the specification's Spinup rate), Sun elevation sin(el) = s_y (from the X-Z plane),
 azimuth az = atan2(s_x, s_z) (about Y from +Z). A desired torque tau_d is produced by the coils
 as m = B x tau_d / |B|^2 (then m x B = tau_d minus its component along B, which coils cannot
 produce). The coils saturate per axis downstream (components.acs.magnetorquer).
@@ -46,7 +46,8 @@ Laws (mode: dipole; wheel):
   follows e_H as -k_h H_perp damps the nutation. k_pf = 5e-3
   1/s (200 s time constant, 2.5x Reorient's): the elevation must be within the fine error (sin 2
   deg) at dusk, since Orbit Night holds only with the fine Sun errors (Orbit Night col 4);
-  1e-2 1/s drove a slow nutation/elevation divergence at 5 s steps. Orbit Night uses the same law (the seed draws the
+  1e-2 1/s drove a slow nutation/elevation divergence at 5 s steps. Orbit Night uses the same law (the
+  specification draws the
   attitude from the optical system at night; here the inputs are the same truth signals).
 - 6 Deploy Paddles: m = 0 ("cuts all magnetic moments to zero"); tau_w = 0 (holds the speed).
 - 9 Ground Command (our choice, safe): m = 0 and tau_w = 0 (wheel holds its speed) until ground
@@ -72,7 +73,7 @@ uT at 420 km, torques of order 0.2 A.m2 x 30 uT = 6 uN.m):
   the loop time constant 500 s is long against the 1 s step and a few x the 90 deg/orbit-quarter
   field rotation, so it averages over the field direction.
 - k_p = 2e-3 1/s: at s_y = 0.5 it asks 1.1e-5 N.m, the coils' authority; precession rates of
-  ~0.05 deg/s, RMD-scale reorientations as the seed's 6000 s delay implies.
+  ~0.05 deg/s, RMD-scale reorientations as the specification's 6000 s delay implies.
 - K_a = 2.5e-3 1/s2, D_a = 0.07 1/s: 0.05 rad/s natural frequency, damping 0.7, settles in
   ~120 s (within AMD + DPMD), omega_n h = 0.05 at 1 s steps; the torque 0.13 x 2.5e-3 x 1 rad
   = 0.3 mN.m is within the 1 mN.m wheel.
@@ -84,12 +85,13 @@ import math
 from ..core.checks import finite_parameters
 from .modes import AcsMode
 
-WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = AcsMode
+(WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT,
+ GROUND_COMMAND) = AcsMode
 
 PARAMETER_DEFAULTS = {
     "Ix": 0.05, "Iy": 0.13, "Iz": 0.10,  # kg.m2, the 12 kg 0.3 x 0.1 x 0.2 m box
     "J_w": 2.0e-5,  # kg.m2, components.acs.momentum_wheel default
-    "spin_rate": math.radians(5.0),  # rad/s, the seed's +5 deg/s about Y
+    "spin_rate": math.radians(5.0),  # rad/s, the specification's +5 deg/s about Y
     "k_detumble": 2.0e-3,  # N.m.s
     "k_nutation": 2.0e-3,  # N.m.s
     "k_momentum": 2.0e-3,  # 1/s
@@ -101,7 +103,7 @@ PARAMETER_DEFAULTS = {
     "max_slew_rate": math.radians(0.3),  # rad/s
     "precession_taper": 6.0e-4,  # N.m.s: precession at full gain below this momentum error, off at twice it
     "reorient_hold_elevation": math.sin(math.radians(15.0)),  # 1 (a sine), above the 10 deg coarse error
-    "reorient_duration": 6000.0,  # s, the seed's RMD
+    "reorient_duration": 6000.0,  # s, the specification's RMD
 }
 NONNEGATIVE = ("reorient_hold_elevation", "reorient_duration")
 B_MIN = 1.0e-9  # T: below it the field is taken as absent (no coil command)
@@ -112,7 +114,8 @@ def check_parameters(params=None):
     for k, v in p.items():
         if k in NONNEGATIVE:
             if v < 0 or (k == "reorient_hold_elevation" and v >= 1.0):
-                raise ValueError(f"parameter {k} = {v!r} must be in [0, {'1)' if k.startswith('reorient_hold') else 'inf)'}")
+                upper = "1)" if k.startswith("reorient_hold") else "inf)"
+                raise ValueError(f"parameter {k} = {v!r} must be in [0, {upper}")
         elif v <= 0:
             raise ValueError(f"parameter {k} = {v!r} must be in (0, inf)")
     return p

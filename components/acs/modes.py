@@ -1,36 +1,36 @@
-"""ACS mode manager of seed 002: ten modes of a spinning spacecraft with three magnetic torque
+"""ACS mode manager of the ACS mode specification: ten modes of a spinning spacecraft with three magnetic torque
 coils, a momentum wheel on Y, deployable solar paddles on the +Z face and a star-tracking
-optical system, driven by the seed's decision tables.
+optical system, driven by the specification's decision tables.
 
 Modes: 0 Wait, 1 Detumble, 2 Spinup, 3 Reorient, 4 Deploy Wheel, 5 Acquire, 6 Deploy Paddles,
 7 Orbit Day, 8 Orbit Night, 9 Ground Command.
 
 Tables as data
 --------------
-Every column of every table of the seed is one `Rule` in `RULES`, in the seed's order: the
+Every column of every table of the specification is one `Rule` in `RULES`, in the specification's order: the
 mode whose table holds it (= the mode it leads into), its 1-based column, the current modes it
 applies from ("Control Mode" rows) and its conditions ("State Values" rows) by name, True/False
-as printed (a blank is a don't-care and is left out). Condition names are the seed's rows
+as printed (a blank is a don't-care and is left out). Condition names are the specification's rows
 written as predicates:
 
 - Booleans: `orbit_day`, `paddles_deployed`, `optical_tracking`, `reset`, `ground_command`;
 - comparisons `<quantity> <op> <threshold>` with op one of > >= < <=. Quantities:
   `xz_momentum_error`, `momentum_error`, `|wheel_rate|`, `|sin_sun_elevation|`,
   `|sin_sun_azimuth|`, `body_rate`, `t_in_mode`; thresholds are parameter names
-  (`PARAMETER_DEFAULTS`), the mode delays by the seed's abbreviations (WMD ... GCMD).
+  (`PARAMETER_DEFAULTS`), the mode delays by the specification's abbreviations (WMD ... GCMD).
 
-Every delay row of the seed ("t - t(entered X) >= D") names the mode X the column applies from,
+Every delay row of the specification ("t - t(entered X) >= D") names the mode X the column applies from,
 so it is written `t_in_mode >= D` (checked when the tables are built). Times are compared with a
 tolerance TIME_TOL = 1 ns, so that communication points accumulated in floating point
 (100 steps of 0.1 s) reach a delay; `t_in_mode >= D` is true from t_in_mode >= D - 1 ns.
-Sun errors are magnitudes: the seed compares "sine sun elevation/azimuth" with error bounds,
+Sun errors are magnitudes: the specification compares "sine sun elevation/azimuth" with error bounds,
 so the absolute values of the sines are compared (the sign says on which side the Sun is; a
-sine cannot tell azimuth a from 180 deg - a, the seed's choice, see the module's README).
+sine cannot tell azimuth a from 180 deg - a, the specification's choice, see the module's README).
 `|wheel_rate|`: the wheel may spin either way about Y.
 
-Where the draft contradicts itself, a rule's `conditions` differ from what the seed prints; the
+Where the draft contradicts itself, a rule's `conditions` differ from what the specification prints; the
 literal seed values are then in `seed_conditions` and the reason in `note` (amendments A1-A6,
-listed in `AMENDMENTS`). Columns the seed does not print but its text requires are marked
+listed in `AMENDMENTS`). Columns the specification does not print but its text requires are marked
 `added=True`.
 
 Evaluation semantics (`decide`)
@@ -48,7 +48,7 @@ from-modes contain m and whose conditions all hold "fires". Then, in this order:
 5. no rule fires: the controller is uncertain -> Spinup.
 
 "Uncertain" is exactly cases 3-with-conflict and 5; the decision falls back to Spinup, the
-seed's safe mode, and `uncertain` is set until the next decision. A fallback while already in
+specification's safe mode, and `uncertain` is set until the next decision. A fallback while already in
 Spinup stays in Spinup without restarting its timer (so SMD can elapse); from another mode it
 enters Spinup. Startup is the pseudo-mode STARTUP, whose only rule (Wait col 1) enters Wait at
 the start time.
@@ -59,7 +59,7 @@ present at t and the time in mode t - t_entered; a transition enters its mode at
 so `time_in_mode` reads (t + h) - t_entered. A delay condition `t_in_mode >= D` therefore fires
 at the first communication point at least D after the mode was entered, never before.
 
-Actuator permissions per mode (`PERMISSIONS`) follow the seed's mode descriptions.
+Actuator permissions per mode (`PERMISSIONS`) follow the specification's mode descriptions.
 """
 import math
 import re
@@ -70,7 +70,7 @@ from ..core.checks import finite_parameters
 
 
 class AcsMode(IntEnum):
-    """The ten modes of the seed's draft, in its numbering (the FMU output `mode`)."""
+    """The ten modes of the specification's draft, in its numbering (the FMU output `mode`)."""
     WAIT = 0
     DETUMBLE = 1
     SPINUP = 2
@@ -84,7 +84,8 @@ class AcsMode(IntEnum):
 
 
 # The decision tables below read best with bare names: one per mode, in value order.
-WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT, GROUND_COMMAND = AcsMode
+(WAIT, DETUMBLE, SPINUP, REORIENT, DEPLOY_WHEEL, ACQUIRE, DEPLOY_PADDLES, ORBIT_DAY, ORBIT_NIGHT,
+ GROUND_COMMAND) = AcsMode
 STARTUP = -1  # pseudo-mode before the first decision ("Control Mode: Startup")
 MODE_NAMES = ("Wait", "Detumble", "Spinup", "Reorient", "Deploy Wheel", "Acquire", "Deploy Paddles",
               "Orbit Day", "Orbit Night", "Ground Command")
@@ -99,8 +100,8 @@ DELAYS = ("WMD", "DMD", "SMD", "RMD", "DWMD", "AMD", "DPMD", "ODMD", "GCMD")
 DELAY_MODE = {"WMD": WAIT, "DMD": DETUMBLE, "SMD": SPINUP, "RMD": REORIENT, "DWMD": DEPLOY_WHEEL,
               "AMD": ACQUIRE, "DPMD": DEPLOY_PADDLES, "ODMD": ORBIT_DAY, "GCMD": GROUND_COMMAND}
 
-# Defaults. The delays are the seed's. The thresholds are ours, for a 6U-class spacecraft of
-# about 0.1 kg.m2 per axis (the NEIGHBOR host's order of magnitude) spun at the seed's 5 deg/s
+# Defaults. The delays are the specification's. The thresholds are ours, for a 6U-class spacecraft of
+# about 0.1 kg.m2 per axis (the NEIGHBOR host's order of magnitude) spun at the specification's 5 deg/s
 # about Y: spin momentum 0.1 * 5 deg/s = 8.7e-3 N.m.s.
 PARAMETER_DEFAULTS = {
     # detumbled when the X-Z momentum is below 1e-3 N.m.s (0.57 deg/s transverse rate at 0.1 kg.m2)
@@ -166,12 +167,12 @@ def _parse(name):
 @dataclass(frozen=True)
 class Rule:
     target: int  # the mode whose table holds the column = the mode it leads into
-    column: int  # 1-based column of that table in the seed (added columns after the seed's)
+    column: int  # 1-based column of that table in the specification (added columns after the specification's)
     from_modes: tuple  # "Control Mode" rows marked T
     conditions: dict  # "State Values": name -> required truth (blank = absent)
     kind: str = "normal"  # "normal", "startup", "reset", "ground"
     seed_conditions: dict = None  # the literal draft, where `conditions` amends it
-    added: bool = False  # a column the seed's text requires but its table does not print
+    added: bool = False  # a column the specification's text requires but its table does not print
     note: str = ""
 
     def fires(self, mode, inputs, t_in_mode, params):
@@ -206,19 +207,19 @@ def before(delay):  # "t - t(entered X) < D"
 
 
 RULES = (
-    # ---- Seed "= Wait (Mode 0)" (ACS Mode), 3 columns ----------------------------------------
+    # ---- Table "= Wait (Mode 0)" (ACS Mode), 3 columns ----------------------------------------
     Rule(WAIT, 1, (STARTUP,), {}, kind="startup"),
     Rule(WAIT, 2, ANY, {"reset": T}, kind="reset",
          note="'Any' includes Wait: a reset in Wait re-enters Wait and restarts WMD"),
     Rule(WAIT, 3, (WAIT,), {before("WMD"): T}),
-    # ---- Seed "= Detumble (Mode 1)" (ACS Mode (2)), 6 columns -----------------------------------
+    # ---- Table "= Detumble (Mode 1)" (ACS Mode (2)), 6 columns -----------------------------------
     Rule(DETUMBLE, 1, (WAIT,), {since("WMD"): T}),
     Rule(DETUMBLE, 2, (DETUMBLE,), {before("DMD"): T}),
     Rule(DETUMBLE, 3, (DETUMBLE,), {before("DMD"): F, XZ_HIGH: T}),
     Rule(DETUMBLE, 4, (SPINUP,), {XZ_HIGH: T, since("SMD"): T, PADDLES: F}),
     Rule(DETUMBLE, 5, (SPINUP,), {XZ_HIGH: T, since("SMD"): T, TRACKING: F}),
     Rule(DETUMBLE, 6, (GROUND_COMMAND,), {since("GCMD"): T}),
-    # ---- Seed "= Spinup (Mode 2)" (ACS Mode (3)), 9 columns -------------------------------------
+    # ---- Table "= Spinup (Mode 2)" (ACS Mode (3)), 9 columns -------------------------------------
     Rule(SPINUP, 1, (DETUMBLE,), {since("DMD"): T, XZ_LOW: T}),
     Rule(SPINUP, 2, (SPINUP,), {before("SMD"): T, PADDLES: F, TRACKING: F}),
     Rule(SPINUP, 3, (SPINUP,), {XZ_LOW: T, before("SMD"): F, PADDLES: F, TRACKING: F, MOM_HIGH: T}),
@@ -232,7 +233,7 @@ RULES = (
     Rule(SPINUP, 9, (ORBIT_NIGHT,), {TRACKING: T, DAY: F, "body_rate > max_tumble_rate": T,
                                      "|sin_sun_azimuth| > fine_azimuth_error": F,
                                      "|sin_sun_elevation| > fine_elevation_error": F}),
-    # ---- Seed "= Reorient (Mode 3)" (ACS Mode (4)), 5 columns -----------------------------------
+    # ---- Table "= Reorient (Mode 3)" (ACS Mode (4)), 5 columns -----------------------------------
     Rule(REORIENT, 1, (SPINUP,), {since("SMD"): T, XZ_LOW: T, MOM_HIGH: F, DAY: T, PADDLES: F}),
     Rule(REORIENT, 2, (SPINUP,), {since("SMD"): T, XZ_LOW: T, MOM_HIGH: F, DAY: T, TRACKING: F}),
     Rule(REORIENT, 3, (REORIENT,), {DAY: T, since("RMD"): T},
@@ -242,7 +243,7 @@ RULES = (
          note="literal: before RMD Reorient holds only while the elevation is beyond the coarse "
               "error; reaching it earlier, or a momentum error in daylight, matches no rule (Spinup)"),
     Rule(REORIENT, 5, (ACQUIRE,), {DAY: T, EL_COARSE_HIGH: T, since("AMD"): T}),
-    # ---- Seed "= Deploy Wheel (Mode 4)" (ACS Mode (5)), 2 columns -------------------------------
+    # ---- Table "= Deploy Wheel (Mode 4)" (ACS Mode (5)), 2 columns -------------------------------
     Rule(DEPLOY_WHEEL, 1, (REORIENT,), {since("RMD"): T, DAY: T, MOM_HIGH: F, EL_COARSE_HIGH: F, WHEEL_SLOW: T},
          seed_conditions={since("RMD"): T, DAY: T, MOM_HIGH: T, EL_COARSE_HIGH: T, WHEEL_SLOW: T},
          note="A1: the draft's momentum and elevation rows read '>' with T; read as '<=' (F). "
@@ -250,7 +251,7 @@ RULES = (
               "day, RMD), so Deploy Wheel could never be entered; and Reorient's goal is a small "
               "elevation. Read so, it is Acquire col 1 with the wheel below its nominal rate."),
     Rule(DEPLOY_WHEEL, 2, (DEPLOY_WHEEL,), {before("DWMD"): T}),
-    # ---- Seed "= Acquire (Mode 5)" (ACS Mode (6)), 8 columns ------------------------------------
+    # ---- Table "= Acquire (Mode 5)" (ACS Mode (6)), 8 columns ------------------------------------
     Rule(ACQUIRE, 1, (REORIENT,), {since("RMD"): T, DAY: T, MOM_LOW: T, EL_COARSE_LOW: T, WHEEL_NOMINAL: T}),
     Rule(ACQUIRE, 2, (ACQUIRE,), {DAY: T, before("AMD"): T}),
     Rule(ACQUIRE, 3, (ACQUIRE,), {DAY: T, EL_COARSE_LOW: T, before("AMD"): F, AZ_COARSE_HIGH: T}),
@@ -259,10 +260,10 @@ RULES = (
     Rule(ACQUIRE, 6, (DEPLOY_PADDLES,), {PADDLES: F, since("DPMD"): T}),
     Rule(ACQUIRE, 7, (ORBIT_DAY,), {DAY: T, EL_COARSE_LOW: T, AZ_COARSE_HIGH: T, since("ODMD"): T}),
     Rule(ACQUIRE, 8, (ORBIT_DAY,), {EL_COARSE_LOW: T, AZ_COARSE_HIGH: T, TRACKING: T}),
-    # ---- Seed "= Deploy Paddles (Mode 6)" (ACS Mode (7)), 2 columns -----------------------------
+    # ---- Table "= Deploy Paddles (Mode 6)" (ACS Mode (7)), 2 columns -----------------------------
     Rule(DEPLOY_PADDLES, 1, (ACQUIRE,), {since("AMD"): T, DAY: T, EL_COARSE_LOW: T, AZ_COARSE_LOW: T, PADDLES: F}),
     Rule(DEPLOY_PADDLES, 2, (DEPLOY_PADDLES,), {PADDLES: F, before("DPMD"): T}),
-    # ---- Seed "= Orbit Day (Mode 7)" (ACS Mode (8)), 6 columns ----------------------------------
+    # ---- Table "= Orbit Day (Mode 7)" (ACS Mode (8)), 6 columns ----------------------------------
     Rule(ORBIT_DAY, 1, (ACQUIRE,), {since("AMD"): T, DAY: T, EL_COARSE_LOW: T, AZ_COARSE_LOW: T, PADDLES: T}),
     Rule(ORBIT_DAY, 2, (ORBIT_NIGHT,), {DAY: T, "|sin_sun_elevation| >= fine_elevation_error": T},
          note="the draft's garbled '=>' read as '>=', the complement of Orbit Night col 4's '<'"),
@@ -275,7 +276,7 @@ RULES = (
               "Acquire in daylight, the usual case) matches no rule and falls to Spinup at once; "
               "every other '< delay' hold (Acquire col 2: day, < AMD) has only the delay."),
     Rule(ORBIT_DAY, 6, (ORBIT_DAY,), {DAY: T, EL_COARSE_LOW: T, AZ_COARSE_LOW: T, TRACKING: F, before("ODMD"): F}),
-    # ---- Seed "= Orbit Night (Mode 8)" (ACS Mode (9)), 4 columns --------------------------------
+    # ---- Table "= Orbit Night (Mode 8)" (ACS Mode (9)), 4 columns --------------------------------
     Rule(ORBIT_NIGHT, 1, (SPINUP,), {PADDLES: T, TRACKING: T, since("SMD"): T},
          seed_conditions={PADDLES: T, TRACKING: T},
          note="A3: SMD added. Every other exit from Spinup waits SMD (Detumble 4-5, Reorient 1-2); "
@@ -292,7 +293,7 @@ RULES = (
     Rule(ORBIT_NIGHT, 4, (ORBIT_NIGHT,), {TRACKING: T, DAY: F, "body_rate <= max_tumble_rate": T,
                                           "|sin_sun_azimuth| < fine_azimuth_error": T,
                                           "|sin_sun_elevation| < fine_elevation_error": T}),
-    # ---- Seed "= Ground Command (Mode 9)", 1 column ("Received ground control command: T") ------
+    # ---- Table "= Ground Command (Mode 9)", 1 column ("Received ground control command: T") ------
     Rule(GROUND_COMMAND, 1, tuple(m for m in MODES if m != WAIT), {"ground_command": T}, kind="ground",
          note="from any mode but Wait (see col 2); a command in Ground Command restarts GCMD"),
     Rule(GROUND_COMMAND, 2, (WAIT,), {"ground_command": T, since("WMD"): T}, kind="ground", added=True,
@@ -312,7 +313,7 @@ AMENDMENTS = {
     "A6": "Ground Command from Wait only after WMD",
 }
 
-# Actuator permissions per mode, from the seed's descriptions (coils_enabled, wheel_enabled,
+# Actuator permissions per mode, from the specification's descriptions (coils_enabled, wheel_enabled,
 # paddle_deploy). wheel_enabled: the wheel is under control (holding or changing its speed);
 # false: commanded to zero torque.
 PERMISSIONS = {

@@ -23,7 +23,7 @@ Limits:
 
 Defaults: a small CubeSat wheel, J_w = 2.0e-5 kg.m2, 1 mN.m, 6000 rpm (628.3 rad/s), i.e.
 12.6 mN.m.s of storage: the 10-20 mN.m.s class of commercial 1U-3U wheels, enough to take the
-0.011 N.m.s of the 12 kg host box (Iy = 0.13 kg.m2) spinning 5 deg/s about Y, the seed's
+0.011 N.m.s of the 12 kg host box (Iy = 0.13 kg.m2) spinning 5 deg/s about Y, the specification's
 spin-up rate.
 """
 import math

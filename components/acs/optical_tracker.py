@@ -1,4 +1,4 @@
-"""Optical (star-tracking) system of seed 002, reduced to its "in-state tracking" flag.
+"""Optical (star-tracking) system of the ACS mode specification, reduced to its "in-state tracking" flag.
 
 Model (simple, documented):
 - lock: the camera holds a star-pattern lock once its lock conditions have held continuously
@@ -12,7 +12,7 @@ Model (simple, documented):
   Orbit Day -> Orbit Night column needs) and on the state.
 Defaults: max_rate 1 deg/s (the mode manager's max tumble rate), acquisition_time 30 s (lost-in-
 space star identification of small trackers: seconds to tens of seconds), loss_time 5 s (below
-the seed's ODMD of 10 s: tracking must still be reported at dawn, Orbit Night -> Orbit Day col 4,
+the specification's ODMD of 10 s: tracking must still be reported at dawn, Orbit Night -> Orbit Day col 4,
 and lost before ODMD in Orbit Day, else Orbit Night col 3 takes it back to night).
 """
 import math

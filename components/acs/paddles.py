@@ -1,10 +1,10 @@
-"""Deployable solar paddles (seed 002, mounted on the +Z face): a deploy command in, the state
+"""Deployable solar paddles (ACS mode specification, mounted on the +Z face): a deploy command in, the state
 "deployed" out.
 
 Model: the deployment progresses while the deploy command is true (burn-wire release and
 spring-driven hinge motion, lumped); the paddles are deployed once the commanded time reaches
 deployment_time and stay deployed (latched; a dropped command before then pauses the
-progress, it does not undo it). Default 60 s: within the seed's DPMD of 120 s, so the Deploy
+progress, it does not undo it). Default 60 s: within the specification's DPMD of 120 s, so the Deploy
 Paddles mode sees them deployed before its delay runs out. Progress is advanced in step(h)
 with the command held over the step, so `deployed` is a state (no direct feedthrough).
 """

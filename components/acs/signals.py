@@ -1,10 +1,10 @@
-"""State values of the seed-002 mode manager computed from the truth (a stand-in for the
+"""State values of the mode manager of the ACS mode specification computed from the truth (a stand-in for the
 sensors and the attitude/momentum estimator of the real ACS), plus a ground-command window.
 
 Definitions (all in B; H_B = J omega is the body's momentum, h_w the wheels' relative momentum):
 - H = H_B + h_w, the total angular momentum;
 - xz_momentum_error = sqrt(H_x^2 + H_z^2) (N.m.s): the momentum off the Y (spin) axis;
-- momentum_error = |H - H_d| with H_d = Iy w_s y_hat (N.m.s), w_s = 5 deg/s, the seed's spin:
+- momentum_error = |H - H_d| with H_d = Iy w_s y_hat (N.m.s), w_s = 5 deg/s, the specification's spin:
   the desired momentum is the body spinning at +5 deg/s about Y, or, after Deploy Wheel, the
   same momentum carried by the wheel;
 - with s = sun_heading_B / |sun_heading_B|: sin_sun_elevation = s_y (elevation from the body

@@ -29,10 +29,11 @@ from . import thruster_control as tc
 NEIGHBOR_J = (0.05, 0.13, 0.10)
 DEFAULT_KP = tuple(2.0 * j * 1.0 ** 2 for j in NEIGHBOR_J)
 DEFAULT_KD = tuple(2.0 * 0.9 * 1.0 * j for j in NEIGHBOR_J)
+DEFAULT_MAX_TORQUE = tuple(tc.pair_torques())  # the thesis' thruster-pair torques
 
 
 class ReferenceTrackingController:
-    def __init__(self, Kp=DEFAULT_KP, Kd=DEFAULT_KD, max_torque=tc.pair_torques(), quantize=False,
+    def __init__(self, Kp=DEFAULT_KP, Kd=DEFAULT_KD, max_torque=DEFAULT_MAX_TORQUE, quantize=False,
                  angle_tol=math.radians(0.1), rate_tol=math.radians(0.01)):
         self.Kp = tc.check_gains("Kp", Kp)
         self.Kd = tc.check_gains("Kd", Kd)

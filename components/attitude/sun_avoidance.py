@@ -1,7 +1,7 @@
 """Sun-avoidance slew (SAS) guidance: a rest-to-rest eigenaxis slew, split into three eigenaxis
 segments when the direct one would sweep a body-fixed boresight through the Sun keep-out cone.
 
-Conventions (CONVENTIONS.md, components/core/rotations.py): q = q_BN scalar last, A(q) maps N to B,
+Conventions (docs/conventions.md, components/core/rotations.py): q = q_BN scalar last, A(q) maps N to B,
 q_total = q_second (x) q_first, so A(q_second (x) q_first) = A(q_second) A(q_first).
 
 Inputs of the plan
@@ -26,7 +26,7 @@ so the boresight in N is P_i rotated about e_N by theta (Rodrigues):
     P_N(theta) = (P_i.e) e + cos(theta) P_perp + sin(theta) (e x P_perp),  P_perp = P_i - (P_i.e) e
 
 i.e. it sweeps an arc of the circle (cone) of half-angle acos(P_i.e) about e_N, not a great
-circle in general (only when e is perpendicular to P, e.g. the seed's e = P_i x P_f / |..|).
+circle in general (only when e is perpendicular to P, e.g. the SAS pseudocode's e = P_i x P_f / |..|).
 The cosine of the boresight-to-Sun angle gamma along the arc is
 
     cos gamma(theta) = c0 + a cos(theta) + b sin(theta) = c0 + r cos(theta - theta*)
@@ -35,7 +35,7 @@ The cosine of the boresight-to-Sun angle gamma along the arc is
 so the smallest angle over theta in [0, phi] is acos(c0 + r) if theta* (taken in [0, 2 pi))
 lies in the swept arc, else the smaller of the two end angles (function `min_sun_angle`). The
 path intrudes when that minimum is below epsilon. For a great-circle rotation (e.P = 0, c0 = 0)
-the interior minimum is pi/2 - acos|S.e| = |alpha|: the seed's test |alpha| < epsilon with
+the interior minimum is pi/2 - acos|S.e| = |alpha|: the SAS pseudocode's test |alpha| < epsilon with
 alpha = pi/2 - acos(S.e), valid when the Sun's projection S_par lies on the swept arc.
 
 2. Three-segment path when the direct slew intrudes
@@ -44,7 +44,7 @@ Let eps_D = epsilon + m (waypoint cone, on which the path rides), theta_i = angl
 theta_f = angle(P_f, S).
 
 * Segment 1: rotate the boresight in the plane of P_i and S, toward S, onto the eps_D cone:
-  axis e1_N = (P_i x S)/|P_i x S|, angle phi1 = theta_i - eps_D (seed 1(b): acos(P_i.S_par) -
+  axis e1_N = (P_i x S)/|P_i x S|, angle phi1 = theta_i - eps_D (pseudocode step 1(b): acos(P_i.S_par) -
   eps_D with the plane through S itself). A rotation about e1_N by +phi1 moves P_i toward S
   along the great circle, so the Sun angle falls monotonically from theta_i to eps_D and never
   below. q1 = q(A(q0) e1_N, phi1) (x) q0. (If P_i is inside the margin, phi1 < 0: the boresight
@@ -65,7 +65,7 @@ theta_f = angle(P_f, S).
   phi2 <= pi) and the long one (-q_err2: axis -e2, angle 2 pi - phi2) reach the same attitude
   along the two arcs; the plan takes the short one if its minimum Sun angle (section 1) is at
   least eps_D, else the long one. When no roll is left the axis is +-S and the boresight rides
-  exactly along the cone (seed 1(c): rotation about the Sun axis). So every point of every
+  exactly along the cone (pseudocode step 1(c): rotation about the Sun axis). So every point of every
   segment stays at or outside eps_D or between the segment's end angles, all > epsilon.
 
 Segments of zero angle (e.g. P_i already on the eps_D cone) are dropped. If P_i or P_f lies
@@ -74,13 +74,13 @@ and its angle stays between the two.
 
 Candidates. Plan (A) above ("cone-eigenaxis") is always safe but its segment 2 can be long
 (when the circle through P_1 and P_2 is the direct path's great circle, the safe arc goes the
-other way round). Two more candidates follow the seed more literally: segment 2 a rotation about
+other way round). Two more candidates follow the SAS pseudocode more literally: segment 2 a rotation about
 the Sun axis along the eps_D cone from P_1 to P_2 (either way round; the boresight stays exactly
 on the cone), segment 3 the eigenaxis rotation from there to q_f (boresight motion and the
 remaining roll together; "sun-axis", "sun-axis-other-way"). Their segment 3 has no guarantee,
 so every candidate is checked segment by segment with the exact swept-arc test, a candidate
 counts only if its whole path stays at or outside min(eps_D, theta_i, theta_f), and the plan
-takes the shortest-duration candidate that does. The seed's phi2 = 2 asin(sin eps / sin theta)
+takes the shortest-duration candidate that does. The SAS pseudocode's phi2 = 2 asin(sin eps / sin theta)
 (the angle about the Sun axis) and phi3 = acos(P_f.P_2) are the boresight-only versions of
 these segments; they alone do not reach the full final attitude.
 If the direct slew does not intrude, the plan is the single eigenaxis rotation q_err.
@@ -258,7 +258,8 @@ class SunAvoidanceGuidance:
 
     `time` (the communication point the FMU reached) is the only state."""
 
-    def __init__(self, boresight_B, sun_N, epsilon, q0, q_f, w_max, a_max, inertia=((0.05, 0, 0), (0, 0.13, 0), (0, 0, 0.1)),
+    def __init__(self, boresight_B, sun_N, epsilon, q0, q_f, w_max, a_max,
+                 inertia=((0.05, 0, 0), (0, 0.13, 0), (0, 0, 0.1)),
                  margin=math.radians(5.0), t_start=0.0):
         self.P = _unit(boresight_B, "boresight_B")
         self.S = _unit(sun_N, "sun_N")
@@ -290,7 +291,8 @@ class SunAvoidanceGuidance:
         for name, th in (("initial (q0)", self.theta_i), ("final (q_f)", self.theta_f)):
             if th <= epsilon:
                 raise ValueError(f"the {name} boresight is {math.degrees(th):.4g} deg from the Sun, inside the "
-                                 f"keep-out cone epsilon = {math.degrees(epsilon):.4g} deg: no Sun-avoiding slew exists")
+                                 f"keep-out cone epsilon = {math.degrees(epsilon):.4g} deg: no Sun-avoiding slew "
+                                 "exists")
         self._plan()
         self.time = float(t_start)
 

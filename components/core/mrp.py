@@ -2,7 +2,7 @@
 
 Convention: Schaub and Junkins, "Analytical Mechanics of Space Systems" (MRPs, Sec. 3.5),
 written with our scalar-last quaternion q = [q1, q2, q3, q4] (q4 the scalar part; Markley and
-Crassidis, CONVENTIONS.md). Schaub's Euler parameters (beta0, beta1, beta2, beta3) are
+Crassidis, docs/conventions.md). Schaub's Euler parameters (beta0, beta1, beta2, beta3) are
 (q4, q1, q2, q3), and Schaub's [BN(beta)] is exactly Markley's A(q) (both map N-frame
 components to B-frame components), so
 

@@ -1,6 +1,6 @@
 """Scenario epoch and Julian dates.
 
-Simulation time is seconds since the scenario epoch (CONVENTIONS.md). The epoch is an ISO 8601
+Simulation time is seconds since the scenario epoch (docs/conventions.md). The epoch is an ISO 8601
 UTC string, "YYYY-MM-DDThh:mm:ss[.fff]Z" (or "+00:00" instead of "Z"); `parse_epoch` accepts
 nothing else (no local times, no other offsets, no date-only strings), so a typo cannot shift
 the scenario silently.

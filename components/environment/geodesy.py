@@ -1,6 +1,6 @@
 """Earth-fixed coordinates and altitudes shared by the orbit and atmosphere models.
 
-Frames: N is the product's inertial frame (CONVENTIONS.md), used as true-of-date; the Earth-fixed
+Frames: N is the product's inertial frame (docs/conventions.md), used as true-of-date; the Earth-fixed
 frame E is N rotated about z by the Greenwich mean sidereal time (IAU 1982, as in
 `components.environment.magnetic_field.gmst`), r_E = R3(GMST) r_N. Polar motion, precession and nutation
 are ignored: over a mission they move a point by far less than the uncertainty of any density

@@ -33,7 +33,7 @@ import math
 import numpy as np
 from numba import njit
 
-from ..orbit.elements import MU_EARTH, R_EQ
+from ..core.constants import MU_EARTH, R_EQ
 
 EGM96_CBAR_N0 = {2: -0.484165371736e-03, 3: 0.957254173792e-06, 4: 0.539873863789e-06,
                  5: 0.685323475630e-07, 6: -0.149957994714e-06}

@@ -1,4 +1,4 @@
-"""NEIGHBOR's on-board data storage and UHF downlink (thesis seed 003, section 3.6, Table 7,
+"""NEIGHBOR's on-board data storage and UHF downlink (the NEIGHBOR thesis, section 3.6, Table 7,
 Figure 47, Appendix I).
 
 Capacity: the STM32L432KC's "256 kB" flash, taken as 256000 bytes (k = 1000) because

@@ -1,8 +1,8 @@
-"""NEIGHBOR's power supply (thesis seed 003, section 3.5, Tables 5-6, Figure 46, Appendix I):
+"""NEIGHBOR's power supply (the NEIGHBOR thesis, section 3.5, Tables 5-6, Figure 46, Appendix I):
 one LG HG2 Li-ion cell drained by the components that are switched on.
 
 Battery: 3.0 Ah at 3.6 V = 10.8 Wh = 38880 J (`CELL_CAPACITY`, the `capacity` parameter).
-Energy on interfaces is in J (CONVENTIONS.md); 1 Wh = 3600 J.
+Energy on interfaces is in J (docs/conventions.md); 1 Wh = 3600 J.
 
 Loads: one on/off switch each, named, described and powered (Table 5) in
 components.mission.power_bus (the names are the FMU's Boolean inputs).

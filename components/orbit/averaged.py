@@ -325,7 +325,8 @@ class OrbitAveraged:
         if density_model is not None:
             for name in ("kernel", "kernel_data", "density"):
                 if not hasattr(density_model, name):
-                    raise ValueError(f"density_model {density_model!r} lacks .{name} (components.environment.atmosphere model)")
+                    raise ValueError(f"density_model {density_model!r} lacks .{name} "
+                                     "(components.environment.atmosphere model)")
         self.atmosphere = density_model  # None: no drag
         M = elements.mean_from_true(ta, e)
         self.y = np.array([a, e * math.cos(argp), e * math.sin(argp), inc, raan % TWO_PI, (argp + M) % TWO_PI])

@@ -42,7 +42,7 @@ from numba import njit
 from scipy.integrate._ivp import dop853_coefficients as _dop
 
 from ..core import rotations, time_utils
-from ..environment import geodesy
+from ..environment import atmosphere, geodesy
 from ..core.checks import positive
 from ..environment.gravity import accel_zonal, zonal_coefficients
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
@@ -260,7 +260,6 @@ class CowellOrbit:
                              f"reentry_altitude = {self.reentry_altitude:.1f} m; raise sma0 or lower ecc0")
         self.drag = bool(drag)
         if isinstance(density_model, str):
-            from ..environment import atmosphere  # helper A's module (imported only when a name is given)
             density_model = atmosphere.make_density_model(density_model, space_weather=space_weather,
                                                           inclination=float(inc0))
         if self.drag and density_model is None:

@@ -21,7 +21,7 @@ so nothing here rounds.
 
 Thruster model (`MainThrusters`): the de-orbit thrusters fire together along one body axis.
 Sign convention: `axis_B` is the direction of the FORCE ON THE SPACECRAFT in B (the exhaust
-leaves along -axis_B); the default [1, 0, 0] pushes along +x_B, the long axis (CONVENTIONS.md).
+leaves along -axis_B); the default [1, 0, 0] pushes along +x_B, the long axis (docs/conventions.md).
 A retrograde burn therefore needs an attitude with +x_B along -v. While `burn_enable` is true
 and the budget is not spent, the thrust is n F axis_B and the mass falls at
 mdot = n F / (Isp g0). Thrust stops once m0 - m >= m_p (Appendix F's break test); a step that
@@ -179,8 +179,8 @@ def feed_lines(lengths=None, outer_diameter=FEED_LINE_OD, pressure=STORAGE_PRESS
         raise ValueError(f"feed-line wall {t_w!r} m is thicker than the outer radius {r_o!r} m "
                          "(lower pressure or safety_factor, or a stronger material)")
     rho = positive("density", density)
-    material = tuple(math.pi * (r_o ** 2 - r_i ** 2) * l for l in lengths)
-    outer = tuple(math.pi * r_o ** 2 * l for l in lengths)
+    material = tuple(math.pi * (r_o ** 2 - r_i ** 2) * length for length in lengths)
+    outer = tuple(math.pi * r_o ** 2 * length for length in lengths)
     masses = tuple(rho * v for v in material)
     return {"wall_thickness": t_w, "inner_radius": r_i, "outer_radius": r_o, "lengths": lengths,
             "material_volumes": material, "outer_volumes": outer, "masses": masses,

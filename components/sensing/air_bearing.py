@@ -1,24 +1,24 @@
-"""Attitude thresholding for a spherical air-bearing (SAB) testbed without an IMU (seed 001).
+"""Attitude thresholding for a spherical air-bearing (SAB) testbed without an IMU (the air-bearing note).
 
 The "kinematics" node of the testbed receives a stream of direction cosine matrices, estimates
 the angular velocity from its time derivative, extracts 3-2-1 Euler angles (yaw psi, pitch
 theta, roll phi), limits pitch and roll to +-tau so that a half-sphere table stays on its cup,
 rebuilds the attitude from the limited angles and publishes it.
 
-Conventions (CONVENTIONS.md) and how the seed maps onto them
+Conventions (docs/conventions.md) and how the description maps onto them
 -----------------------------------------------------------
 - dcm_BN = [BN] maps N-frame components to B-frame components, v_B = [BN] v_N; it is
   components.core.rotations.attitude_matrix(q_BN) (rows: the B axes in N components). Quaternions are
   scalar last, q = [q1, q2, q3, q4].
-- The seed writes R = R^N_B (B to N), so seed R^N_B = [BN]^T: a seed DCM enters as its
-  transpose. The seed's explicit 3-2-1 matrix R_321(phi, theta, psi) = R1(phi) R2(theta)
+- The description writes R = R^N_B (B to N), so its R^N_B = [BN]^T: a DCM of the description enters as its
+  transpose. The description's explicit 3-2-1 matrix R_321(phi, theta, psi) = R1(phi) R2(theta)
   R3(psi) (frame rotations, first entry c_theta c_psi, (1,3) entry -s_theta) is, entry by entry,
   the matrix that maps N components to B components for the aerospace yaw-pitch-roll sequence
-  (psi about n3, theta about the intermediate 2 axis, phi about b1), and the seed's extraction
+  (psi about n3, theta about the intermediate 2 axis, phi about b1), and the description's extraction
   (theta = asin(-R13), ...) reads the entries of exactly that matrix. In our convention that is
   [BN] = R_321(phi, theta, psi) = attitude_matrix(q_x(phi) (x) q_y(theta) (x) q_z(psi)). Read
   as B-to-N, the same matrix would describe a 1-2-3 rotation with negated angles, not a yaw
-  about the table's vertical, so the seed's B-to-N label is converted by the transpose and
+  about the table's vertical, so the description's B-to-N label is converted by the transpose and
   R_321 is used as [BN]. Yaw is a rotation about the vertical n3; pitch and roll are the tilt:
   the angle between b3 and n3 satisfies cos(tilt) = cos(theta) cos(phi) >= cos(tau)^2.
 
@@ -31,11 +31,11 @@ slightly non-orthonormal DCM onto the nearest rotation), with A = attitude_matri
     phi   = atan2(A23, A33)                     in (-pi, pi]
     psi   = atan2(A12, A11)                     in (-pi, pi]
 
-How this differs from the seed: the seed takes phi = asin(R23 / cos theta), which covers only
+How this differs from the description: the description takes phi = asin(R23 / cos theta), which covers only
 [-pi/2, pi/2] (a roll of 120 deg comes out as 60 deg and the three angles no longer give the
 DCM back; upside down cannot be represented) and divides by cos(theta) (undefined at the
 singularity, and |R23 / cos theta| can exceed 1 by rounding, a domain error); theta = asin(-R13)
-loses accuracy near +-90 deg, where atan2 with sqrt(A11^2 + A12^2) does not; the seed states
+loses accuracy near +-90 deg, where atan2 with sqrt(A11^2 + A12^2) does not; the description states
 psi in [0, pi), but atan2 gives (-pi, pi], which is what we output.
 
 Gimbal lock (pitch = +-90 deg): when cos(theta) = sqrt(A11^2 + A12^2) < GIMBAL_LOCK_COS (1e-7,
@@ -63,7 +63,7 @@ DCMs C_prev (at t_prev) and C (at t, h = t - t_prev):
   with q4 >= 0 (the shorter rotation). Exact for a constant rate; for a varying rate it is the
   mean rate over the step (the rate at the step's midpoint to O(h^2), at its end to O(h)).
   Valid while |omega| h < pi.
-- "finite_difference" (the seed's R_dot): W = -(C - C_prev)/h C^T, omega = vee((W - W^T)/2);
+- "finite_difference" (the description's R_dot): W = -(C - C_prev)/h C^T, omega = vee((W - W^T)/2);
   for a constant rate this gives sin(|omega| h)/h along the rate axis (relative error
   (|omega| h)^2 / 6).
 Before the first step (no previous sample) omega is zero.
@@ -145,7 +145,7 @@ def euler321_from_quaternion(q):
 
 
 def dcm_from_euler321(psi, theta, phi):
-    """The seed's R_321(phi, theta, psi) = R1(phi) R2(theta) R3(psi): [BN] (N to B)."""
+    """The description's R_321(phi, theta, psi) = R1(phi) R2(theta) R3(psi): [BN] (N to B)."""
     sf, cf = math.sin(phi), math.cos(phi)
     st, ct = math.sin(theta), math.cos(theta)
     sp, cp = math.sin(psi), math.cos(psi)
@@ -179,7 +179,7 @@ def rate_log_map(c, c_prev, h):
 
 
 def rate_finite_difference(c, c_prev, h):
-    """omega from the seed's R_dot: W = -(C - C_prev)/h C^T, omega = vee(skew part of W)."""
+    """omega from the description's R_dot: W = -(C - C_prev)/h C^T, omega = vee(skew part of W)."""
     d = tuple(tuple((c[i][j] - c_prev[i][j]) / h for j in range(3)) for i in range(3))
     w = matmul_t(d, c)
     w = tuple(tuple(-x for x in row) for row in w)

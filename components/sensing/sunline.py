@@ -1,17 +1,17 @@
-"""Sunline from ephemeris: the Sun heading in the body frame (seed 004).
+"""Sunline from ephemeris: the Sun heading in the body frame (the sunline module description).
 
 The heading from the spacecraft to the Sun, from the two positions alone (no sun-sensor
 filtering), rotated into B with the attitude:
 
-    d_N = (r_SN_N - r_BN_N) / |r_SN_N - r_BN_N|      (seed Eq. 1: r_sun - r_sc, normalized)
-    d_B = [BN(sigma_BN)] d_N                          (seed Eq. 2)
+    d_N = (r_SN_N - r_BN_N) / |r_SN_N - r_BN_N|      (module description Eq. 1: r_sun - r_sc, normalized)
+    d_B = [BN(sigma_BN)] d_N                          (module description Eq. 2)
 
 r_SN_N is the Sun's position and r_BN_N the spacecraft's, both in N (m). The attitude is the
 MRP sigma_BN (Schaub and Junkins, components.core.mrp) or, equivalently, the scalar-last quaternion
 q_BN with A(q) (components.core.rotations); both map N components to B components, and both give the
 same heading (to rounding) for the same attitude, whichever MRP set or quaternion sign.
 
-Limitation (as in the seed): the heading is only as good as the ephemeris; the Sun is treated
+Limitation (as in the module description): the heading is only as good as the ephemeris; the Sun is treated
 as a point, with no light-time or aberration correction.
 """
 import math
@@ -49,7 +49,7 @@ def _apply(C, v):
 
 
 def sun_heading_B(r_SN_N, r_BN_N, sigma_BN):
-    """d_B = [BN(sigma_BN)] (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N| (seed Eq. 1-2)."""
+    """d_B = [BN(sigma_BN)] (r_SN_N - r_BN_N)/|r_SN_N - r_BN_N| (module description Eq. 1-2)."""
     d_N, _ = sun_vector_N(r_SN_N, r_BN_N)
     return _apply(mrp.to_dcm(sigma_BN), d_N)
 
@@ -67,7 +67,8 @@ class SunlineEphemeris:
 
     def __init__(self, attitude_input="mrp"):
         if attitude_input not in ATTITUDE_INPUTS:
-            raise ValueError(f"attitude_input = {attitude_input!r} must be one of {', '.join(map(repr, ATTITUDE_INPUTS))}")
+            raise ValueError(f"attitude_input = {attitude_input!r} must be one of "
+                             f"{', '.join(map(repr, ATTITUDE_INPUTS))}")
         self.attitude_input = attitude_input
 
     def heading(self, r_SN_N, r_BN_N, sigma_BN=(0.0, 0.0, 0.0), q_BN=(0.0, 0.0, 0.0, 1.0)):
