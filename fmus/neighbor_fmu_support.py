@@ -19,10 +19,12 @@ import copy
 import math
 import os
 import sys
+from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
 from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
+Scalar = Union[float, int, bool, str]
 
 
 def use_bundled_components(wrapper_file):
@@ -89,7 +91,7 @@ class NeighborSlave(Fmi2Slave):
         }
         return var
 
-    def parameter(self, name, start, unit, description, kind=float):
+    def parameter(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> None:
         self.values[name] = kind(start)
 
         def setter(value, name=name):
@@ -99,11 +101,12 @@ class NeighborSlave(Fmi2Slave):
         self._register(name, kind, Fmi2Causality.parameter, Fmi2Variability.fixed, unit, description,
                        setter=setter, initial=Fmi2Initial.exact)
 
-    def parameter_array(self, name, starts, unit, description, kind=float):
+    def parameter_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
+                        kind: type = float) -> None:
         for i, start in enumerate(starts, 1):
             self.parameter(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
 
-    def input(self, name, start, unit, description, kind=float):
+    def input(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> None:
         self.values[name] = kind(start)
 
         def setter(value, name=name):
@@ -113,18 +116,21 @@ class NeighborSlave(Fmi2Slave):
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
 
-    def input_array(self, name, starts, unit, description, kind=float):
+    def input_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
+                    kind: type = float) -> None:
         for i, start in enumerate(starts, 1):
             self.input(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
 
-    def output(self, name, getter, unit, description, kind=float, depends_on=()):
+    def output(self, name: str, getter: Callable[[], Scalar], unit: Optional[str], description: str,
+               kind: type = float, depends_on: Iterable[str] = ()) -> None:
         """`depends_on`: input names this output depends on directly (feedthrough)."""
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         self._register(name, kind, Fmi2Causality.output, variability, unit, description,
                        getter=lambda: kind(getter()), initial=Fmi2Initial.calculated,
                        depends_on=depends_on)
 
-    def output_array(self, name, n, getter, unit, description, kind=float, depends_on=()):
+    def output_array(self, name: str, n: int, getter: Callable[[], Sequence[Scalar]], unit: Optional[str],
+                     description: str, kind: type = float, depends_on: Iterable[str] = ()) -> None:
         """`getter()` returns the whole vector; element i is output as `name[i+1]`."""
         for i in range(n):
             self.output(f"{name}[{i + 1}]", lambda i=i: getter()[i], unit,
@@ -211,7 +217,7 @@ class NeighborSlave(Fmi2Slave):
         self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
 
     # ---- helpers for wrappers -----------------------------------------------------------
-    def feedthrough(self, compute):
+    def feedthrough(self, compute: Callable[[], Any]) -> Any:
         """Value of `compute()` cached until an input or parameter changes.
 
         Several outputs of a controller come from one computation on the current inputs;
@@ -225,7 +231,7 @@ class NeighborSlave(Fmi2Slave):
             cache[compute.__name__] = hit
         return hit[1]
 
-    def vector(self, name, n):
+    def vector(self, name: str, n: int) -> list:
         """[values of name[1] .. name[n]] (the element names are built once, not per call)."""
         keys = self._vector_keys.get((name, n))
         if keys is None:
@@ -234,7 +240,7 @@ class NeighborSlave(Fmi2Slave):
         return [values[k] for k in keys]
 
     @property
-    def model(self):
+    def model(self) -> Any:
         if self._model is None:
             try:
                 self._model = self.build_model()
@@ -243,14 +249,15 @@ class NeighborSlave(Fmi2Slave):
                 raise ParameterError(f"{type(self).__name__} instance '{self.instance_name}': {exc}") from exc
         return self._model
 
-    def build_model(self):  # pragma: no cover - every wrapper implements it
+    def build_model(self) -> Any:  # pragma: no cover - every wrapper implements it
         raise NotImplementedError
 
-    def setup_experiment(self, start_time, stop_time=None, tolerance=None):
+    def setup_experiment(self, start_time: float, stop_time: Optional[float] = None,
+                         tolerance: Optional[float] = None) -> None:
         self.start_time = float(start_time or 0.0)
         self._model = None  # rebuilt so that a model that keeps time starts at start_time
 
-    def exit_initialization_mode(self):
+    def exit_initialization_mode(self) -> None:
         # Build (and so validate) the model from the final parameter values.
         self.model  # noqa: B018
 

@@ -29,8 +29,3 @@ def atomic_write(path, mode="w", **open_kwargs):
 def write_text_atomic(path, text, encoding="utf-8"):
     with atomic_write(path, "w", encoding=encoding, newline="") as f:
         f.write(text)
-
-
-def write_bytes_atomic(path, data):
-    with atomic_write(path, "wb") as f:
-        f.write(data)

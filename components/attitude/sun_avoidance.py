@@ -99,7 +99,7 @@ torque_ff = J omega_dot_ref + omega_ref x J omega_ref.
 """
 import math
 
-from ..core import rotations as attitude
+from ..core import rotations
 from ..core.checks import positive
 
 TWO_PI = 2.0 * math.pi
@@ -109,7 +109,7 @@ def _unit(v, what):
     v = tuple(float(x) for x in v)
     if len(v) != 3 or not all(math.isfinite(x) for x in v):
         raise ValueError(f"{what} {list(v)} must be three finite numbers")
-    n = attitude.norm(v)
+    n = rotations.norm(v)
     if n < 1e-12:
         raise ValueError(f"{what} {list(v)} has zero length; give a non-zero direction")
     return tuple(x / n for x in v)
@@ -119,12 +119,12 @@ def _quat(q, what):
     q = tuple(float(x) for x in q)
     if len(q) != 4 or not all(math.isfinite(x) for x in q):
         raise ValueError(f"{what} {list(q)} must be four finite numbers")
-    return attitude.normalized(q, what)
+    return rotations.normalized(q, what)
 
 
 def angle_between(u, v):
     """Angle (rad) between unit vectors, accurate near 0 and pi (atan2 of |u x v| and u.v)."""
-    return math.atan2(attitude.norm(attitude.cross(u, v)), attitude.dot(u, v))
+    return math.atan2(rotations.norm(rotations.cross(u, v)), rotations.dot(u, v))
 
 
 def mat_vec(M, v):
@@ -138,29 +138,29 @@ def mat_t_vec(M, v):
 def rotate(v, e, theta):
     """Active rotation of v about unit axis e by theta (Rodrigues)."""
     c, s = math.cos(theta), math.sin(theta)
-    ev = attitude.dot(e, v)
-    exv = attitude.cross(e, v)
+    ev = rotations.dot(e, v)
+    exv = rotations.cross(e, v)
     return tuple(c * v[i] + s * exv[i] + (1 - c) * ev * e[i] for i in range(3))
 
 
 def boresight_N(q, P):
     """Boresight direction in N for attitude q: A(q)^T P."""
-    return mat_t_vec(attitude.attitude_matrix(q), P)
+    return mat_t_vec(rotations.attitude_matrix(q), P)
 
 
 def perpendicular(v):
     """A unit vector perpendicular to unit v."""
     a = (1.0, 0.0, 0.0) if abs(v[0]) < 0.9 else (0.0, 1.0, 0.0)
-    return _unit(attitude.cross(v, a), "perpendicular")
+    return _unit(rotations.cross(v, a), "perpendicular")
 
 
 def min_sun_angle(P_start, e, phi, S):
     """Smallest angle between S and the boresight P_start (N) rotated about unit e (N) through
     theta in [0, phi], phi >= 0 (section 1 of the module docstring). Returns (angle, theta)."""
-    pe = attitude.dot(P_start, e)
+    pe = rotations.dot(P_start, e)
     perp = tuple(P_start[i] - pe * e[i] for i in range(3))
-    a = attitude.dot(perp, S)
-    b = attitude.dot(attitude.cross(e, perp), S)
+    a = rotations.dot(perp, S)
+    b = rotations.dot(rotations.cross(e, perp), S)
     candidates = [0.0, phi]
     r = math.hypot(a, b)
     if r > 1e-15:
@@ -179,9 +179,9 @@ def _cone_segment(q, a, b, boresight, phi):
     """Axis in B (at attitude q) and angle >= 0 of a rotation by phi about a x b (in N; about
     any axis perpendicular to the boresight when a and b are parallel), for the segments
     between a boresight direction and the keep-out cone."""
-    c = attitude.cross(a, b)
-    e_N = _unit(c, "axis") if attitude.norm(c) > 1e-9 else perpendicular(boresight)
-    e_B = mat_vec(attitude.attitude_matrix(q), e_N)
+    c = rotations.cross(a, b)
+    e_N = _unit(c, "axis") if rotations.norm(c) > 1e-9 else perpendicular(boresight)
+    e_B = mat_vec(rotations.attitude_matrix(q), e_N)
     if phi < 0:
         e_B, phi = tuple(-x for x in e_B), -phi
     return e_B, phi
@@ -190,11 +190,11 @@ def _cone_segment(q, a, b, boresight, phi):
 def eigenaxis(q_from, q_to):
     """Short-way eigenaxis rotation from q_from to q_to: (axis in B, angle in [0, pi]) with
     q_to = q(axis, angle) (x) q_from (up to sign). Axis (1, 0, 0) for a zero angle."""
-    dq = attitude.circle_cross(q_to, attitude.conjugate(q_from))
+    dq = rotations.circle_cross(q_to, rotations.conjugate(q_from))
     if dq[3] < 0:
         dq = tuple(-x for x in dq)
     v = dq[:3]
-    s = attitude.norm(v)
+    s = rotations.norm(v)
     angle = 2.0 * math.atan2(s, dq[3])
     axis = tuple(x / s for x in v) if s > 1e-15 else (1.0, 0.0, 0.0)
     return axis, angle
@@ -245,12 +245,7 @@ class Segment:
         self.q_end = self.attitude(self.angle)
 
     def attitude(self, theta):
-        return attitude.circle_cross(attitude.from_axis_angle(self.axis_B, theta), self.q_start)
-
-    def as_dict(self):
-        p = self.profile
-        return {"q_start": list(self.q_start), "axis_B": list(self.axis_B), "angle": self.angle,
-                "t_begin": self.t_begin, "t1": p.t1, "t2": p.t2, "tf": p.tf, "triangle": p.triangle}
+        return rotations.circle_cross(rotations.from_axis_angle(self.axis_B, theta), self.q_start)
 
 
 class SunAvoidanceGuidance:
@@ -299,7 +294,7 @@ class SunAvoidanceGuidance:
     # ---- planning ---------------------------------------------------------------------
     def _plan(self):
         axis_B, phi = eigenaxis(self.q0, self.q_f)
-        e_N = mat_t_vec(attitude.attitude_matrix(self.q0), axis_B)
+        e_N = mat_t_vec(rotations.attitude_matrix(self.q0), axis_B)
         self.direct_min_angle = min_sun_angle(self.P_i, e_N, phi, self.S)[0] if phi > 0 else self.theta_i
         self.intrudes = self.direct_min_angle < self.epsilon
         if not self.intrudes:
@@ -317,7 +312,6 @@ class SunAvoidanceGuidance:
         _, self.path_kind, plan = min(safe, key=lambda x: x[0])
         self.candidates = {name: (plan_["duration"], plan_["min_angle"]) for name, plan_ in plans}
         self.segments = plan["segments"]
-        self.segment_min_angles = plan["angles"]
         self.min_angle = plan["min_angle"]
         self.t_end = self.segments[-1].t_end if self.segments else self.t_start
         self.duration = self.t_end - self.t_start
@@ -333,7 +327,7 @@ class SunAvoidanceGuidance:
             segments.append(seg)
             q, t = seg.q_end, seg.t_end
             pN = boresight_N(seg.q_start, self.P)
-            eN = mat_t_vec(attitude.attitude_matrix(seg.q_start), seg.axis_B)
+            eN = mat_t_vec(rotations.attitude_matrix(seg.q_start), seg.axis_B)
             angles.append(min_sun_angle(pN, eN, seg.angle, self.S)[0])
         return {"segments": segments, "angles": angles, "duration": t - self.t_start,
                 "min_angle": min(angles) if angles else self.theta_i}
@@ -343,16 +337,16 @@ class SunAvoidanceGuidance:
         eps_d = self.epsilon + self.margin
         # Segment 1: in the plane of P_i and S, toward S, onto the eps_d cone.
         e1_B, phi1 = _cone_segment(self.q0, P_i, S, P_i, self.theta_i - eps_d)
-        q1 = attitude.circle_cross(attitude.from_axis_angle(e1_B, phi1), self.q0)
+        q1 = rotations.circle_cross(rotations.from_axis_angle(e1_B, phi1), self.q0)
         P1 = boresight_N(q1, self.P)
         # Segment 3 (built backwards from q_f): from the eps_d cone, away from S, to P_f.
         e3_B, phi3 = _cone_segment(self.q_f, S, P_f, P_f, self.theta_f - eps_d)
-        q2 = attitude.circle_cross(attitude.from_axis_angle(e3_B, -phi3), self.q_f)
+        q2 = rotations.circle_cross(rotations.from_axis_angle(e3_B, -phi3), self.q_f)
         P2 = boresight_N(q2, self.P)
         candidates = []
         # (A) Segment 2 = eigenaxis q1 -> q2, the way (short or long) whose arc stays outside eps_d.
         e2_B, phi2 = eigenaxis(q1, q2)
-        e2_N = mat_t_vec(attitude.attitude_matrix(q1), e2_B)
+        e2_N = mat_t_vec(rotations.attitude_matrix(q1), e2_B)
         short = min_sun_angle(P1, e2_N, phi2, S)[0] if phi2 > 0 else eps_d
         if short < eps_d - 1e-9:
             long_ = min_sun_angle(P1, tuple(-x for x in e2_N), TWO_PI - phi2, S)[0]
@@ -362,13 +356,13 @@ class SunAvoidanceGuidance:
         # (B) Segment 2 = rotation about the Sun axis along the eps_d cone from P_1 to P_2 (either
         # way round); segment 3 = eigenaxis from there to q_f (boresight and roll together).
         # Accepted only if segment 3's arc also stays outside eps_d.
-        a1 = tuple(P1[i] - attitude.dot(P1, S) * S[i] for i in range(3))
-        a2 = tuple(P2[i] - attitude.dot(P2, S) * S[i] for i in range(3))
-        psi = math.atan2(attitude.dot(attitude.cross(a1, a2), S), attitude.dot(a1, a2))
-        S_B = mat_vec(attitude.attitude_matrix(q1), S)
+        a1 = tuple(P1[i] - rotations.dot(P1, S) * S[i] for i in range(3))
+        a2 = tuple(P2[i] - rotations.dot(P2, S) * S[i] for i in range(3))
+        psi = math.atan2(rotations.dot(rotations.cross(a1, a2), S), rotations.dot(a1, a2))
+        S_B = mat_vec(rotations.attitude_matrix(q1), S)
         for name, ang in (("sun-axis", psi), ("sun-axis-other-way", psi - math.copysign(TWO_PI, psi))):
             axis = S_B if ang >= 0 else tuple(-x for x in S_B)
-            q2b = attitude.circle_cross(attitude.from_axis_angle(axis, abs(ang)), q1)
+            q2b = rotations.circle_cross(rotations.from_axis_angle(axis, abs(ang)), q1)
             e3b, phi3b = eigenaxis(q2b, self.q_f)
             candidates.append((name, [(e1_B, phi1), (axis, abs(ang)), (e3b, phi3b)]))
         return candidates
@@ -398,7 +392,7 @@ class SunAvoidanceGuidance:
         J = self.J
         Jw = mat_vec(J, w)
         Jwd = mat_vec(J, wd)
-        g = attitude.cross(w, Jw)
+        g = rotations.cross(w, Jw)
         torque = (Jwd[0] + g[0], Jwd[1] + g[1], Jwd[2] + g[2])
         return {"q": q, "omega": w, "omega_dot": wd, "torque_ff": torque, "segment": k,
                 "sun_angle": angle_between(boresight_N(q, self.P), self.S), "done": t >= self.t_end}
@@ -408,11 +402,6 @@ class SunAvoidanceGuidance:
         if not math.isfinite(t_new):
             raise ValueError(f"time {t_new!r} must be finite")
         self.time = float(t_new)
-
-    def plan_summary(self):
-        return {"intrudes": self.intrudes, "direct_min_angle": self.direct_min_angle, "path": self.path_kind,
-                "duration": self.duration, "min_angle": self.min_angle,
-                "segments": [s.as_dict() for s in self.segments]}
 
     def get_state(self):
         return {"time": self.time}

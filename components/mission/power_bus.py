@@ -44,4 +44,3 @@ LOADS = (
 )
 LOAD_NAMES = tuple(load.name for load in LOADS)
 DEFAULT_LOAD_POWER = {load.name: load.power for load in LOADS}
-LOAD_DESCRIPTIONS = {load.name: load.description for load in LOADS}

@@ -5,10 +5,11 @@ import numpy as np
 import pytest
 
 import system_ssp
+from system_ssp.systems.generators.acs_modes import SHORT_STEP, SHORT_STOP
 
 SHORT = "parameters/acs_modes_shortened.ssv"
 GROUND = "parameters/acs_modes_ground_command.ssv"
-STOP, STEP = 18000.0, 5.0  # generate_acs_modes.SHORT_STOP, SHORT_STEP
+STOP, STEP = SHORT_STOP, SHORT_STEP
 OUTPUTS = ["modes.mode", "modes.uncertain", "shadow.orbit_day"]
 
 
