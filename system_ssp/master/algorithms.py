@@ -1,9 +1,9 @@
 """The master algorithms, over one `InstanceTable`: fixed-step (Jacobi or Gauss-Seidel, with
 step multiples) and scheduled (Gauss-Seidel with mode-dependent steps, nc:Schedule).
 
-An algorithm fills a `StepInfo`: `start` after initialization, `advance` for each macro step,
-`finish` at the end; `finished` says when to stop; `refresh_for_record` brings the values a
-recorded row shows up to date."""
+An algorithm fills a `StepInfo`: `start` after initialization; `run` steps until the stop time or
+a stop condition and calls the observers after every macro step; `finish` at the end;
+`refresh_for_record` brings the values a recorded row shows up to date."""
 import ctypes
 import math
 
@@ -38,9 +38,6 @@ class FixedStepAlgorithm:
         self.table.t = info.t = self.plan.start
         info.record_every = self.plan.record_every
 
-    def finished(self, info):
-        return info.fired is not None or info.steps >= self.plan.n_steps
-
     def _transfer(self, k):
         """Jacobi: set the inputs for step k of every component due then (and all at the end)."""
         N, mult, setters = self.plan.n_steps, self.mult, self.table.setters
@@ -48,39 +45,45 @@ class FixedStepAlgorithm:
             if self.all_one or k % mult[ci] == 0 or k >= N:
                 setters[ci]()
 
-    def advance(self, info):
+    def run(self, info, observe):
+        """Step until the stop time or a stop condition, calling `observe` (the observers' step
+        functions) after every communication step."""
         p, table = self.plan, self.table
         start, stop, h, N = p.start, p.stop, p.step_size, p.n_steps
-        mult, all_one = self.mult, self.all_one
-        k = info.steps
-        t = start + k * h
-        table.t = t
-        if self.jacobi:
-            if k > 0:
-                self._transfer(k)
-            do_steps = table.do_steps
-            for ci in range(self.n):
-                mk = mult[ci]
-                if all_one or k % mk == 0:
-                    # The nominal step, not a difference of rounded times: models that integrate
-                    # with the step (the thesis' Euler scripts) must see exactly h every step.
-                    do_steps[ci](t, mk * h if k + mk < N else stop - t)
-            for get in table.getters:
-                get()
-        else:
-            steppers = self.steppers
-            for ci in self.order:
-                mk = mult[ci]
-                if all_one or k % mk == 0:
-                    steppers[ci](t, mk * h if k + mk < N else stop - t)
-            setters, getters, has_ft = table.setters, table.getters, table.has_ft
-            for ci in self.order:
-                setters[ci]()
-                if has_ft[ci]:
-                    getters[ci]()
-        info.steps = k + 1
-        info.t = table.t = start + info.steps * h if info.steps < N else stop
-        info.last = info.steps == N
+        mult, all_one, n, order = self.mult, self.all_one, self.n, self.order
+        do_steps, steppers = table.do_steps, self.steppers
+        setters, getters, has_ft = table.setters, table.getters, table.has_ft
+        jacobi = self.jacobi
+        while info.fired is None and info.steps < N:
+            k = info.steps
+            t = start + k * h
+            table.t = t
+            if jacobi:
+                if k > 0:
+                    self._transfer(k)
+                for ci in range(n):
+                    mk = mult[ci]
+                    if all_one or k % mk == 0:
+                        # The nominal step, not a difference of rounded times: models that
+                        # integrate with the step (the thesis' Euler scripts) must see exactly h.
+                        do_steps[ci](t, mk * h if k + mk < N else stop - t)
+                for get in getters:
+                    get()
+            else:
+                for ci in order:
+                    mk = mult[ci]
+                    if all_one or k % mk == 0:
+                        steppers[ci](t, mk * h if k + mk < N else stop - t)
+                for ci in order:
+                    setters[ci]()
+                    if has_ft[ci]:
+                        getters[ci]()
+            k += 1
+            info.steps = k
+            info.t = table.t = start + k * h if k < N else stop
+            info.last = k == N
+            for f in observe:
+                f(info)
 
     def refresh_for_record(self):
         pass
@@ -219,10 +222,17 @@ class ScheduledAlgorithm:
         self.ev_values = [sig.read() for sig in self.events]
         info.record_every = self.mode.record_every
 
-    def finished(self, info):
-        return info.fired is not None or self.t >= self.plan.stop - self.tol
+    def run(self, info, observe):
+        """Step until the stop time or a stop condition, calling `observe` (the observers' step
+        functions) after every macro step."""
+        end = self.plan.stop - self.tol
+        advance = self._advance
+        while info.fired is None and self.t < end:
+            advance(info)
+            for f in observe:
+                f(info)
 
-    def advance(self, info):
+    def _advance(self, info):
         table, tol, stop = self.table, self.tol, self.plan.stop
         mode = self.mode = self.next_mode
         order, mult, h_mode = mode.order, mode.mult, mode.h

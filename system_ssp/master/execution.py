@@ -2,7 +2,7 @@
 observers, the result; the instances are freed whatever happens."""
 from .algorithms import FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
-from .observers import ProgressBar, Profiler, Recorder, StepInfo, StopConditions
+from .observers import Observer, ProgressBar, Profiler, Recorder, StepInfo, StopConditions
 from .result import Result
 
 
@@ -15,10 +15,11 @@ def execute(system, plan, progress=False):
         table.prepare()
         table.initialize()
         algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
-        stop = StopConditions(table, plan.stops)
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record,
                             capacity=plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024)
-        observers = [stop, recorder]
+        observers = [recorder]
+        if plan.stops:  # first: the recorder records a row where a stop condition fires
+            observers.insert(0, StopConditions(table, plan.stops))
         bar = ProgressBar(plan) if progress else None
         if bar is not None:
             observers.append(bar)
@@ -31,10 +32,7 @@ def execute(system, plan, progress=False):
         try:
             for obs in observers:
                 obs.start(info)
-            while not algorithm.finished(info):
-                algorithm.advance(info)
-                for obs in observers:
-                    obs.step(info)
+            algorithm.run(info, [obs.step for obs in observers if type(obs).step is not Observer.step])
             for obs in observers:
                 obs.finish(info)
         finally:
