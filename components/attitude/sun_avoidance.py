@@ -301,7 +301,7 @@ class SunAvoidanceGuidance:
             plans = [("direct", self._build([(axis_B, phi)]))]
             floor = self.epsilon
         else:
-            plans = [(name, self._build(rotations)) for name, rotations in self._three_segment_candidates()]
+            plans = [(name, self._build(turns)) for name, turns in self._three_segment_candidates()]
             # Segments 1 and 3 start/end at the boresight's own angle when that lies within the margin.
             floor = min(self.epsilon + self.margin, self.theta_i, self.theta_f)
         # Keep the candidates whose every segment stays outside the cone (exact swept-arc test),
@@ -317,10 +317,10 @@ class SunAvoidanceGuidance:
         self.duration = self.t_end - self.t_start
         self.q_end = self.segments[-1].q_end if self.segments else self.q0
 
-    def _build(self, rotations):
+    def _build(self, turns):
         segments, angles = [], []
         q, t = self.q0, self.t_start
-        for axis, angle in rotations:
+        for axis, angle in turns:
             if angle <= 1e-12:
                 continue
             seg = Segment(q, axis, angle, self.w_max, self.a_max, t)
