@@ -26,24 +26,37 @@ change. Outputs are written to a temporary file and renamed, so an interrupted b
 leaves a truncated FMU or SSP behind.
 """
 import argparse
+import ast
 import hashlib
 import importlib
 import inspect
 import json
-import re
-import sys
-import tempfile
-import zipfile
+import os
 from pathlib import Path
+import re
+import shutil
+import site
+import subprocess
+import sys
+import sysconfig
+import uuid
 from xml.etree import ElementTree as ET
+import zipfile
+
+import fmpy
+from fmpy.validation import validate_fmu
+from lxml import etree
+import pythonfmu
 
 from system_ssp import __version__
 from system_ssp.atomic import atomic_write, write_text_atomic
+from system_ssp.ssp.reader import NS_SSD, NS_SSV
 from system_ssp.ssp.units import BUILTIN, base_unit_attributes
 
 ROOT = Path(__file__).resolve().parent
 FMU_SOURCES = ROOT / "fmus"
 SUPPORT = FMU_SOURCES / "neighbor_fmu_support.py"
+RUNTIME = FMU_SOURCES / "runtime"
 COMPONENTS = ROOT / "components"
 SYSTEMS = ROOT / "system_ssp" / "systems"
 BUILD = ROOT / "build"
@@ -68,7 +81,8 @@ def _component_files():
 
 
 def wrapper_scripts():
-    return sorted(p for p in FMU_SOURCES.glob("neighbor_*.py") if p != SUPPORT)
+    """fmus/neighbor_*.py, but the support modules (neighbor_*_support.py)."""
+    return sorted(p for p in FMU_SOURCES.glob("neighbor_*.py") if not p.stem.endswith("_support"))
 
 
 def _import_wrapper(script):
@@ -144,42 +158,223 @@ def complete_model_description(xml_bytes, meta, can_get_set_state, starts):
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
 
 
-def _atomic_zip(dest, write_entries):
+def _atomic_zip(dest, entries):
+    """Write {archive name: bytes} as a zip through a temporary file. Fixed dates, so that the same
+    inputs give the same archive, and normal permissions: 0644, 0755 for binaries."""
     dest.parent.mkdir(parents=True, exist_ok=True)
     with atomic_write(dest, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as zf:
-        write_entries(zf)
+        for name in sorted(entries):
+            info = zipfile.ZipInfo(name, date_time=(2026, 1, 1, 0, 0, 0))
+            info.compress_type = zipfile.ZIP_DEFLATED
+            info.external_attr = (0o755 if name.startswith("binaries/") else 0o644) << 16
+            zf.writestr(info, entries[name])
+
+
+# ---- the FMU runtime: one C binary for every FMU, the Python loader, the model's own package -----
+RUNTIME_C = RUNTIME / "neighbor_fmi2.c"
+RUNTIME_LOADER = RUNTIME / "neighbor_runtime.py"
+PLATFORMS = {  # FMI platform folder: (compiler, file suffix, extra flags)
+    "linux64": ("gcc", ".so", ["-fPIC", "-fvisibility=hidden", "-ldl"]),
+    "win64": ("x86_64-w64-mingw32-gcc", ".dll", ["-static-libgcc"]),
+}
+_compiled = {}
+
+
+def compile_runtime(out_dir=None):
+    """{platform: path} of the runtime binary compiled for every platform whose compiler is on
+    this machine (linux64 always: gcc is required; win64 with mingw-w64). Compiled once per
+    source version (build/runtime/<digest>/)."""
+    digest = _digest([RUNTIME_C])[:16]
+    if digest in _compiled:
+        return _compiled[digest]
+    out_dir = Path(out_dir or BUILD / "runtime" / digest)
+    headers = Path(fmpy.__file__).parent / "c-code"  # the FMI 2.0 headers FMPy ships (BSD-2)
+    out = {}
+    for platform, (cc, suffix, flags) in PLATFORMS.items():
+        target = out_dir / f"neighbor_fmi2{suffix}"
+        if not target.is_file():
+            if shutil.which(cc) is None:
+                if platform == "linux64":
+                    raise BuildError(f"the FMU runtime needs a C compiler: {cc} not found")
+                continue
+            out_dir.mkdir(parents=True, exist_ok=True)
+            tmp = target.with_name(target.name + ".tmp")
+            cmd = [cc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", f"-I{headers}", str(RUNTIME_C),
+                   "-o", str(tmp), *flags]
+            proc = subprocess.run(cmd, capture_output=True, text=True)
+            if proc.returncode != 0:
+                raise BuildError(f"compiling the FMU runtime for {platform} failed:\n{' '.join(cmd)}\n{proc.stderr}")
+            os.replace(tmp, target)
+        out[platform] = target
+    _compiled[digest] = out
+    return out
+
+
+_ROOTS = {"components": ROOT, "pythonfmu": Path(pythonfmu.__file__).parents[1]}
+
+
+def _root_of(top):
+    """Where the top-level name `top` is found for bundling: components, pythonfmu, or a module of
+    fmus/ (the support modules); None for everything else (numpy and the standard library come
+    from the target's Python)."""
+    if top in _ROOTS:
+        return _ROOTS[top]
+    return FMU_SOURCES if top.startswith("neighbor_") and (FMU_SOURCES / f"{top}.py").is_file() else None
+
+
+def _source_of(dotted):
+    """The file of a module or package to bundle, or None."""
+    root = _root_of(dotted.split(".")[0])
+    if root is None:
+        return None
+    base = root.joinpath(*dotted.split("."))
+    for candidate in (base.with_suffix(".py"), base / "__init__.py"):
+        if candidate.is_file():
+            return candidate
+    return None
+
+
+def _imports(path, dotted, is_package):
+    """Absolute names of the modules `path` imports (anywhere, functions included)."""
+    tree = ast.parse(path.read_bytes(), str(path))
+    package = dotted if is_package else dotted.rpartition(".")[0]
+    names = []
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import):
+            names += [a.name for a in node.names]
+        elif isinstance(node, ast.ImportFrom):
+            if node.level:
+                base = package.split(".")[:len(package.split(".")) - (node.level - 1)]
+                module = ".".join(base + ([node.module] if node.module else []))
+            else:
+                module = node.module
+            names.append(module)
+            names += [f"{module}.{a.name}" for a in node.names]
+    return names
+
+
+def bundle(script):
+    """The modules the wrapper `script` imports (computed from the import statements, transitively,
+    parent packages included) and the data files they declare (`PACKAGE_DATA`, paths relative to
+    the module), as {path inside the private package: bytes}; pythonfmu's __init__ (which imports
+    its builder) is replaced by an empty one. The wrapper's and the support module's absolute
+    imports become relative: the bundle is importable under any package name."""
+    wrapper = script.stem
+    found = {wrapper: script}
+    todo = [wrapper]
+    while todo:
+        name = todo.pop()
+        path = found[name]
+        parts = name.split(".")
+        for i in range(1, len(parts)):  # importing a.b.c runs a/__init__ and a/b/__init__ first
+            parent = ".".join(parts[:i])
+            if parent not in found and _source_of(parent) is not None:
+                found[parent] = _source_of(parent)
+                todo.append(parent)
+        if name == "pythonfmu":
+            continue  # replaced below: its own __init__ would pull in the builder
+        for imported in _imports(path, name, path.name == "__init__.py"):
+            if imported not in found and _source_of(imported) is not None:
+                found[imported] = _source_of(imported)
+                todo.append(imported)
+    files = {}
+    for name, path in found.items():
+        rel = Path(*name.split("."))
+        rel = rel / "__init__.py" if path.name == "__init__.py" else rel.with_suffix(".py")
+        text = path.read_text(encoding="utf-8")
+        if name == "pythonfmu":
+            text = '"""pythonfmu\'s authoring API (fmi2slave, enums, variables), bundled."""\n'
+        elif "." not in name:  # the wrapper and the support modules: top level of the package
+            text = _relative_imports(text, path)
+        elif _absolute_project_imports(text, path):
+            raise BuildError(f"{path}: bundled modules import each other relatively; found "
+                             + ", ".join(_absolute_project_imports(text, path)))
+        files[rel.as_posix()] = text.encode("utf-8")
+        module_dir = path.parent
+        for data in _package_data(path):
+            source = module_dir / data
+            if not source.is_file():
+                raise BuildError(f"{path}: PACKAGE_DATA names {data!r}, which does not exist")
+            files[(rel.parent / data).as_posix()] = source.read_bytes()
+    return files
+
+
+def _absolute_project_imports(text, path):
+    tree = ast.parse(text, str(path))
+    return [node.module for node in ast.walk(tree)
+            if isinstance(node, ast.ImportFrom) and node.level == 0 and node.module
+            and _root_of(node.module.split(".")[0]) is not None]
+
+
+def _relative_imports(text, path):
+    """`from components...`, `from neighbor_fmu_support ...`, `from pythonfmu...` -> `from .X`."""
+    lines = text.splitlines(keepends=True)
+    tree = ast.parse(text, str(path))
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Import) and any(_root_of(a.name.split(".")[0]) for a in node.names):
+            raise BuildError(f"{path}:{node.lineno}: use `from X import ...` for the project's modules")
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and _root_of(node.module.split(".")[0]):
+            line = lines[node.lineno - 1]
+            start = node.col_offset
+            if not line[start:].startswith(f"from {node.module}"):
+                raise BuildError(f"{path}:{node.lineno}: cannot rewrite this import")
+            lines[node.lineno - 1] = line[:start] + "from ." + line[start + 5:]
+    return "".join(lines)
+
+
+def _package_data(path):
+    """The module's PACKAGE_DATA tuple of relative file names, read without importing it."""
+    tree = ast.parse(path.read_bytes(), str(path))
+    for node in tree.body:
+        if isinstance(node, ast.Assign) and any(isinstance(t, ast.Name) and t.id == "PACKAGE_DATA"
+                                                 for t in node.targets):
+            return list(ast.literal_eval(node.value))
+    return []
+
+
+def _runtime_config(package, wrapper, cls, guid):
+    """resources/neighbor_runtime.txt: the model's class, its GUID, and where the Python the FMU
+    was built with lives (a Python-less host starts that one when it exists; see docs)."""
+    libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
+    libpython = Path(libdir or "", soname or "")
+    lines = [f"slave={package} {wrapper} {cls.__name__}", f"guid={guid}",
+             f"python_version={sys.version_info[0]}.{sys.version_info[1]}"]
+    if libpython.is_file():
+        lines += [f"libpython={libpython}", f"python_home={sys.base_prefix}"]
+    for folder in dict.fromkeys(site.getsitepackages() + [site.getusersitepackages()]):
+        if Path(folder).is_dir():
+            lines.append(f"site_packages={folder}")
+    return ("\n".join(lines) + "\n").encode("utf-8")
 
 
 def build_fmu(script, dest_dir):
-    """Build one wrapper script into `<dest_dir>/<ClassName>.fmu` with a complete model
-    description; returns the FMU path. Raises BuildError if fmpy finds a problem."""
-    from fmpy.validation import validate_fmu
-    from pythonfmu.builder import FmuBuilder
-
+    """Build one wrapper script into `<dest_dir>/<ClassName>.fmu`: the model description from
+    pythonfmu's declarations, completed; the runtime binary per platform; the loader; the
+    model's own modules under a package name private to this build. Returns the FMU path; raises
+    BuildError if fmpy finds a problem."""
     script = Path(script).resolve()
     dest_dir = Path(dest_dir)
     cls = _import_wrapper(script)
     instance = cls(instance_name="build", resources=str(script.parent))
-    with tempfile.TemporaryDirectory(prefix="neighbor_fmu_") as tmp:
-        raw = FmuBuilder.build_FMU(script, dest=tmp, project_files=[SUPPORT, COMPONENTS],
-                                   canGetAndSetFMUstate=cls.can_get_and_set_state)
-        with zipfile.ZipFile(raw) as src:
-            entries = {info.filename: src.read(info.filename) for info in src.infolist()}
-    if not any(name.startswith("binaries/") for name in entries):
-        import pythonfmu
-
-        raise BuildError(f"{script.name}: pythonfmu wrote no binaries/; the pythonfmu package in use "
-                         f"({Path(pythonfmu.__file__).parent}) lacks its resources/binaries, e.g. the copy "
-                         "inside an extracted FMU. Import build_fmus before running FMUs in-process.")
-    entries["modelDescription.xml"] = complete_model_description(
-        entries["modelDescription.xml"], instance.fmu_meta, cls.can_get_and_set_state, instance.values)
+    files = bundle(script)
+    code_digest = hashlib.sha256(b"".join(name.encode() + b"\0" + data for name, data in sorted(files.items())))
+    code_digest.update(RUNTIME_LOADER.read_bytes())
+    package = f"nc_{cls.__name__.lower()}_{code_digest.hexdigest()[:12]}"
+    files["__init__.py"] = f'"""{cls.__name__}: this FMU build\'s private package."""\n'.encode()
+    guid = str(uuid.uuid5(uuid.NAMESPACE_URL, f"https://neighbor-cosim.org/fmu/{package}"))
+    instance.guid = guid
+    options = {"needsExecutionTool": "false", "canGetAndSetFMUstate": cls.can_get_and_set_state}
+    xml = ET.tostring(instance.to_xml(options), encoding="utf-8")
+    entries = {"modelDescription.xml": complete_model_description(xml, instance.fmu_meta,
+                                                                  cls.can_get_and_set_state, instance.values),
+               "resources/neighbor_runtime.py": RUNTIME_LOADER.read_bytes(),
+               "resources/neighbor_runtime.txt": _runtime_config(package, script.stem, cls, guid)}
+    for name, data in files.items():
+        entries[f"resources/{package}/{name}"] = data
+    for platform, binary in compile_runtime().items():
+        entries[f"binaries/{platform}/{cls.__name__}{binary.suffix}"] = binary.read_bytes()
     dest = dest_dir / f"{cls.__name__}.fmu"
-
-    def write(zf):
-        for name, data in entries.items():
-            zf.writestr(name, data)
-
-    _atomic_zip(dest, write)
+    _atomic_zip(dest, entries)
     problems = validate_fmu(str(dest))
     if problems:
         dest.unlink()
@@ -211,21 +406,61 @@ def _system_files(ssd):
     return sorted(refs), sorted(set(fmus))
 
 
+def merged_bindings(ssd_bytes, base_dir):
+    """libcosim (and other readers) apply only a component's first ParameterBinding. A component
+    that binds several parameter sets (one per concern) gets one set instead, their values merged
+    in binding order (a later file wins, as the SSP standard and our master apply them), under
+    parameters/merged/<system>.<component>.ssv. Returns (SSD bytes, {archive name: bytes})."""
+    tree = etree.fromstring(ssd_bytes)
+    ns = {"ssd": NS_SSD, "ssv": NS_SSV}
+    system = tree.get("name")
+    extra = {}
+    for comp in tree.iterfind(".//ssd:Component", ns):
+        bindings = comp.find("ssd:ParameterBindings", ns)
+        items = [] if bindings is None else bindings.findall("ssd:ParameterBinding", ns)
+        if len(items) < 2:
+            continue
+        if any(b.get("source") is None or b.get("prefix") or len(b) for b in items):
+            raise BuildError(f"{system}: component {comp.get('name')}: only plain file bindings can be merged")
+        merged, units = {}, {}
+        for b in items:
+            ssv = etree.parse(str(base_dir / b.get("source"))).getroot()
+            for unit in ssv.iterfind("ssv:Units/*", ns):
+                units[unit.get("name")] = unit
+            for par in ssv.iterfind("ssv:Parameters/ssv:Parameter", ns):
+                merged[par.get("name")] = par
+        root = etree.Element(f"{{{NS_SSV}}}ParameterSet", nsmap={"ssv": NS_SSV}, version="1.0",
+                             name=f"{system}.{comp.get('name')}")
+        root.append(etree.Comment(" merged from " + ", ".join(b.get("source") for b in items)
+                                  + " (later files win) "))
+        if units:
+            holder = etree.SubElement(root, f"{{{NS_SSV}}}Units")
+            holder.extend(units.values())
+        params = etree.SubElement(root, f"{{{NS_SSV}}}Parameters")
+        params.extend(merged.values())
+        name = f"parameters/merged/{system}.{comp.get('name')}.ssv"
+        extra[name] = etree.tostring(root, xml_declaration=True, encoding="UTF-8", pretty_print=True)
+        for b in items[1:]:
+            bindings.remove(b)
+        items[0].set("source", name)
+    return etree.tostring(tree, xml_declaration=True, encoding="UTF-8"), extra
+
+
 def pack_ssp(ssd, fmu_dir, dest_dir):
+    """build/ssp/<name>.ssp: the SSD as SystemStructure.ssd (bindings merged per component), the
+    parameter files it and its scenarios use, and its FMUs under resources/."""
     refs, fmus = _system_files(ssd)
     missing = [f for f in fmus if not (fmu_dir / f).is_file()]
     if missing:
         raise BuildError(f"{ssd.name} uses FMUs that were not built: {', '.join(missing)}")
     dest = Path(dest_dir) / f"{ssd.stem}.ssp"
-
-    def write(zf):
-        zf.write(ssd, "SystemStructure.ssd")
-        for ref in refs:
-            zf.write(ssd.parent / ref, ref)
-        for f in fmus:
-            zf.write(fmu_dir / f, f"resources/{f}")
-
-    _atomic_zip(dest, write)
+    text, merged = merged_bindings(ssd.read_bytes(), ssd.parent)
+    entries = {"SystemStructure.ssd": text, **merged}
+    for ref in refs:
+        entries[ref] = (ssd.parent / ref).read_bytes()
+    for f in fmus:
+        entries[f"resources/{f}"] = (fmu_dir / f).read_bytes()
+    _atomic_zip(dest, entries)
     return dest
 
 
@@ -257,7 +492,8 @@ def build_all(clean=False, verbose=True):
         return made
 
     fmu_dir, ssp_dir = BUILD / "fmus", BUILD / "ssp"
-    shared = _component_files() + [SUPPORT, Path(__file__).resolve()]
+    shared = _component_files() + sorted(FMU_SOURCES.glob("neighbor_*_support.py")) + [
+        RUNTIME_C, RUNTIME_LOADER, Path(__file__).resolve()]
     fmus = []
     names = {}
     for script in wrapper_scripts():

@@ -9,7 +9,6 @@ Cowell model, pass --scenarios 420km --max-years 1 to measure a year of the 420 
 Build first: python build_fmus.py
 """
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -44,5 +43,3 @@ def main():
 
 if __name__ == "__main__":
     main()
-    sys.stdout.flush()
-    os._exit(0)  # skip the interpreter teardown that pythonfmu can crash after all is printed

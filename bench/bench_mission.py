@@ -11,7 +11,6 @@ component (set inputs + doStep + get outputs) and the master itself. Target: und
 kernels (about 5-10 s). Build first: python build_fmus.py
 """
 import argparse
-import os
 import sys
 import time
 from pathlib import Path
@@ -44,5 +43,3 @@ def main():
 
 if __name__ == "__main__":
     main()
-    sys.stdout.flush()
-    os._exit(0)  # skip the interpreter teardown that pythonfmu can crash after all is printed

@@ -72,9 +72,4 @@ def main(stop=36000.0, step=2.0):
 
 
 if __name__ == "__main__":
-    import os
     main(*(float(a) for a in sys.argv[1:3]))
-    # leave without the interpreter's teardown: pythonfmu's native side can call a freed logger
-    # callback at shutdown ("corrupted double-linked list"; see tests/conftest.py)
-    sys.stdout.flush()
-    os._exit(0)

@@ -5,11 +5,9 @@ mode and permissions from the mode manager, body rate, field, Sun heading, wheel
 in mode in; commanded coil dipole and wheel motor torque out. Stateless; both outputs are
 direct feedthrough of the inputs.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import control, modes  # noqa: E402 (after use_bundled_components)
+from components.acs import control, modes
 
 PARAMETERS = (
     ("Ix", "kg.m2", "Spacecraft inertia about X (> 0)"),

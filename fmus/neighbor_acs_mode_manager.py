@@ -6,11 +6,9 @@ holds over [t, t + h]). Every output is state (mode, time in mode, permissions o
 no output depends directly on an input. The model keeps the time: the start time at
 initialization (startup -> Wait), t + h after do_step(t, h).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import modes  # noqa: E402 (after use_bundled_components)
+from components.acs import modes
 
 PARAMETERS = (
     ("xz_momentum_error_threshold", "N.m.s", "Detumbled when the X-Z body momentum error is at or below it (> 0)"),

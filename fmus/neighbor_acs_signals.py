@@ -5,11 +5,9 @@ sensors and estimator. The state values depend directly on the inputs; ground_co
 scripted uplink window on the model's time (the start time at initialization, t + h after
 do_step(t, h)), so it is a state.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import signals  # noqa: E402 (after use_bundled_components)
+from components.acs import signals
 
 H_IN = [f"H_B[{i}]" for i in (1, 2, 3)]
 HW_IN = [f"wheel_momentum_B[{i}]" for i in (1, 2, 3)]

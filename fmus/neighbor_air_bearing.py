@@ -15,11 +15,9 @@ DCM's source stepped first) omega holds the committed sample's estimate (one ste
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import air_bearing  # noqa: E402 (after use_bundled_components)
+from components.sensing import air_bearing
 
 DCM_INPUTS = [f"dcm_BN[{i},{j}]" for i in (1, 2, 3) for j in (1, 2, 3)]
 

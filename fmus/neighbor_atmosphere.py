@@ -8,13 +8,13 @@ time: the start time at initialization, t + h after do_step(t, h).
 
 Harris-Priester exponent: this FMU knows no orbit, so hp_exponent = 0 means n = 4.
 """
-from neighbor_fmu_support import NeighborSlave, atmosphere_model, atmosphere_parameters, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
+from neighbor_orbit_support import atmosphere_model, atmosphere_parameters
 
-use_bundled_components(__file__)
-
-from components.environment import atmosphere  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
-from components.core.constants import R_EQ  # noqa: E402 (after use_bundled_components)
+from components.core import jit
+from components.environment import atmosphere
+from components.core import time_utils
+from components.core.constants import R_EQ
 
 
 class Atmosphere(NeighborSlave):
@@ -23,6 +23,7 @@ class Atmosphere(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        self.log(f"density and orbit kernels: {jit.describe()}")
         self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
                        "Scenario epoch (simulation time 0), ISO 8601 UTC 'YYYY-MM-DDThh:mm:ss[.fff]Z'", str)
         atmosphere_parameters(self)
@@ -44,7 +45,8 @@ class Atmosphere(NeighborSlave):
         return self.model.altitude(self.vector("r_BN_N", 3))
 
     def build_model(self):
-        return atmosphere.AtmosphereAtEpoch(atmosphere_model(self.values), self.values["epoch"], self.start_time)
+        model = atmosphere_model(self.values, resources=self.resources)
+        return atmosphere.AtmosphereAtEpoch(model, self.values["epoch"], self.start_time)
 
     def do_step(self, current_time, step_size):
         self.model.advance_to(current_time + step_size)

@@ -9,11 +9,9 @@ input held over the step.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import triad  # noqa: E402 (after use_bundled_components)
+from components.sensing import triad
 
 VECTORS = ([f"nadir_B[{i}]" for i in (1, 2, 3)] + ["nadir_valid"] + [f"sun_B[{i}]" for i in (1, 2, 3)]
            + ["sun_valid"] + [f"r_BN_N[{i}]" for i in (1, 2, 3)] + [f"r_SN_N[{i}]" for i in (1, 2, 3)])

@@ -4,11 +4,9 @@ Wraps components.sensing.air_bearing.AttitudeToDcm: dcm_BN = A(q_BN / |q_BN|) (t
 maps N components to B components. Direct feedthrough, stateless; lets the air-bearing
 system drive the DCM-input kinematics FMU from the RigidBody FMU.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import air_bearing  # noqa: E402 (after use_bundled_components)
+from components.sensing import air_bearing
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 

@@ -5,12 +5,10 @@ model keeps the simulation time: the start time at initialization, t + h after d
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.core import constants  # noqa: E402 (after use_bundled_components)
-from components.orbit import circular  # noqa: E402 (after use_bundled_components)
+from components.core import constants
+from components.orbit import circular
 
 
 class CircularOrbit(NeighborSlave):

@@ -6,11 +6,9 @@ B/s, against Appendix I's 29.503 B/s, k = 1000, and the exact integration). Inpu
 held over a step; every output is a state (no direct dependencies). Overflow is never silent:
 bytes that do not fit are counted in `bytes_lost` and `overflow` latches true.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.mission import data_storage  # noqa: E402 (after use_bundled_components)
+from components.mission import data_storage
 
 
 class DataStorage(NeighborSlave):

@@ -5,11 +5,9 @@ stop test of Appendix D). Stateless: every output is a function of the current i
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import detumble, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.attitude import detumble, thruster_control
 
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
 ACCEL_INPUTS = [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)]

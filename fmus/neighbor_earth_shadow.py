@@ -3,12 +3,10 @@
 Wraps components.environment.eclipse.EarthShadow (Montenbruck and Gill, section 3.4.2). Stateless: every
 output depends directly on both position inputs.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.core import constants  # noqa: E402 (after use_bundled_components)
-from components.environment import eclipse  # noqa: E402 (after use_bundled_components)
+from components.core import constants
+from components.environment import eclipse
 
 R_INPUTS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 SUN_INPUTS = [f"r_SN_N[{i}]" for i in (1, 2, 3)]

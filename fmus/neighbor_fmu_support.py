@@ -16,38 +16,14 @@ getters, so an output that depends directly on inputs is recomputed from the inp
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
 """
 import copy
-import math
-import os
-import sys
 from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
-from pythonfmu import Boolean, Fmi2Causality, Fmi2Initial, Fmi2Slave, Fmi2Variability, Integer, Real, String
+from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
+from pythonfmu.fmi2slave import Fmi2Slave
+from pythonfmu.variables import Boolean, Integer, Real, String
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
 Scalar = Union[float, int, bool, str]
-
-
-def use_bundled_components(wrapper_file):
-    """Let `import components.<x>` in a wrapper find this FMU's own bundled copy.
-
-    Every FMU bundles `components/` in its resources, and in one process the first FMU loaded
-    provides the `components` package for all. Its extracted folder may be gone by the time a
-    later FMU imports a submodule nobody imported yet (fmpy.simulate_fmu removes its folder),
-    so each wrapper puts its own folder first on the package's search path; missing folders
-    are skipped. The same holds for every subpackage already imported (components.core, ...).
-    Call it before importing from `components`; a no-op in the source tree."""
-    bundled = os.path.join(os.path.dirname(os.path.abspath(wrapper_file)), "components")
-    if not os.path.isdir(bundled):
-        return
-    for name, package in list(sys.modules.items()):
-        if name != "components" and not name.startswith("components."):
-            continue
-        path = getattr(package, "__path__", None)
-        if path is None:
-            continue  # a module, not a package
-        folder = os.path.join(bundled, *name.split(".")[1:])
-        if os.path.isdir(folder) and folder not in path:
-            path.insert(0, folder)
 
 
 class ParameterError(ValueError):
@@ -177,45 +153,6 @@ class NeighborSlave(Fmi2Slave):
             return box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"])
         return [[v[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
 
-    def orbit_interface(self, default_sma, mu, epoch, mean):
-        """Parameters and inputs every orbit FMU shares (the Orbit / OrbitAveraged connector
-        contract), so that a system swaps one for the other by replacing a component. `mean`:
-        the initial elements are mean elements (orbit-averaged model) rather than osculating."""
-        kind = "mean " if mean else ""
-        self.parameter("epoch", epoch, None, "Scenario epoch, ISO 8601 UTC; simulation time is seconds since it",
-                       str)
-        self.parameter("sma0", default_sma, "m", f"Initial {kind}semi-major axis (thesis Table 3: 6798.1363 km); "
-                       "perigee must be above reentry_altitude")
-        self.parameter("ecc0", 0.0, "1", f"Initial {kind}eccentricity, in [0, 1)")
-        self.parameter("inc0", math.radians(51.6), "rad", "Initial inclination, in [1e-4, pi - 1e-4] (the element "
-                       "set is singular for equatorial orbits)" if mean else "Initial inclination, in [0, pi]")
-        self.parameter("raan0", 0.0, "rad", "Initial right ascension of the ascending node")
-        self.parameter("argp0", 0.0, "rad", "Initial argument of perigee (ignored for ecc0 = 0)")
-        self.parameter("ta0", 0.0, "rad",
-                       "Initial true anomaly (for ecc0 = 0: argument of latitude from the ascending node)")
-        self.parameter("cartesian0", False, None, "True: start from r0_N and v0_N (osculating state in N) instead of "
-                       "the elements sma0 ... ta0", bool)
-        a = default_sma
-        v = math.sqrt(mu / a)
-        self.parameter_array("r0_N", [a, 0.0, 0.0], "m", "Initial position in N, used when cartesian0 is true")
-        self.parameter_array("v0_N", [0.0, v * math.cos(math.radians(51.6)), v * math.sin(math.radians(51.6))], "m/s",
-                             "Initial velocity in N, used when cartesian0 is true (must give a closed orbit)")
-        self.parameter("Cd", 2.2, "1", "Drag coefficient (> 0, <= 10; thesis Table 2: 2.2)")
-        self.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
-        self.parameter("reentry_altitude", 250e3, "m", "Re-entry altitude (thesis: 250 km), compared with the "
-                       + ("mean perigee altitude" if mean else "geodetic altitude") + "; an initial perigee "
-                       "altitude sma0 (1 - ecc0) - 6378136.3 m below it is an error")
-        atmosphere_parameters(self)
-        self.parameter("mu", mu, "m3/s2", "Earth's gravitational parameter (thesis: 398600.4415 km3/s2), > 0")
-        self.input_array("F_thrust_B", [0.0, 0.0, 0.0], "N",
-                         "Thrust force in the body frame B, held over a step (rotated to N with q_BN)")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         "Attitude quaternion of B relative to N, scalar last (A(q) maps N to B)")
-        self.input("retrograde", False, None,
-                   "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
-                   "ignoring q_BN", bool)
-        self.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
-
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute: Callable[[], Any]) -> Any:
         """Value of `compute()` cached until an input or parameter changes.
@@ -274,67 +211,3 @@ class NeighborSlave(Fmi2Slave):
         self._model = None
         if state["model"] is not None:
             self.model.set_state(state["model"])
-
-
-# ---- atmosphere parameters shared by the Atmosphere, Orbit and OrbitAveraged FMUs ------------
-def atmosphere_parameters(slave):
-    """Declare the shared atmosphere parameters on a NeighborSlave (same names, units and
-    meaning on every FMU that computes a density); `atmosphere_model(slave.values, ...)`
-    builds the model from their values."""
-    slave.parameter("density_model", "jacchia_roberts", None,
-                    "Atmosphere density model: exponential (Vallado Table 8-4), harris_priester (Montenbruck "
-                    "and Gill), msis (NRLMSIS 2.1) or jacchia_roberts (Jacchia 1970 / Roberts, as FreeFlyer)", str)
-    slave.parameter("space_weather_file", "", None,
-                    "CSSI space-weather file (CelesTrak SpaceWx format 1.2) for msis and jacchia_roberts; empty = "
-                    "the bundled copy of 2026-08-22 (observed from 2000, predictions to 2041-10, last entry held "
-                    "after that)", str)
-    slave.parameter("use_constant_space_weather", False, None,
-                    "When true, msis and jacchia_roberts use the constant f107, f107a and ap below instead of "
-                    "the space-weather file", bool)
-    slave.parameter("f107", 150.0, "1",
-                    "Constant daily solar flux F10.7 in solar flux units (1 sfu = 1e-22 W/m2/Hz), 50..400; used "
-                    "when use_constant_space_weather")
-    slave.parameter("f107a", 150.0, "1",
-                    "Constant 81-day mean solar flux F10.7 in solar flux units (1 sfu = 1e-22 W/m2/Hz), 50..400; "
-                    "used when use_constant_space_weather")
-    slave.parameter("ap", 15.0, "1",
-                    "Constant geomagnetic index Ap (daily and 3-hourly), 0..400; used when "
-                    "use_constant_space_weather")
-    slave.parameter("hp_exponent", 0.0, "1",
-                    "Harris-Priester cosine exponent n, 2..6 (2 low inclination, 6 polar); 0 = from the orbit "
-                    "inclination (linear, 2 at 0 deg to 6 at 90 deg), or 4 where the FMU has no orbit")
-
-
-_ATMOSPHERE_CACHE = {}
-
-
-def atmosphere_model(values, inclination=None):
-    """The components.environment.atmosphere density model for the parameter values declared by
-    `atmosphere_parameters` (a mapping name -> value, e.g. slave.values). `inclination` (rad)
-    sets the Harris-Priester exponent when hp_exponent is 0. ValueError naming the parameter
-    for a bad value. A space-weather file is parsed once per path and process."""
-    from components.environment import atmosphere, space_weather
-
-    name = values["density_model"]
-    if name not in atmosphere.MODELS:
-        raise ValueError(f"density_model = {name!r} is unknown; choose one of {', '.join(atmosphere.MODELS)}")
-    n = float(values["hp_exponent"])
-    if n != 0.0 and not (2.0 <= n <= 6.0):
-        raise ValueError(f"hp_exponent = {n!r} must be 0 (from the inclination) or in [2, 6]")
-    sw = None
-    if name in ("msis", "jacchia_roberts"):
-        if values["use_constant_space_weather"]:
-            sw = space_weather.ConstantSpaceWeather(values["f107"], values["f107a"], values["ap"])
-        else:
-            path = values["space_weather_file"]
-            key = os.path.abspath(path) if path else ""
-            if key and not os.path.isfile(key):
-                raise ValueError(f"space_weather_file = {path!r} does not exist")
-            if key not in _ATMOSPHERE_CACHE:
-                try:
-                    _ATMOSPHERE_CACHE[key] = space_weather.SpaceWeather.from_file(path or None)
-                except ValueError as exc:
-                    raise ValueError(f"space_weather_file = {path!r}: {exc}") from None
-            sw = _ATMOSPHERE_CACHE[key]
-    return atmosphere.make_density_model(name, space_weather=sw, inclination=inclination,
-                                         hp_exponent=None if n == 0.0 else n)

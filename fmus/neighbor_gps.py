@@ -3,11 +3,9 @@
 Wraps components.sensing.sensors.GpsReceiver (thesis 3.3.1, NovAtel OEM7700 [45]). One noise sample
 per communication step, drawn in do_step; r_meas_N depends directly on r_BN_N, gps_time is state.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import sensors  # noqa: E402 (after use_bundled_components)
+from components.sensing import sensors
 
 POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 

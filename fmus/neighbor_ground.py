@@ -6,12 +6,10 @@ output depends directly on the input r_BN_N (and on the time the model keeps: th
 initialization, t + h after do_step(t, h)).
 """
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.mission import ground_station as gs  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
+from components.mission import ground_station as gs
+from components.core import time_utils
 
 R = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
 

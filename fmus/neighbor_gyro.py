@@ -3,11 +3,9 @@
 Wraps components.sensing.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
 communication step, drawn in do_step; the output depends directly on the true rate.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import sensors  # noqa: E402 (after use_bundled_components)
+from components.sensing import sensors
 
 RATE = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
 

@@ -7,11 +7,9 @@ the FMU state.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import sensors  # noqa: E402 (after use_bundled_components)
+from components.sensing import sensors
 
 POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 QUAT = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]

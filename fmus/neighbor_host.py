@@ -5,11 +5,9 @@ heartbeat is present before heartbeat_loss_time, lost from it on, and toggled ag
 time of heartbeat_return_times. `next_event_time` is the next toggle so that a master can end a
 step on it. The model keeps the time: the start time at initialization, t + h after do_step.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.mission import host  # noqa: E402 (after use_bundled_components)
+from components.mission import host
 
 
 class HostSpacecraft(NeighborSlave):

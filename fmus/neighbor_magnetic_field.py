@@ -6,12 +6,10 @@ Earth-fixed frame from N by the IAU 1982 GMST. B_N depends directly on the posit
 B_B on the position and the attitude. The model keeps the simulation time: the start time at
 initialization, t + h after do_step(t, h).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.environment import magnetic_field  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
+from components.environment import magnetic_field
+from components.core import time_utils
 
 R_IN = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
 Q_IN = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]

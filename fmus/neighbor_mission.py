@@ -8,13 +8,11 @@ determination) fire at their exact times inside the step and `next_event_time` a
 next one. Every output is state: no output depends directly on an input. The model keeps the
 time: the start time at initialization, t + h after do_step(t, h).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.mission import manager as mm  # noqa: E402 (after use_bundled_components)
-from components.mission.modes import MODE_TABLE, PHASE_TABLE  # noqa: E402 (after use_bundled_components)
-from components.mission.power_bus import LOAD_NAMES, LOADS  # noqa: E402 (after use_bundled_components)
+from components.mission import manager as mm
+from components.mission.modes import MODE_TABLE, PHASE_TABLE
+from components.mission.power_bus import LOAD_NAMES, LOADS
 
 D = mm.PARAMETER_DEFAULTS
 PARAMETERS = (

@@ -5,11 +5,9 @@ saturated (and none beyond the speed limit). wheel_rate and wheel_momentum_B are
 direct dependencies); wheel_torque_B depends directly on torque_cmd and enabled. Connect
 wheel_torque_B and wheel_momentum_B to the RigidBody inputs of the same names.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import momentum_wheel  # noqa: E402 (after use_bundled_components)
+from components.acs import momentum_wheel
 
 
 class MomentumWheel(NeighborSlave):

@@ -6,11 +6,9 @@ loss_time of dawn). `tracking` depends directly on orbit_day.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import optical_tracker  # noqa: E402 (after use_bundled_components)
+from components.acs import optical_tracker
 
 
 class OpticalTracker(NeighborSlave):

@@ -13,13 +13,13 @@ falls below reentry_altitude; the model then holds its state (the system's stop 
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, atmosphere_model, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
+from neighbor_orbit_support import atmosphere_model, orbit_interface
 
-use_bundled_components(__file__)
-
-from components.orbit import cowell, elements  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
-from components.core.constants import MU_EARTH, R_EQ  # noqa: E402 (after use_bundled_components)
+from components.core import jit
+from components.orbit import cowell, elements
+from components.core import time_utils
+from components.core.constants import MU_EARTH, R_EQ
 
 
 class Orbit(NeighborSlave):
@@ -29,7 +29,8 @@ class Orbit(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
+        self.log(f"density and orbit kernels: {jit.describe()}")
+        orbit_interface(self, R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=False)
         self.parameter("zonal_degree", 6, None,
                        "Zonal gravity terms: 0 = point mass only, 2 = J2, ..., 6 = J2..J6 (EGM96)", int)
         self.parameter("drag", True, None, "Atmospheric drag on (false: gravity and thrust only)", bool)
@@ -56,7 +57,7 @@ class Orbit(NeighborSlave):
         if not (0.0 <= v["inc0"] <= math.pi):
             raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [0, pi]")
         sma, ecc, inc, raan, argp, ta = elements.initial_elements(v, v["mu"])
-        density = atmosphere_model(v, inclination=inc) if v["drag"] else None
+        density = atmosphere_model(v, inclination=inc, resources=self.resources) if v["drag"] else None
         return cowell.CowellOrbit(
             epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
             ta0=ta, Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],

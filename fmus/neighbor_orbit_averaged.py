@@ -17,13 +17,13 @@ over a step. The initial Keplerian elements are taken as mean elements.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, atmosphere_model, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
+from neighbor_orbit_support import atmosphere_model, orbit_interface
 
-use_bundled_components(__file__)
-
-from components.orbit import averaged, elements  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
-from components.core.constants import MU_EARTH, R_EQ  # noqa: E402 (after use_bundled_components)
+from components.core import jit
+from components.orbit import averaged, elements
+from components.core import time_utils
+from components.core.constants import MU_EARTH, R_EQ
 
 
 class OrbitAveraged(NeighborSlave):
@@ -32,7 +32,8 @@ class OrbitAveraged(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.orbit_interface(R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
+        self.log(f"density and orbit kernels: {jit.describe()}")
+        orbit_interface(self, R_EQ + 420e3, MU_EARTH, time_utils.DEFAULT_EPOCH, mean=True)
         self.parameter("drag", True, None, "Atmospheric drag on (false: J2 and thrust only, density output 0)",
                        bool)
         self.parameter("j2", averaged.J2, "1",
@@ -71,7 +72,7 @@ class OrbitAveraged(NeighborSlave):
             raise ValueError(f"inc0 = {v['inc0']!r} rad must be in [1e-4, pi - 1e-4]")
         # a Cartesian start is taken as the mean state (no short-period correction)
         sma, ecc, inc, raan, argp, ta = elements.initial_elements(v, v["mu"])
-        density = atmosphere_model(v, inclination=inc) if v["drag"] else None
+        density = atmosphere_model(v, inclination=inc, resources=self.resources) if v["drag"] else None
         return averaged.OrbitAveraged(
             density, epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
             ta0=ta, Cd=v["Cd"], area=v["area"], reentry_altitude=v["reentry_altitude"], mu=v["mu"],

@@ -3,11 +3,9 @@
 Wraps components.acs.paddles.Paddles: deployment progresses while `deploy` is true and latches
 deployed after deployment_time. Outputs are states (no direct dependencies).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import paddles  # noqa: E402 (after use_bundled_components)
+from components.acs import paddles
 
 
 class Paddles(NeighborSlave):

@@ -6,12 +6,10 @@ vs Appendix I, and the exact integration). Inputs: one Boolean per load (held ov
 and `solar_power` (W, default 0: NEIGHBOR has no panels; a host may charge it). `load_power`
 depends directly on the Booleans; energy, state_of_charge, energy_used and empty are states.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.mission import power  # noqa: E402 (after use_bundled_components)
-from components.mission.power_bus import LOADS, LOAD_NAMES  # noqa: E402 (after use_bundled_components)
+from components.mission import power
+from components.mission.power_bus import LOADS, LOAD_NAMES
 
 
 class Power(NeighborSlave):

@@ -10,11 +10,9 @@ the orbit sees full thrust for the whole step, and zero from the next one. `mass
 `propellant_used`, `propellant_remaining`, `burn_time` and `budget_spent` are states at the
 communication point. The orbit FMUs take `mass` and `F_thrust_B` as inputs.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.orbit import propulsion  # noqa: E402 (after use_bundled_components)
+from components.orbit import propulsion
 
 _DEFAULT_BUDGET = propulsion.deorbit_scenario(420e3, 350e3)["propellant"]
 

@@ -8,11 +8,9 @@ threshold logic with quantize = true. Stateless.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import reference_tracking as rt  # noqa: E402 (after use_bundled_components)
+from components.attitude import reference_tracking as rt
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]

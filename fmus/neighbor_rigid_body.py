@@ -11,11 +11,9 @@ the original variables are unchanged; left at zero the model is bit-identical to
 one. H_B stays the body's own J omega (the total is H_B + wheel_momentum_B).
 """
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import rigid_body  # noqa: E402 (after use_bundled_components)
+from components.attitude import rigid_body
 
 
 class RigidBody(NeighborSlave):

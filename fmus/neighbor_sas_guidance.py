@@ -8,11 +8,9 @@ depend on time only (no inputs); the reference time is the FMU's only state.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import rigid_body, sun_avoidance  # noqa: E402 (after use_bundled_components)
+from components.attitude import rigid_body, sun_avoidance
 
 MAX_SEGMENTS = 3
 

@@ -5,12 +5,10 @@ Appendix E, or of Appendix G with accept_antipodal). Stateless.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.core import rotations  # noqa: E402 (after use_bundled_components)
-from components.attitude import slew, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.core import rotations
+from components.attitude import slew, thruster_control
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]

@@ -4,12 +4,10 @@ Wraps components.environment.sun.SunEphemeris (Astronomical Almanac / Vallado Al
 Sun, about 0.01 deg). No inputs; the output is a function of time only. The model keeps the
 simulation time: the start time at initialization, t + h after do_step(t, h).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.environment import sun  # noqa: E402 (after use_bundled_components)
-from components.core import time_utils  # noqa: E402 (after use_bundled_components)
+from components.environment import sun
+from components.core import time_utils
 
 
 class SunEphemeris(NeighborSlave):

@@ -7,11 +7,9 @@ inputs. The generator state is part of the FMU state.
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import sensors  # noqa: E402 (after use_bundled_components)
+from components.sensing import sensors
 
 SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
 POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]

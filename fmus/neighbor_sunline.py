@@ -4,11 +4,9 @@ Wraps components.sensing.sunline.SunlineEphemeris: d_N = (r_SN_N - r_BN_N)/|r_SN
 d_B = [BN(sigma_BN)] d_N, or A(q_BN) d_N with attitude_input = "quaternion". Stateless; both
 outputs are direct feedthrough of the inputs.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.sensing import sunline  # noqa: E402 (after use_bundled_components)
+from components.sensing import sunline
 
 R_SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
 R_SC = [f"r_BN_N[{i}]" for i in (1, 2, 3)]

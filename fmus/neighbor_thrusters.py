@@ -4,11 +4,9 @@ Wraps components.attitude.thrusters.ThrusterPairs (thesis Eq. 13-16 and 74): com
 applied torque and thrust flags out (direct feedthrough), firing time and propellant mass
 accumulated over the steps (states).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import thrusters  # noqa: E402 (after use_bundled_components)
+from components.attitude import thrusters
 
 CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
 

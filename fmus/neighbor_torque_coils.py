@@ -3,11 +3,9 @@
 Wraps components.acs.magnetorquer.TorqueCoils: the commanded dipole saturated per axis (zero when
 disabled) and the torque dipole x field. Both outputs are direct feedthrough of the inputs.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.acs import magnetorquer  # noqa: E402 (after use_bundled_components)
+from components.acs import magnetorquer
 
 CMD_IN = [f"dipole_cmd_B[{i}]" for i in (1, 2, 3)] + ["enabled"]
 B_IN = [f"B_B[{i}]" for i in (1, 2, 3)]

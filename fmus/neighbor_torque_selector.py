@@ -3,11 +3,9 @@ attitude controller (detumble, slew or tracking) to the RCS thrusters.
 
 Wraps components.attitude.command_selector.select_command. Direct feedthrough; no state.
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import command_selector  # noqa: E402 (after use_bundled_components)
+from components.attitude import command_selector
 
 
 class _Stateless:

@@ -10,11 +10,9 @@ latched from the q_BN input at the first step while enabled (before that the out
 q_d = q_BN) and released while disabled; otherwise it starts at q_d0 and is propagated every
 step. Each do_step propagates it at omega_d over the communication step (Eq. 19-21).
 """
-from neighbor_fmu_support import NeighborSlave, use_bundled_components
+from neighbor_fmu_support import NeighborSlave
 
-use_bundled_components(__file__)
-
-from components.attitude import deorbit_tracking, rigid_body, thruster_control  # noqa: E402 (after use_bundled_components)
+from components.attitude import deorbit_tracking, rigid_body, thruster_control
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]

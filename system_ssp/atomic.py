@@ -9,14 +9,22 @@ from pathlib import Path
 import tempfile
 
 
+def _umask():
+    mask = os.umask(0)
+    os.umask(mask)
+    return mask
+
+
 @contextmanager
 def atomic_write(path, mode="w", **open_kwargs):
-    """`with atomic_write(path, "w") as f: f.write(...)`; `mode` "w" (text) or "wb"."""
+    """`with atomic_write(path, "w") as f: f.write(...)`; `mode` "w" (text) or "wb". The file
+    gets the permissions a plain open() would give it (0666 less the umask)."""
     path = Path(path)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".tmp", dir=path.parent)
     try:
         with os.fdopen(fd, mode, **open_kwargs) as f:
             yield f
+        os.chmod(tmp, 0o666 & ~_umask())
         os.replace(tmp, path)
     except BaseException:
         try:

@@ -1,7 +1,6 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
 `info`, `thesis`, `deorbit-study` and `mission`, and `--version`."""
 import argparse
-import os
 import sys
 
 from . import __version__
@@ -129,10 +128,4 @@ def main(argv=None):
 
 def console_main():
     """Entry point of the `neighbor-cosim` command (and `python -m system_ssp`)."""
-    code = main()
-    # Leave without the interpreter's teardown: pythonfmu's native side can call a logger callback
-    # that Python already freed while the interpreter shuts down ("corrupted double-linked list",
-    # an abort after every result was written). Everything is written and flushed by now.
-    sys.stdout.flush()
-    sys.stderr.flush()
-    os._exit(code or 0)
+    sys.exit(main())

@@ -1,12 +1,26 @@
 """Shared fixtures: the product's FMUs and SSPs, built (incrementally) once per session."""
-import os
+import ctypes
 from pathlib import Path
-import sys
 
+from fmpy.fmi1 import printLogMessage
+from fmpy.fmi2 import fmi2CallbackFunctions, fmi2CallbackLoggerTYPE
+from fmpy.logging import addLoggerProxy
 import pytest
 
-# pythonfmu's builder must come from the installed package: a pythonfmu FMU run in this process
-# puts its own bundled copy (without the binaries the builder packs) on the import path.
+# FMPy routes the messages of every FMU instance that uses its logger proxy (the default one
+# included) to the Python logger registered last (one global in its logging library). A test that
+# passes a logger of its own to fmpy.simulate_fmu leaves that global pointing at a callback that
+# is gone once the call returns, and the next FMU message crashes the process. After every test
+# the global is pointed at a logger that lives as long as the session.
+_FMPY_CALLBACKS = fmi2CallbackFunctions()
+_FMPY_LOGGER = fmi2CallbackLoggerTYPE(printLogMessage)
+
+
+@pytest.fixture(autouse=True)
+def fmpy_logger_alive():
+    yield
+    _FMPY_CALLBACKS.logger = _FMPY_LOGGER  # addLoggerProxy swaps it for its proxy: set it again
+    addLoggerProxy(ctypes.byref(_FMPY_CALLBACKS))
 
 
 @pytest.fixture(scope="session")
@@ -43,23 +57,3 @@ def fmu_paths(built):
 @pytest.fixture(scope="session")
 def ssp_paths(built):
     return built[1]
-
-
-_exit_status = {}
-
-
-def pytest_sessionfinish(session, exitstatus):
-    _exit_status["status"] = int(exitstatus)
-
-
-def pytest_unconfigure(config):
-    """Leave without the interpreter's teardown once pytest has reported.
-
-    pythonfmu's native side can call a logger callback that Python already freed while the
-    interpreter shuts down (seen here as an intermittent "corrupted double-linked list" abort
-    after all tests passed, from FMU instances fmpy.simulate_fmu created and dropped). Every
-    result is reported by now, so skip that teardown and keep pytest's own exit status."""
-    if "status" in _exit_status:
-        sys.stdout.flush()
-        sys.stderr.flush()
-        os._exit(_exit_status["status"])

@@ -31,8 +31,8 @@ the Earth-fixed rotation inside the force model and was not done in the time ava
 import math
 
 import numpy as np
-from numba import njit
 
+from ..core.jit import njit
 from ..core.constants import MU_EARTH, R_EQ
 
 EGM96_CBAR_N0 = {2: -0.484165371736e-03, 3: 0.957254173792e-06, 4: 0.539873863789e-06,

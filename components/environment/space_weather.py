@@ -36,10 +36,12 @@ import math
 import os
 
 import numpy as np
-from numba import njit
+
+from ..core.jit import njit
 
 DATA_DIR = os.path.join(os.path.dirname(os.path.abspath(__file__)), "data")
 BUNDLED_FILE = os.path.join(DATA_DIR, "SW-All_CSSI_2026-08-22_from2000.txt")
+PACKAGE_DATA = ("data/SW-All_CSSI_2026-08-22_from2000.txt",)  # what an FMU that imports this bundles
 
 # daily-table columns
 COL_F107_OBS = 0          # observed F10.7 of the day

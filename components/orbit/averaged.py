@@ -37,11 +37,11 @@ the trapezoidal rule over N equally spaced eccentric longitudes F_k (spectrally 
 periodic integrand), weighted by dM = (r / a) dF. Default N = 16: thesis lifetimes change by
 < 1e-5 relative from N = 12 to 24 (Jacchia-Roberts, 525 km, 86.37 y). The density is the atmosphere kernel at each
 node's actual 3D position at the current time (the orbit is averaged as a snapshot: within one
-orbit the Sun moves 0.06 deg and the space weather is constant). Numba evaluates the whole
-average in one call for models with a kernel; for msis (kernel None) the nodes come from numba
-and the densities from model.density in Python (slow: N pymsis calls per evaluation, about 4 ms).
+orbit the Sun moves 0.06 deg and the space weather is constant). The whole average is one call
+of a compiled function (numba, when installed) with the model's kernel bound in; NRLMSIS's kernel
+calls pymsis for each node (slow: N pymsis calls per evaluation, about 4 ms).
 
-J2 secular drift (first order): dRAAN/dt and dargp/dt from components.orbit_elements.
+J2 secular drift (first order): dRAAN/dt and dargp/dt from components.orbit.elements.
 j2_secular_rates, and dM/dt = n + 3/4 n J2 (R/p)^2 eta (2 - 3 sin^2 i) (Vallado Eq. 9-41;
 orbit_elements has no M rate). argp's drift rotates (ex, ey); lam gets dargp/dt + dM/dt.
 
@@ -61,8 +61,8 @@ the clock.
 import math
 
 import numpy as np
+from ..core.jit import njit
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
-from numba import njit
 
 from ..environment import geodesy
 from . import elements
@@ -382,12 +382,8 @@ class OrbitAveraged:
         bc = self.Cd * self.area / mass
         jd = self.jd(t)
         self.evaluations += 1
-        kern = self.atmosphere.kernel
-        if kern is not None:
-            return _drag_function(kern)(y, jd, self.mu, bc, self.omega_atm, self.n_nodes, self.atmosphere.kernel_data)
-        R, V, geo = _nodes(y, self.mu, self.n_nodes)
-        rho = np.array([self.atmosphere.density(R[k], jd) for k in range(self.n_nodes)])
-        return _drag_sum(y, self.mu, bc, self.omega_atm, R, V, geo, rho)
+        return _drag_function(self.atmosphere.kernel)(y, jd, self.mu, bc, self.omega_atm, self.n_nodes,
+                                                      self.atmosphere.kernel_data)
 
     def j2_rates(self, y):
         """(dRAAN/dt, dargp/dt, dM/dt - n) of J2 (rad/s)."""

@@ -16,13 +16,12 @@ F_B, q_BN, `retrograde` and the mass are inputs held constant across a communica
 (zero-order hold). The density rho comes from a model of components/environment/atmosphere/
 (`make_density_model`) and is evaluated at every integrator stage (no caching across stages).
 
-Integrator: Dormand-Prince 8(5,3) (DOP853, Hairer's error estimator and step control, the same
-method and coefficients as scipy's DOP853, scipy.integrate._ivp.dop853_coefficients), written as
-one numba function that integrates a whole communication step with adaptive internal steps and
-lands exactly on its end; the last internal step size is carried to the next communication step.
-When the density model has a numba kernel it is called inside the compiled right-hand side. For a
-model without a kernel (NRLMSIS through pymsis) the same equations run as a Python right-hand side
-in Hairer's Fortran DOP853 (scipy.integrate.ode) with the same tolerances.
+Integrator: Dormand-Prince 8(5,3) (DOP853, Hairer's coefficients in components/orbit/dop853.py,
+his error estimator and step control), written as one function that integrates a whole
+communication step with adaptive internal steps and lands exactly on its end; the last internal
+step size is carried to the next communication step. It is compiled by numba when numba is
+installed (components/core/jit.py) and runs as plain Python otherwise, with the same results. The
+density model's kernel is called at every stage (NRLMSIS's calls pymsis from compiled code).
 
 Tolerances (defaults, from a convergence check, see bench/bench_orbit.py and the report):
 rtol = 1e-11, atol = 1e-4 m on position and 1e-7 m/s on velocity.
@@ -38,14 +37,14 @@ flag and time, and the held inputs: restoring it reproduces later steps bit for 
 import math
 
 import numpy as np
-from numba import njit
-from scipy.integrate._ivp import dop853_coefficients as _dop
 
+from ..core.jit import njit
 from ..core import rotations, time_utils
 from ..environment import atmosphere, geodesy
 from ..core.checks import positive
 from ..environment.gravity import accel_zonal, zonal_coefficients
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
+from . import dop853
 from .elements import kepler_to_cartesian, osculating_ecc, osculating_sma
 
 RTOL = 1e-11
@@ -54,12 +53,7 @@ ATOL_VELOCITY = 1e-7  # m/s
 MAX_INTERNAL_STEPS = 1_000_000
 INITIAL_STEP = 10.0  # s, first internal step (the controller adapts it at once)
 
-_NS = _dop.N_STAGES  # 12
-_A = np.ascontiguousarray(_dop.A[:_NS, :_NS])
-_B = np.ascontiguousarray(_dop.B)
-_C = np.ascontiguousarray(_dop.C[:_NS])
-_E3 = np.ascontiguousarray(_dop.E3)
-_E5 = np.ascontiguousarray(_dop.E5)
+_A, _B, _C, _E3, _E5 = (np.ascontiguousarray(x) for x in (dop853.A, dop853.B, dop853.C, dop853.E3, dop853.E5))
 
 # indices into the force-parameter vector `fp`
 _MU, _REQ, _DRAG, _BC, _JD0, _WE, _TX, _TY, _TZ, _TMAG, _RETRO = range(11)
@@ -138,7 +132,7 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
              reentry_altitude, max_steps):
     """DOP853 from t to t_end (lands exactly). Returns (t, y, h_next, reentered, steps, rejected).
 
-    Step control as scipy's DOP853 (safety 0.9, factor limits 0.2..10, error exponent -1/8)."""
+    Step control as Hairer's DOP853 (safety 0.9, factor limits 0.2..10, error exponent -1/8)."""
     n = 6
     y = y0.copy()
     K = np.empty((13, n))
@@ -266,11 +260,8 @@ class CowellOrbit:
             raise ValueError("drag is on but no density_model was given; give a model from "
                              "components.environment.atmosphere.make_density_model or drag=False")
         self.density_model = density_model
-        kernel = getattr(density_model, "kernel", None) if self.drag else _zero_density
-        self._kernel = kernel
-        self._kdata = (getattr(density_model, "kernel_data", ()) or ()) if self.drag else ()
-        if kernel is not None and not self.drag:
-            self._kdata = ()
+        self._kernel = density_model.kernel if self.drag else _zero_density
+        self._kdata = (density_model.kernel_data or ()) if self.drag else ()
         self.t = time_utils.check_time(t0, "t0")
         self.t_state = self.t
         self.y = np.concatenate([r0, v0])
@@ -333,13 +324,10 @@ class CowellOrbit:
         if t == self.t:
             return
         if not self.reentered:
-            if self._kernel is not None:
-                ts, y, h, reentered, steps, _ = _advance(
-                    self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
-                    self.zonal_degree, self._kernel, self._kdata, _A, _B, _C, _E3, _E5,
-                    self.reentry_altitude, MAX_INTERNAL_STEPS)
-            else:
-                ts, y, h, reentered, steps = self._advance_python(t)
+            ts, y, h, reentered, steps, _ = _advance(
+                self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
+                self.zonal_degree, self._kernel, self._kdata, _A, _B, _C, _E3, _E5,
+                self.reentry_altitude, MAX_INTERNAL_STEPS)
             self.t_state, self.y, self.h, self.steps = float(ts), y, float(h), self.steps + int(steps)
             if reentered:
                 self.reentered = True
@@ -349,60 +337,6 @@ class CowellOrbit:
 
     def step(self, h):
         self.advance_to(self.t + h)
-
-    def _advance_python(self, t_end):
-        """Python right-hand side (density models without a numba kernel) in Hairer's DOP853
-        (scipy.integrate.ode). That wrapper takes one scalar atol, so it integrates the scaled
-        state z = [r, k v] with k = atol_position / atol_velocity: the same error test as the
-        numba path (scale atol + rtol |y| per component)."""
-        from scipy.integrate import ode
-
-        fp = self._force_parameters()
-        J, nmax, model = self.J, self.zonal_degree, self.density_model
-        k = self.atol[0] / self.atol[3]
-        out = np.empty(6)
-        y = np.empty(6)
-
-        def density(r, jd):
-            return float(model.density(r, jd))
-
-        dens = _PythonDensity(density)
-
-        def f(t, z):
-            y[:3] = z[:3]
-            y[3:] = z[3:] / k
-            _deriv_py(t, y, fp, J, nmax, dens, out)
-            out[3:] *= k
-            return out.copy()
-
-        state = {"reentered": False, "t": self.t_state, "z": None, "steps": 0, "t_prev": self.t_state,
-                 "h": self.h}
-
-        def solout(t, z):  # called after every accepted step (and once at the start)
-            if t > state["t_prev"]:
-                state["steps"] += 1
-                if t < t_end:  # the last step is clipped to land on t_end: keep the one before
-                    state["h"] = t - state["t_prev"]
-                state["t_prev"] = t
-            if geodetic_altitude_nb(z[0], z[1], z[2]) < self.reentry_altitude:
-                state["reentered"], state["t"], state["z"] = True, t, np.array(z, dtype=float)
-                return -1
-            return 0
-
-        solver = ode(f).set_integrator("dop853", rtol=self.rtol, atol=float(self.atol[0]),
-                                       nsteps=MAX_INTERNAL_STEPS, first_step=min(self.h, t_end - self.t_state))
-        solver.set_solout(solout)
-        z0 = self.y.copy()
-        z0[3:] *= k
-        solver.set_initial_value(z0, self.t_state)
-        z = solver.integrate(t_end)
-        if state["reentered"]:
-            t_end, z = state["t"], state["z"]
-        elif not solver.successful():
-            raise RuntimeError(f"orbit integrator (DOP853, Python RHS) failed with code {solver.get_return_code()}")
-        y_end = np.array(z, dtype=float)
-        y_end[3:] /= k
-        return float(t_end), y_end, state["h"], state["reentered"], state["steps"]
 
     # ---- outputs -------------------------------------------------------------------------
     def jd_state(self):
@@ -456,23 +390,3 @@ class CowellOrbit:
         self._outputs = None
 
 
-class _PythonDensity:
-    def __init__(self, fn):
-        self.fn = fn
-
-
-def _deriv_py(t, y, fp, J, nmax, dens, out):
-    """The right-hand side of _deriv with a Python density function (models without a kernel)."""
-    x, yy, z, vx, vy, vz = (float(c) for c in y)
-    ax, ay, az = accel_zonal(x, yy, z, fp[_MU], fp[_REQ], J, nmax)
-    if fp[_DRAG] != 0.0:
-        rho = dens.fn(np.array((x, yy, z)), fp[_JD0] + t / DAY)
-        w = fp[_WE]
-        vrx, vry, vrz = vx + w * yy, vy - w * x, vz
-        k = -fp[_BC] * rho * math.sqrt(vrx * vrx + vry * vry + vrz * vrz)
-        ax, ay, az = ax + k * vrx, ay + k * vry, az + k * vrz
-    ax, ay, az = ax + fp[_TX], ay + fp[_TY], az + fp[_TZ]
-    if fp[_RETRO] != 0.0:
-        k = -fp[_TMAG] / math.sqrt(vx * vx + vy * vy + vz * vz)
-        ax, ay, az = ax + k * vx, ay + k * vy, az + k * vz
-    out[:] = (vx, vy, vz, ax, ay, az)

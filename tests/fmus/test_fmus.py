@@ -18,11 +18,19 @@ def test_every_fmu_is_built_valid_and_fully_declared(fmu_paths):
 
 
 def test_module_names_are_unique(fmu_paths):
-    modules = []
-    for path in fmu_paths.values():
+    """Every FMU's code lives in one package named for the FMU and its build: no two FMUs (or two
+    builds of one) can load each other's modules in one process."""
+    packages = []
+    for name, path in fmu_paths.items():
         with zipfile.ZipFile(path) as zf:
-            modules.append(zf.read("resources/slavemodule.txt").decode().strip())
-    assert len(set(modules)) == len(modules) and all(m.startswith("neighbor_") for m in modules)
+            text = zf.read("resources/neighbor_runtime.txt").decode()
+            config = dict(line.split("=", 1) for line in text.splitlines())
+            package, module, cls = config["slave"].split()
+            assert cls == name and module.startswith("neighbor_")
+            assert package.startswith(f"nc_{name.lower()}_") and f"resources/{package}/{module}.py" in zf.namelist()
+            assert not any(n.startswith(("resources/components", "resources/pythonfmu")) for n in zf.namelist())
+        packages.append(package)
+    assert len(set(packages)) == len(packages)
 
 
 def _deps(path):

@@ -3,7 +3,7 @@
     MODELS = ("exponential", "harris_priester", "msis", "jacchia_roberts")
     model = make_density_model(name, space_weather=None, inclination=None, hp_exponent=None)
     model.density(r_N, jd_utc)                 # kg/m^3 at the N position r_N (m), UTC Julian date
-    model.kernel(r, jd, model.kernel_data)     # the same number from numba code (None for msis)
+    model.kernel(r, jd, model.kernel_data)     # the same number from compiled code (numba, when installed)
 
 Every model converts the inertial position itself: Earth-fixed frame by GMST rotation and WGS-84
 geodetic latitude/longitude/altitude, exactly as components.environment.geodesy (the kernels call numba

@@ -4,8 +4,8 @@ product's own functions in components.environment) and the `DensityModel` interf
 import math
 
 import numpy as np
-from numba import njit
 
+from ...core.jit import njit
 from .. import geodesy, magnetic_field, sun
 from ...core.time_utils import DAYS_PER_CENTURY, J2000_JD
 

@@ -6,8 +6,8 @@ Static: no time, no space weather. Table as in GMAT ExponentialAtmosphere, with 
 import math
 
 import numpy as np
-from numba import njit
 
+from ...core.jit import njit
 from .base import DensityModel, geodetic
 
 # ---- exponential (Vallado Table 8-4) ----------------------------------------------------------

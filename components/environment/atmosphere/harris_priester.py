@@ -4,8 +4,8 @@ bulge, the exponent n and the extrapolation outside 100-1000 km."""
 import math
 
 import numpy as np
-from numba import njit
 
+from ...core.jit import njit
 from ...core.time_utils import DAYS_PER_CENTURY, J2000_JD
 from .base import DensityModel, geodetic, sun_position_au_nb
 

@@ -41,8 +41,8 @@ differs by 0.3 m in radius); Roberts' Earth radius is GMAT's polar radius 6378.1
 import math
 
 import numpy as np
-from numba import njit
 
+from ...core.jit import njit
 from ...core.constants import R_EQ
 from ...core.time_utils import DAYS_PER_CENTURY, J2000_JD
 from .. import space_weather

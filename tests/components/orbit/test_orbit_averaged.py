@@ -5,10 +5,10 @@ cross-check of the mean decay with components.orbit."""
 import math
 
 import fmpy
-from numba import njit
 import numpy as np
 import pytest
 
+from components.core.jit import njit, objmode
 from components.environment import atmosphere
 from components.orbit import averaged as oa
 from components.orbit import elements, propulsion
@@ -36,14 +36,29 @@ class ConstantDensity:
         return self.rho
 
 
-class PythonOnly(ConstantDensity):
-    """The same, without a kernel (the path msis takes)."""
+_PYTHON_DENSITY = {}
 
-    kernel = None
+
+def _python_density(r, jd):
+    return _PYTHON_DENSITY["rho"]
+
+
+@njit
+def _callback_kernel(r, jd, data):
+    with objmode(rho="float64"):
+        rho = _python_density(r, jd)
+    return rho
+
+
+class PythonOnly(ConstantDensity):
+    """The same, with the density computed in Python and called from the kernel (the path msis
+    takes)."""
 
     def __init__(self, rho):
         super().__init__(rho)
-        self.kernel = None
+        _PYTHON_DENSITY["rho"] = float(rho)
+        self.kernel = _callback_kernel
+        self.kernel_data = (0.0,)
 
 
 def elements_vector(r, v):
