@@ -4,23 +4,28 @@
     python build_fmus.py --clean    # rebuild everything
     python build_fmus.py --check    # also run fmpy's validation on every FMU
 
-FMUs: each `fmus/neighbor_*.py` wrapper becomes `build/fmus/<ClassName>.fmu`, built with
-pythonfmu and bundling `components/` and `fmus/neighbor_fmu_support.py`, so an FMU needs
-only the Python interpreter and the third-party packages (numpy, scipy). pythonfmu writes no
-units, no output dependencies and no InitialUnknowns, so the model description is completed
-here from what the wrapper declared (`NeighborSlave.fmu_meta`):
-- `unit` on every Real that has one, with `UnitDefinitions` in SI base-unit exponents;
-- `ModelStructure/Outputs` with each output's real `dependencies` (inputs it reads
-  directly; a stateful output depends on none) and `InitialUnknowns` for every output,
-  depending on those inputs and on the parameters;
-- `canGetAndSetFMUstate` where the wrapper captures the model's full state.
+FMUs: each `fmus/neighbor_*.py` wrapper becomes `build/fmus/<ClassName>.fmu`:
+- modelDescription.xml: pythonfmu's, from the wrapper's declarations, completed here from what
+  pythonfmu cannot write (`NeighborSlave.fmu_meta`): `unit` on every Real that has one, with
+  `UnitDefinitions` in SI base-unit exponents; `ModelStructure/Outputs` with each output's real
+  `dependencies` and `InitialUnknowns`; `canGetAndSetFMUstate` where the wrapper captures the
+  model's full state. The GUID is derived from the code, so the same code gives the same FMU.
+- binaries/<platform>/<ClassName>.so|.dll: the runtime (fmus/runtime/neighbor_fmi2.c),
+  compiled here with gcc (linux64) and, when it is installed, mingw-w64 (win64).
+- resources/neighbor_runtime.py and .txt: the loader the binary runs and what it needs to know
+  (the model's class, the GUID, the Python the FMU was built with).
+- resources/nc_<name>_<digest>/: the model's code, as one package whose name is private to this
+  build: the wrapper, the support modules it uses, exactly the modules of components/ it
+  imports (computed from the import statements), their PACKAGE_DATA files, and pythonfmu's
+  authoring classes. The target needs Python and numpy only (docs/interoperability.md).
 A built FMU must pass `fmpy.validation.validate_fmu` or the build fails.
 
 SSPs: each `system_ssp/systems/<name>.ssd` becomes `build/ssp/<name>.ssp` with the SSD as
-SystemStructure.ssd, every .ssv/.ssm it references, the scenario parameter sets named
+SystemStructure.ssd (a component's several parameter bindings merged into one, which libcosim
+needs), every .ssv/.ssm it references, the scenario parameter sets named
 `parameters/<name>_*.ssv`, and the FMUs its components use under resources/.
 
-Only what changed is rebuilt: an FMU is rebuilt when its wrapper, the support module,
+Only what changed is rebuilt: an FMU is rebuilt when its wrapper, a support module, the runtime,
 anything in components/ or this script changes; an SSP when its SSD, parameter files or FMUs
 change. Outputs are written to a temporary file and renamed, so an interrupted build never
 leaves a truncated FMU or SSP behind.
@@ -55,7 +60,6 @@ from system_ssp.ssp.units import BUILTIN, base_unit_attributes
 
 ROOT = Path(__file__).resolve().parent
 FMU_SOURCES = ROOT / "fmus"
-SUPPORT = FMU_SOURCES / "neighbor_fmu_support.py"
 RUNTIME = FMU_SOURCES / "runtime"
 COMPONENTS = ROOT / "components"
 SYSTEMS = ROOT / "system_ssp" / "systems"

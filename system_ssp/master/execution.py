@@ -15,8 +15,8 @@ def execute(system, plan, progress=False):
         table.prepare()
         table.initialize()
         algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
-        recorder = Recorder(table, plan.record, algorithm.refresh_for_record,
-                            capacity=plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024)
+        expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
+        recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
         observers = [recorder]
         if plan.stops:  # first: the recorder records a row where a stop condition fires
             observers.insert(0, StopConditions(table, plan.stops))

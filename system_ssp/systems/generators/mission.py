@@ -177,13 +177,17 @@ def system(orbit_fmu):
     conns += [("mission", name, "power", name, 0) for name in LOAD_NAMES]
     return {
         "description": f"NEIGHBOR mission from deployment to re-entry ({orbit_fmu} orbit): operating modes, "
-                       "heartbeat, ground contact, de-orbit attitude control and burn, power, data",
+                       "heartbeat, ground contact, de-orbit attitude control and burn, power, data. Correct at the "
+                       "fixed 15 ms step; years of coasting need the mode-dependent steps of the "
+                       "org.neighbor-cosim.master annotation (nc:Schedule)",
         "components": comps,
         "connections": conns,
         "stop": [("orbit", "reentered")],
         "order": ORDER,
         "stop_time": 40.0 * YEAR,
-        "step_size": 3600.0,
+        # The fixed step a master without our nc:Schedule runs at (and `--no-schedule`): the 15 ms of
+        # the attitude loop, which every phase is correct at. The schedule only saves the steps.
+        "step_size": 0.015,
         "schedule": {"modes": [
             ("detumble", 0.015, maneuver_active("detumble"), 20,
              [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.DETUMBLE])], maneuver_every("detumble")),

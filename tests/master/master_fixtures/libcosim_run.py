@@ -7,7 +7,10 @@ import json
 import sys
 
 from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
 from libcosimpy.CosimObserver import CosimObserver
+
+log_output_level(CosimLogLevel.WARNING)
 
 
 def main():
