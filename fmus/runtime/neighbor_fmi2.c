@@ -19,7 +19,8 @@
  *   (out of memory, an internal error).
  *
  * The Python side lives in the FMU's resources: neighbor_runtime.py (the loader, executed from
- * its path, never imported) and one private package with the model's code (see build_fmus.py).
+ * its path into a module private to the FMU build, never imported) and one private package with
+ * the model's code (see build_fmus.py).
  */
 #include <stdarg.h>
 #include <stddef.h>
@@ -97,6 +98,8 @@ static struct {
     void (*ErrClear)(void);
     void (*IncRef)(PyObject *);
     void (*DecRef)(PyObject *);
+    PyObject *(*ImportAddModule)(const char *);
+    PyObject *(*ModuleGetDict)(PyObject *);
 } py;
 
 static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
@@ -115,6 +118,7 @@ static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
     S(UnicodeFromString, "PyUnicode_FromString"), S(UnicodeAsUTF8, "PyUnicode_AsUTF8"),
     S(ErrOccurred, "PyErr_Occurred"), S(ErrFetch, "PyErr_Fetch"), S(ErrNormalize, "PyErr_NormalizeException"),
     S(ErrClear, "PyErr_Clear"), S(IncRef, "Py_IncRef"), S(DecRef, "Py_DecRef"),
+    S(ImportAddModule, "PyImport_AddModule"), S(ModuleGetDict, "PyModule_GetDict"),
 #undef S
 };
 
@@ -459,15 +463,29 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
             free(inst);
             return NULL;
         }
-        PyObject *ns = py.DictNew();
-        py.DictSetItemString(ns, "__builtins__", py.EvalGetBuiltins());
-        PyObject *r = py.RunString(code, PY_FILE_INPUT, ns, ns);
+        /* The loader's namespace is a module of the interpreter named after a hash of its code and
+         * the FMU's GUID, so unloading and loading the library again (a host that frees it after
+         * every run) reuses it instead of leaving one more copy behind, and no two FMU builds
+         * share one. */
+        unsigned long long h = 1469598103934665603ULL;  /* FNV-1a 64 */
+        for (const unsigned char *p = (const unsigned char *)code; *p; p++) h = (h ^ *p) * 1099511628211ULL;
+        for (const unsigned char *p = (const unsigned char *)(fmuGUID ? fmuGUID : ""); *p; p++)
+            h = (h ^ *p) * 1099511628211ULL;
+        char module_name[64];
+        snprintf(module_name, sizeof module_name, "_neighbor_runtime_%016llx", h);
+        PyObject *module = py.ImportAddModule(module_name);  /* borrowed, kept in sys.modules */
+        PyObject *ns = module ? py.ModuleGetDict(module) : NULL;  /* borrowed */
+        if (ns && !py.DictGetItemString(ns, "instantiate")) {
+            py.DictSetItemString(ns, "__builtins__", py.EvalGetBuiltins());
+            PyObject *r = py.RunString(code, PY_FILE_INPUT, ns, ns);
+            if (r) py.DecRef(r);
+            else ns = NULL;
+        }
         free(code);
-        if (!r) {
+        if (!ns) {
             status = fail(inst, "loading neighbor_runtime.py");
-            py.DecRef(ns);
         } else {
-            py.DecRef(r);
+            py.IncRef(ns);
             loader = ns;
         }
     }

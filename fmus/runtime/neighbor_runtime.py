@@ -1,7 +1,8 @@
 """The Python side of a neighbor-cosim FMU's binary (neighbor_fmi2.c): loads the model.
 
-The binary executes this file from the FMU's resources into a namespace of its own (it is never
-imported, so the loaders of different FMUs cannot collide) and calls `instantiate`, `reset`,
+The binary executes this file from the FMU's resources into a module of its own, named after a
+hash of this code and the FMU's GUID (it is never imported, so the loaders of different FMU builds
+cannot collide; a library loaded again reuses it) and calls `instantiate`, `reset`,
 `drain` and `describe`. The model's code is one package with a name private to the FMU build
 (resources/<package>/, named in neighbor_runtime.txt): two FMUs, or two builds of one FMU, in one
 process never share code or data; two instances of the same build share the loaded modules.

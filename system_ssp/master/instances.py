@@ -8,6 +8,9 @@ is one fmi2Get* call per type straight into that buffer. The calls go to FMPy's 
 functions with value-reference arrays and value buffers built once per run.
 """
 import ctypes
+import itertools
+import os
+import weakref
 
 from fmpy import calloc, free
 from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
@@ -34,54 +37,108 @@ class StepFailed(Exception):
         self.ci, self.call, self.status = ci, call, status
 
 
-# pythonfmu keeps the logger of the instance created last and may call it after that instance is
-# gone (messages of other instances, teardown at exit): the callbacks must outlive every
-# instance, so they are kept for the life of the process.
-_CALLBACKS_KEPT = []
+class _Messages:
+    """One logger for every FMU instance the master creates, kept for the life of the process.
+
+    An FMU may call the logger it was given after the instance is gone (pythonfmu keeps the logger
+    of the instance created last; FMPy's logger proxy keeps one global logger for all instances),
+    so the callback itself must never be freed; it routes each message by the instance's
+    componentEnvironment, a number, to the instance that is still alive (messages for an instance
+    already freed are dropped). Nothing of a run is kept alive by it."""
+
+    def __init__(self):
+        self.live = weakref.WeakValueDictionary()  # componentEnvironment number -> FmuInstance
+        self.numbers = itertools.count(1)
+        self.c_logger = fmi2CallbackLoggerTYPE(self.log)
+
+    def log(self, env, instance_name, status, category, message):
+        try:
+            inst = self.live.get(env or 0)
+            name = instance_name.decode("utf-8", "replace") if instance_name else ""
+            if inst is not None and name and name != inst.name:
+                # a binary that keeps the callbacks of the instance created last (stock pythonfmu):
+                # the instance name it passes says whose message it is
+                inst = next((i for i in self.live.values() if i.name == name), inst)
+            if inst is None or (status < 1 and not inst.debug):
+                return
+            text = message.decode("utf-8", "replace") if message else ""
+            cat = category.decode("utf-8", "replace") if category else ""
+            label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
+            inst.messages.append((label, cat, text))
+            if len(inst.messages) > 200:
+                del inst.messages[:100]
+        except Exception:  # never let a logging problem propagate into C
+            pass
+
+    def callbacks(self, inst):
+        """The fmi2CallbackFunctions for one new instance, its componentEnvironment registered."""
+        number = next(self.numbers)
+        self.live[number] = inst
+        cb = fmi2CallbackFunctions()
+        cb.logger = self.c_logger
+        cb.allocateMemory = _ALLOCATE
+        cb.freeMemory = _FREE
+        cb.componentEnvironment = number
+        try:
+            addLoggerProxy(ctypes.byref(cb))  # formats printf-style messages of C FMUs
+        except Exception:
+            pass
+        return cb
+
+
+def _unloadable(unzipdir):
+    """Whether an FMU's library may be unloaded after its instances are freed: yes for our runtime
+    (it never finalizes the interpreter and leaves no code of its own referenced from Python), no
+    for a stock pythonfmu binary (resources/slavemodule.txt), whose unloading while the interpreter
+    holds objects it created crashes the process at exit."""
+    return not os.path.exists(os.path.join(unzipdir, "resources", "slavemodule.txt"))
+
+
+_ALLOCATE = fmi2CallbackAllocateMemoryTYPE(calloc)
+_FREE = fmi2CallbackFreeMemoryTYPE(free)
+_MESSAGES = _Messages()
 
 
 class FmuInstance:
-    """One FMU instance plus the logger that collects its messages."""
+    """One FMU instance (its FMPy object, library loaded) and the messages it logged."""
 
-    def __init__(self, info, table):
+    def __init__(self, info, debug=False):
         self.info = info
         self.name = info.name
         self.messages = []  # (status label, category, message)
+        self.debug = debug
         self.instantiated = False
         self.initialized = False
-        self.failed = False
+        self.failed_status = None  # the FMI status of a failed call (3 error, 4 fatal), once one failed
         md = info.md
-
-        def logger(env, instance_name, status, category, message):
-            try:
-                text = message.decode("utf-8", "replace") if message else ""
-                cat = category.decode("utf-8", "replace") if category else ""
-                label = STATUS[status] if 0 <= status < len(STATUS) else str(status)
-                if status >= 1 or table.debug:
-                    # pythonfmu reports through the logger of the most recently instantiated
-                    # instance, so route by the instance name the FMU passes.
-                    name = instance_name.decode("utf-8", "replace") if instance_name else ""
-                    target = table.by_name.get(name, self)
-                    target.messages.append((label, cat, text))
-                    if len(target.messages) > 200:
-                        del target.messages[:100]
-            except Exception:  # never let a logging problem propagate into C
-                pass
-
-        self._logger = fmi2CallbackLoggerTYPE(logger)
-        cb = fmi2CallbackFunctions()
-        cb.logger = self._logger
-        cb.allocateMemory = fmi2CallbackAllocateMemoryTYPE(calloc)
-        cb.freeMemory = fmi2CallbackFreeMemoryTYPE(free)
-        try:
-            addLoggerProxy(ctypes.byref(cb))
-        except Exception:
-            pass
-        self.callbacks = cb
-        _CALLBACKS_KEPT.append((self._logger, cb))
+        self.callbacks = _MESSAGES.callbacks(self)
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=info.unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=info.name)
         self.fn = self.fmu._functions
+
+    def free(self):
+        """fmi2Terminate (when initialized and healthy), fmi2FreeInstance (unless the FMU reported
+        fatal: FMI 2.0 allows no further call then), and the library unloaded."""
+        fmu, self.fn = self.fmu, None
+        if fmu is None:
+            return
+        self.fmu = None
+        healthy = self.failed_status is None
+        if self.initialized and healthy:
+            try:
+                fmu.terminate()
+            except Exception:
+                pass
+        if self.instantiated and self.failed_status != 4:
+            try:
+                fmu.fmi2FreeInstance(fmu.component)
+            except Exception:
+                pass
+        if self.failed_status != 4 and _unloadable(self.info.unzipdir):
+            try:
+                fmu.freeLibrary()
+            except Exception:
+                pass
 
     def take_messages(self):
         msgs = self.messages
@@ -204,14 +261,14 @@ class InstanceTable:
         self.plan = plan
         self.debug = False
         self.instances = []
-        self.by_name = {}
         self.t = plan.start  # the time error messages name
 
     # ---- errors -------------------------------------------------------------------------
     def error(self, ci, call, exc=None, status=None):
         """A SimulationError for a failed call of component ci, with the messages it logged."""
         inst = self.instances[ci]
-        inst.failed = True
+        if inst.failed_status is None:
+            inst.failed_status = status if status is not None and status > 2 else 3
         texts = []
         for _, _, m in inst.take_messages():
             if "PyObject_CallMethod\n" in m:  # pythonfmu: keep the Python exception text
@@ -244,12 +301,11 @@ class InstanceTable:
         p = self.plan
         for info in self.system.comps:
             try:
-                inst = FmuInstance(info, self)
+                inst = FmuInstance(info, self.debug)
             except Exception as exc:
                 raise SimulationError(f"component {info.name!r}: cannot load the FMU binary "
                                       f"({self.system.namer(info.decl.fmu_path)}): {exc}") from None
             self.instances.append(inst)
-            self.by_name[inst.name] = inst
             ci = len(self.instances) - 1
             self.call(ci, "fmi2Instantiate", inst.fmu.instantiate, False, inst.callbacks, True)
             inst.instantiated = True
@@ -270,25 +326,11 @@ class InstanceTable:
             self.call(ci, f"setting parameters/start values ({vtype})", setter, vrs, values)
 
     def free(self):
-        for inst in self.instances:
-            if inst.failed:
-                # FMI 2.0: after an error/fatal status only fmi2FreeInstance may be called; a
-                # pythonfmu instance that raised is left alone (freeing it can crash at exit).
-                continue
-            try:
-                if inst.initialized:
-                    inst.fmu.terminate()
-            except Exception:
-                pass
-            try:
-                # fmi2FreeInstance only: unloading a pythonfmu library (dlclose) while the
-                # interpreter still holds objects created by it crashes the process at exit,
-                # so the library stays loaded (dlopen of the same file reuses it next run).
-                if inst.instantiated:
-                    inst.fmu.fmi2FreeInstance(inst.fmu.component)
-            except Exception:
-                pass
-        self.instances = []
+        """Free every instance and unload the libraries that may be unloaded (see FmuInstance.free)."""
+        instances, self.instances = self.instances, []
+        for inst in instances:
+            inst.free()
+        self.G = self.gets = self.sets = self.getters = self.setters = self.do_steps = self.steppers = None
 
     def messages(self):
         return {inst.name: list(inst.messages) for inst in self.instances if inst.messages}

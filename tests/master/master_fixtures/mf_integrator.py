@@ -1,4 +1,11 @@
-"""Test fixture: integrator x' = u (explicit Euler), stateful output x."""
+"""Test fixture: integrator x' = u (explicit Euler), stateful output x.
+
+For the failure and interruption tests: `fail_at` (a doStep at t >= fail_at raises; negative: never),
+`step_delay` (seconds each doStep sleeps, a run that lasts long enough to be interrupted) and
+`touch_file` (created at the first doStep: the run has started).
+"""
+import time
+
 from neighbor_fmu_support import NeighborSlave
 
 
@@ -21,6 +28,9 @@ class MfIntegrator(NeighborSlave):
         self.parameter("x0", 0.0, None, "Initial state")
         self.input("u", 0.0, None, "Rate")
         self.output("x", lambda: self.model.x, None, "State")
+        self.parameter("fail_at", -1.0, "s", "Time from which doStep raises (negative: never)")
+        self.parameter("step_delay", 0.0, "s", "Seconds each doStep sleeps")
+        self.parameter("touch_file", "", None, "File created at the first doStep (empty: none)", kind=str)
         self.output("steps", lambda: self.values["n_steps"], None, "Steps taken", kind=int)
         self.values["n_steps"] = 0
 
@@ -28,6 +38,13 @@ class MfIntegrator(NeighborSlave):
         return _IntModel(self.values["x0"])
 
     def do_step(self, current_time, step_size):
+        if 0.0 <= self.values["fail_at"] <= current_time:
+            raise ValueError(f"fixture failure at t={current_time:g} s")
+        if self.values["touch_file"] and self.values["n_steps"] == 0:
+            with open(self.values["touch_file"], "w"):
+                pass
+        if self.values["step_delay"] > 0.0:
+            time.sleep(self.values["step_delay"])
         self.model.x += step_size * self.values["u"]
         self.values["n_steps"] += 1
         return True
