@@ -26,8 +26,9 @@ class DetumbleController(NeighborSlave):
                              "Rate tolerance: no firing inside it, done when all rates are inside it (> 0)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
-        self.parameter("signed_stop_test", True, None,
-                       "True: Appendix D's one-sided test omega - omega_d <= tol; false: |omega - omega_d| <= tol",
+        self.parameter("signed_stop_test", False, None,
+                       "False: done when |omega - omega_d| <= tol on every axis; true: Appendix D's literal one-sided "
+                       "test omega - omega_d <= tol (the thesis cases)",
                        bool)
         self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
         self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2", "Angular acceleration of the last step")

@@ -4,7 +4,9 @@ Wraps components.attitude.sun_avoidance.SunAvoidanceGuidance: plans (from parame
 rest eigenaxis slew from q0 to q_f, split into three eigenaxis segments around the Sun keep-out
 cone when the direct one would sweep the boresight through it, each with a bang-coast-bang
 profile, and streams the analytic reference at the communication point time. Its outputs
-depend on time only (no inputs); the reference time is the FMU's only state.
+depend on time only; its one input, the spacecraft's attitude, is only checked against q0 when
+initialization ends (a mismatch is an error, not a reference that jumps). The reference time is
+the FMU's only state.
 """
 import math
 
@@ -32,6 +34,11 @@ class SunAvoidanceGuidance(NeighborSlave):
         self.parameter("w_max", 0.05, "rad/s", "Maximum slew rate of each segment (> 0)")
         self.parameter("a_max", 0.01, "rad/s2", "Maximum slew acceleration of each segment (> 0)")
         self.parameter("t_start", 0.0, "s", "Simulation time at which the slew starts (q0 held before)")
+        self.parameter("q0_tolerance", 1e-6, "rad",
+                       "Largest rotation between q0 and the attitude input q_BN when initialization ends (> 0)")
+        self.input_array("q_BN", [0.0] * 4, "1",
+                         "Spacecraft attitude q_BN, scalar last (connect to the dynamics): must equal q0 at the "
+                         "start; all zeros (not connected) skips the check")
         self.parameter("mass", 12.0, "kg", "Spacecraft mass for the box inertia of the feed-forward torque (Eq. 4)")
         self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Ix uses a, b; Iz uses a, c)")
         self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Ix uses a, b; Iy uses b, c)")
@@ -79,6 +86,11 @@ class SunAvoidanceGuidance(NeighborSlave):
         model.time = self.start_time
         return model
 
+    def exit_initialization_mode(self):
+        super().exit_initialization_mode()
+        if not self.values["q0_tolerance"] > 0.0:
+            raise ValueError(f"q0_tolerance {self.values['q0_tolerance']} must be > 0")
+        sun_avoidance.check_start(self.vector("q0", 4), self.vector("q_BN", 4), self.values["q0_tolerance"])
 
     def do_step(self, current_time, step_size):
         self.model.step(current_time + step_size)

@@ -7,8 +7,10 @@ Thesis Eq. 9-16 and Appendix C `Detumble`, stop test of Appendix D:
     done when  omega_i - omega_d,i <= tol_i  for every axis          (Appendix D)
 
 The Appendix D test is one-sided (no absolute value): an axis whose rate overshoots below
-the target counts as converged. `signed_stop_test=True` (the default) keeps it, because the
-thesis numbers were produced with it; False uses |omega_i - omega_d,i| <= tol_i.
+the target counts as converged, so a spacecraft tumbling at -0.5 rad/s on every axis would be
+"done" at once. The default is the two-sided test |omega_i - omega_d,i| <= tol_i;
+`signed_stop_test=True` is the thesis' literal test (its validation-case parameter sets set it;
+both end the thesis cases at the same step).
 omega_dot is the angular acceleration of the last integration step (the scripts keep the
 w_dot of the previous `StateChange`; zero before the first step).
 """
@@ -19,7 +21,7 @@ from . import thruster_control as tc
 
 class DetumbleController:
     def __init__(self, Kp, Kd, omega_d=(0.0, 0.0, 0.0), omega_tol=(math.radians(0.01),) * 3,
-                 torque_level=None, signed_stop_test=True):
+                 torque_level=None, signed_stop_test=False):
         self.Kp = tc.check_gains("Kp", Kp)
         self.Kd = tc.check_gains("Kd", Kd)
         self.omega_d = tuple(float(x) for x in omega_d)

@@ -122,6 +122,21 @@ def _quat(q, what):
     return rotations.normalized(q, what)
 
 
+def check_start(q0, q_actual, tolerance):
+    """Refuse a plan whose start attitude q0 is not the spacecraft's attitude q_actual at the
+    start (both scalar last; within `tolerance` rad of rotation): the reference would jump.
+    An all-zero q_actual means there is nothing to compare with (the input is not connected)."""
+    if not all(math.isfinite(x) for x in q_actual):
+        raise ValueError(f"the attitude at the start {list(q_actual)} must be finite")
+    if all(x == 0.0 for x in q_actual):
+        return
+    _, angle = eigenaxis(_quat(q_actual, "attitude at the start"), _quat(q0, "q0"))
+    if angle > tolerance:
+        raise ValueError(f"q0 {list(q0)} is {math.degrees(angle):.4g} deg away from the attitude at the start "
+                         f"q_BN {list(q_actual)} (tolerance {math.degrees(tolerance):.3g} deg): the guidance must "
+                         "start from the dynamics' initial attitude (set both to the same q0)")
+
+
 def angle_between(u, v):
     """Angle (rad) between unit vectors, accurate near 0 and pi (atan2 of |u x v| and u.v)."""
     return math.atan2(rotations.norm(rotations.cross(u, v)), rotations.dot(u, v))

@@ -164,3 +164,30 @@ def test_console_command_version_and_help():
         assert sub in helptext.stdout
     mission_help = subprocess.run([str(exe), "mission", "--help"], capture_output=True, text=True, timeout=120)
     assert mission_help.returncode == 0 and "--scenario" in mission_help.stdout
+
+
+def test_detumble_default_stop_test_is_two_sided(ssp_paths):
+    """A spacecraft tumbling at -0.5 rad/s on every axis is not 'done' at t = 0 (before: 0 steps,
+    'stop condition detumble.done at t=0 s'); the thesis cases keep Appendix D's literal test."""
+    tumble = {f"dynamics.omega0[{i}]": -0.5 for i in (1, 2, 3)}
+    with system_ssp.System(ssp_paths["detumble"]) as system:
+        r = system.run(parameters=tumble, stop_time=0.3)
+        assert r.stop_reason == "reached stop time" and r.steps == 20
+        literal = system.run(parameters={**tumble, "detumble.signed_stop_test": True}, stop_time=0.3)
+        assert literal.steps == 0
+        ci = system.by_name["detumble"].index
+        assert (ci, "signed_stop_test") not in system.collect_parameters()
+        for case in ("detumble_case1", "detumble_case2"):
+            values = system.collect_parameters(parameter_sets=[f"parameters/{case}.ssv"])
+            assert values[(ci, "signed_stop_test")] is True
+
+
+def test_sun_avoidance_guidance_refuses_a_start_away_from_the_dynamics(ssp_paths):
+    """The guidance plans from its q0; a dynamics that starts elsewhere is refused when
+    initialization ends, naming both attitudes (before: the reference jumped at t = 0)."""
+    with system_ssp.System(ssp_paths["sun_avoidance_slew"]) as system:
+        with pytest.raises(system_ssp.SimulationError, match=r"component 'guidance'.*q0 .* 33.4 deg away from the "
+                                                             r"attitude at the start q_BN"):
+            system.run(parameters={"dynamics.q0[1]": 0.3}, stop_time=1.0)
+        r = system.run(stop_time=1.0)
+        assert r.stop_reason == "reached stop time"

@@ -83,7 +83,8 @@ SYSTEM = {
                     ("guidance", "done", "tracker", "guidance_done", 0),
                     ("dynamics", "q_BN", "tracker", "q_BN", 4),
                     ("dynamics", "omega_BN_B", "tracker", "omega_BN_B", 3),
-                    ("tracker", "torque_cmd_B", "dynamics", "torque_B", 3)],
+                    ("tracker", "torque_cmd_B", "dynamics", "torque_B", 3),
+                    ("dynamics", "q_BN", "guidance", "q_BN", 4)],  # checked against guidance.q0 at the start
     "stop": [("tracker", "done")],
     "order": ["tracker", "dynamics", "guidance"],
     "stop_time": 600.0,

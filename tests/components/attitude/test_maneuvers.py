@@ -174,10 +174,18 @@ def test_detumble_thresholds():
     # below one pair torque: no firing even outside the rate tolerance
     torque, flags = ctrl.command((2e-5, 0, 0), (0, 0, 0))
     assert 100 * 2e-5 < 0.0025 and flags == [0, 0, 0]
-    # Appendix D's one-sided stop test counts an overshoot below the target as done
-    assert ctrl.done((-1.0, 0.0, 0.0))
-    assert not DetumbleController([100.0] * 3, [1.0] * 3, signed_stop_test=False).done((-1.0, 0.0, 0.0))
-    assert not ctrl.done((1.1 * tol, 0, 0)) and ctrl.done((tol, tol, tol))
+    assert not ctrl.done((1.1 * tol, 0, 0)) and ctrl.done((tol, tol, tol)) and ctrl.done((-tol, 0, tol))
+
+
+def test_detumble_stop_test_is_two_sided_by_default():
+    """A spacecraft tumbling at -0.5 rad/s (or 1e6 rad/s the other way) on every axis is not
+    detumbled (before: the default was Appendix D's one-sided test, done at t = 0); the thesis'
+    literal test stays available and is what the thesis cases use."""
+    ctrl = DetumbleController([100.0] * 3, [1.0] * 3)
+    assert not ctrl.done((-0.5, -0.5, -0.5)) and not ctrl.done((-1e6, -1e6, -1e6))
+    assert not ctrl.done((0.0, 0.0, -1.0))
+    literal = DetumbleController([100.0] * 3, [1.0] * 3, signed_stop_test=True)
+    assert literal.done((-0.5, -0.5, -0.5)) and not literal.done((0.0, 0.0, 1.0))
 
 
 def test_slew_sign_of_zero_and_antipodal_stop_test():

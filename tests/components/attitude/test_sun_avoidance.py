@@ -355,3 +355,15 @@ def test_system_flies_around_the_sun(sas_build, scenario, n_seg):
     q_end = [r.final[n] for n in q_names]
     assert q_angle(q_end, gen.Q_F) <= math.radians(0.1)
     assert max(abs(r.final[n]) for n in w_names) <= math.radians(0.01)
+
+
+def test_start_attitude_must_match_the_dynamics():
+    """The guidance plans from q0; a spacecraft that starts elsewhere is refused, naming both."""
+    q0 = at.normalized((0.1, 0.2, 0.3, 0.9), "q")
+    sa.check_start(q0, q0, 1e-6)
+    sa.check_start(q0, tuple(-x for x in q0), 1e-6)  # the same attitude
+    sa.check_start(q0, (0.0, 0.0, 0.0, 0.0), 1e-6)  # not connected
+    with pytest.raises(ValueError, match=r"q0 .* is 11.46 deg away from the attitude at the start"):
+        sa.check_start(q0, at.circle_cross(at.from_axis_angle((0.0, 0.0, 1.0), 0.2), q0), 1e-6)
+    with pytest.raises(ValueError, match="must be finite"):
+        sa.check_start(q0, (math.nan, 0.0, 0.0, 1.0), 1e-6)
