@@ -16,6 +16,7 @@ getters, so an output that depends directly on inputs is recomputed from the inp
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
 """
 import copy
+from collections import OrderedDict
 from typing import Any, Callable, Iterable, Optional, Sequence, Union
 
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
@@ -30,6 +31,15 @@ class ParameterError(ValueError):
     """A parameter or input value outside its allowed range (message names the variable)."""
 
 
+class _Variables(OrderedDict):
+    """pythonfmu's value reference -> variable table, with a clear error for a value reference
+    the code does not declare (a model description from another build)."""
+
+    def __missing__(self, vr):
+        raise ValueError(f"value reference {vr} is not a variable of this FMU's code (it declares 0..{len(self) - 1}): "
+                         "the modelDescription.xml does not come from the same build as the code")
+
+
 class NeighborSlave(Fmi2Slave):
     author = "neighbor-cosim"
     license = "MIT"
@@ -39,6 +49,7 @@ class NeighborSlave(Fmi2Slave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        self.vars = _Variables(self.vars)
         self.values = {}
         self.fmu_meta = {}
         self._model = None

@@ -81,6 +81,17 @@ def _invert(tr, c):
     return (tr[0], {v: k for k, v in tr[1].items()})
 
 
+def check_connector_units(comps, units):
+    """Every Real connector's unit, connected or not, is defined and convertible to the unit of
+    its FMU variable (an unconnected one is still the unit parameter values are read in)."""
+    for comp in comps:
+        for name, conn in comp.decl.connectors.items():
+            if conn.unit is None or name not in comp.vars:
+                continue
+            fmu_unit = comp.fmu_unit(comp.vars[name])
+            units.convert(conn.unit, fmu_unit, comp, comp, f"{conn.origin}: connector {comp.name}.{name}")
+
+
 def resolve_connections(desc, comps, by_name, units):
     """[Link] for the SSD's connections: each joins an output to an input (system connectors
     resolved as pass-throughs), every input fed at most once."""
@@ -100,6 +111,12 @@ def resolve_connections(desc, comps, by_name, units):
         if connector not in comp.vars:
             raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} has no variable "
                            f"{connector!r}{near(connector, comp.vars)}")
+        declared = comp.decl.connectors
+        if declared and connector not in declared:
+            # a component that lists its connectors lists all it is connected through (SSP 1.0);
+            # one that lists none is taken to expose its FMU's variables
+            raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} declares connectors but not "
+                           f"{connector!r}{near(connector, declared)} (add an ssd:Connector for it)")
         return ("comp", comp, connector)
 
     def role(e):

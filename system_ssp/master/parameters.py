@@ -1,5 +1,6 @@
 """Parameter and start values: from the SSD's bindings, the caller's parameter sets and
 overrides, each checked against the FMU variable's type, finiteness and unit."""
+import logging
 import math
 import numbers
 from pathlib import Path
@@ -10,6 +11,8 @@ from ..errors import SSPError
 from ..ssp import reader
 from ..ssp.units import conversion, describe
 from .names import near, split_name
+
+LOG = logging.getLogger("system_ssp.master")
 
 
 def _bad(value, label, expected):
@@ -120,11 +123,18 @@ def resolve_parameter(system, comp, var, value, vtype=None, unit=None, units=Non
 
 
 def read_parameter_set(system, ps):
-    """A caller's parameter set: a path, or a name inside the .ssp (at its root or in resources/)."""
+    """A caller's parameter set: a path, or a name inside the .ssp (at its root or in resources/).
+    A relative path that names a file both here and inside the .ssp is read from here, with a
+    warning naming both (the other one is not read)."""
     p = Path(ps)
-    if not p.is_file() and system.archive_root is not None:
+    if system.archive_root is not None and not p.is_absolute():
         cand = [system.archive_root / ps, system.archive_root / "resources" / ps]
-        p = next((c for c in cand if c.is_file()), p)
+        inside = next((c for c in cand if c.is_file()), None)
+        if inside is not None and p.is_file():
+            LOG.warning("parameter set %r: using %s from the working directory, not %s inside %s", ps,
+                        p.resolve(), inside.relative_to(system.archive_root).as_posix(), system.path)
+        elif inside is not None:
+            p = inside
     if not p.is_file():
         where = f" (also looked inside {system.path})" if system.archive_root is not None else ""
         raise SSPError(f"parameter set {ps!r}: file not found{where}")

@@ -5,15 +5,24 @@ import numbers
 from ..errors import SSPError
 from ..ssp.reader import ANNOTATION_TYPE
 from .connections import KIND, NUMERIC
+from .graph import toposort
 from .names import near, split_name
 from .parameters import collect_parameters
 from .plan import ALGORITHMS, RunPlan, ScheduleMode, SchedulePlan
 
 
+# The most communication steps a fixed-step run may take: a day of wall time at the master's
+# typical 50 us per step (a step size typed a few orders of magnitude too small is refused with
+# its step count instead of running for years).
+MAX_STEPS = 2_000_000_000
+
+
 def _order(system, order, algo):
     names = [c.name for c in system.comps]
+    where = "component order"
     if order is None:
         order = system.desc.master.order
+        where = f"{system.desc.master.order_origin}: nc:Order"
     if order is not None:
         if isinstance(order, str):
             order = order.replace(",", " ").split()
@@ -29,8 +38,15 @@ def _order(system, order, algo):
                 parts.append("listed more than once: " + ", ".join(dup))
             if missing:
                 parts.append("missing: " + ", ".join(missing))
-            raise SSPError(f"component order {order}: must name every component exactly once ("
+            raise SSPError(f"{where} {order}: must name every component exactly once ("
                            + "; ".join(parts) + ")")
+        if algo == "gauss-seidel":
+            _, cycle = toposort(len(names), system.graph.edges)
+            if cycle:  # no order of a feedthrough cycle gives every input this step's value
+                loop = " -> ".join(names[i] for i in cycle)
+                raise SSPError(f"{where} {order}: the components form an algebraic loop (direct feedthrough "
+                               f"cycle) {loop}, which no Gauss-Seidel order resolves (use algorithm jacobi, or "
+                               "break the loop)")
         return [system.by_name[o].index for o in order]
     if algo == "gauss-seidel":
         return system.graph.order()
@@ -116,6 +132,10 @@ def make_plan(system, stop_time=None, step_size=None, start_time=None, parameter
     sched = None
     if schedule and m.schedule:
         sched = _schedule(system, algo, mult)
+    if sched is None and n_steps > MAX_STEPS:
+        raise SSPError(f"{stop - start:g} s in steps of {h:g} s are {n_steps:,} communication steps, more than the "
+                       f"{MAX_STEPS:,} a run may take (about {n_steps * 50e-6 / 86400:,.0f} days at 50 us per "
+                       "step): use a larger step size or a shorter run")
     return RunPlan(start=start, stop=stop, step_size=h, n_steps=n_steps, algorithm=algo, order=tuple(order_idx),
                    multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
                    record_every=int(record_every), profile=bool(profile), schedule=sched)

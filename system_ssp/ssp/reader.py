@@ -107,6 +107,7 @@ class MasterSettings:
     step_size: float = None
     algorithm: str = None
     order: list = None
+    order_origin: str = ""  # file:line of nc:Order
     step_multiples: dict = field(default_factory=dict)
     stop_conditions: list = field(default_factory=list)
     schedule: "Schedule" = None
@@ -227,11 +228,23 @@ def parse_units(parent, namer):
         b = u.find("ssc:BaseUnit", NS)
         exps, factor, offset = (0,) * 8, 1.0, 0.0
         if b is not None:
-            exps = tuple(int(b.get(n, "0")) for n in SI_BASE_UNITS)
+            try:
+                exps = tuple(int(b.get(n, "0")) for n in SI_BASE_UNITS)
+            except ValueError:
+                raise SSPError(f"{origin}: ssc:BaseUnit exponents must be integers") from None
             factor = _float_attr(b, "factor", origin, 1.0)
             offset = _float_attr(b, "offset", origin, 0.0)
-        units[u.get("name")] = Unit(u.get("name"), exps, factor, offset)
+        name = _required(u, "name", origin)
+        units[name] = Unit(name, exps, factor, offset)
     return units
+
+
+def _required(el, attr, origin):
+    """The value of a required attribute (the schema says so; without validation we check)."""
+    value = el.get(attr)
+    if value is None or not value.strip():
+        raise SSPError(f"{origin}: <{etree.QName(el).localname}> needs a non-empty {attr} attribute")
+    return value
 
 
 def _type_child(el):
@@ -277,16 +290,21 @@ def parse_ssv(root, namer):
     display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
     units = parse_units(root.find("ssv:Units", NS), namer)
     values = []
+    seen = {}  # name -> line: a name twice in one set is refused (which one was meant?)
     params = root.find("ssv:Parameters", NS)
     for p in ([] if params is None else params.findall("ssv:Parameter", NS)):
         origin = f"{display}:{p.sourceline}"
+        name = _required(p, "name", origin)
+        if name in seen:
+            raise SSPError(f"{origin}: parameter {name!r} is already set on line {seen[name]} of this parameter set")
+        seen[name] = p.sourceline
         tv = None
         for child in p:
             if isinstance(child.tag, str) and etree.QName(child).namespace == NS_SSV and _local(child) in TYPE_TAGS:
                 tv = child
                 break
         if tv is None:
-            raise SSPError(f"{origin}: parameter {p.get('name')!r} has no value")
+            raise SSPError(f"{origin}: parameter {name!r} has no value")
         kind = _local(tv)
         raw = tv.get("value")
         try:
@@ -314,7 +332,7 @@ def parse_ssm(root, namer):
     mapping = {}
     for e in root.findall("ssm:MappingEntry", NS):
         origin = f"{display}:{e.sourceline}"
-        mapping[e.get("source")] = (e.get("target"), _parse_transform(e, origin),
+        mapping[_required(e, "source", origin)] = (_required(e, "target", origin), _parse_transform(e, origin),
                                     e.get("suppressUnitConversion", "false") == "true", origin)
     return mapping
 
@@ -386,11 +404,13 @@ def _parse_connectors(el, namer):
         return out
     for c in conns.findall("ssd:Connector", NS):
         t = _type_child(c)
-        out[c.get("name")] = Connector(
-            name=c.get("name"), kind=c.get("kind"),
+        corigin = f"{namer(c.getroottree().docinfo.URL)}:{c.sourceline}"
+        name = _required(c, "name", corigin)
+        out[name] = Connector(
+            name=name, kind=_required(c, "kind", corigin),
             type=_local(t) if t is not None else None,
             unit=t.get("unit") if (t is not None and _local(t) == "Real") else None,
-            origin=f"{namer(c.getroottree().docinfo.URL)}:{c.sourceline}")
+            origin=corigin)
     return out
 
 
@@ -428,6 +448,7 @@ def parse_master_annotation(el, namer, settings):
             corigin = f"{namer(child.getroottree().docinfo.URL)}:{child.sourceline}"
             if child.tag == _q("nc", "Order"):
                 settings.order = (child.text or "").split()
+                settings.order_origin = corigin
             elif child.tag == _q("nc", "StepMultiple"):
                 comp, mult = child.get("component"), child.get("multiple")
                 try:
@@ -558,13 +579,13 @@ def parse_ssd(ssd_path, namer, validate=True):
             raise SSPError(f"{origin}: signal dictionary references are not supported")
         if tag != "Component":
             continue
-        name = el.get("name")
+        name = _required(el, "name", origin)
         ctype = el.get("type", "application/x-fmu-sharedlibrary")
         if ctype != "application/x-fmu-sharedlibrary":
             raise SSPError(f"{origin}: component {name!r} has type {ctype!r}; only FMUs are supported")
         if desc.component(name) is not None:
             raise SSPError(f"{origin}: duplicate component name {name!r}")
-        source = el.get("source")
+        source = _required(el, "source", origin)
         fmu_path = resolve_uri(source, base_dir)
         comp = Component(name=name, source=source, fmu_path=fmu_path, type=ctype,
                          connectors=_parse_connectors(el, namer), origin=origin)
@@ -577,8 +598,8 @@ def parse_ssd(ssd_path, namer, validate=True):
     for c in ([] if conns is None else conns.findall("ssd:Connection", NS)):
         origin = f"{display}:{c.sourceline}"
         desc.connections.append(Connection(
-            start_element=c.get("startElement") or None, start_connector=c.get("startConnector"),
-            end_element=c.get("endElement") or None, end_connector=c.get("endConnector"),
+            start_element=c.get("startElement") or None, start_connector=_required(c, "startConnector", origin),
+            end_element=c.get("endElement") or None, end_connector=_required(c, "endConnector", origin),
             transform=_parse_transform(c, origin),
             suppress_unit_conversion=c.get("suppressUnitConversion", "false") in ("true", "1"),
             origin=origin))
