@@ -5,13 +5,21 @@
         r = system.run(parameter_sets=["parameters/slew_case2.ssv"], outputs=["dynamics.q_BN[4]"])
 
 `SSPError` names the file and line, component, variable or connection of a bad input;
-`SimulationError` (a subclass) an FMU that failed, with the messages it logged. The algorithms,
+`SimulationError` (a subclass) an FMU that failed, with the messages it logged; `RunInterrupted`
+(a subclass) a run stopped by Ctrl-C or SIGTERM. Both carry the rows recorded so far (`err.result`). The algorithms,
 the parameter order, the `org.neighbor-cosim.master` annotation and `nc:Schedule` are described
 in docs/master.md.
 """
-from .errors import SimulationError, SSPError
-from .master import Result, System, simulate, write_csv_atomic
+import logging
+
+from .errors import RunInterrupted, SimulationError, SSPError
+from .master import Result, System, simulate, write_csv_atomic, write_result
 
 __version__ = "0.2.0"
 
-__all__ = ["simulate", "System", "Result", "SSPError", "SimulationError", "write_csv_atomic", "__version__"]
+# A library prints nothing by itself: the master's and the FMUs' messages go to the "system_ssp"
+# loggers for the application to show (the command line does, see --log-level).
+logging.getLogger("system_ssp").addHandler(logging.NullHandler())
+
+__all__ = ["simulate", "System", "Result", "SSPError", "SimulationError", "RunInterrupted", "write_csv_atomic",
+           "write_result", "__version__"]

@@ -1,11 +1,20 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `thesis`, `deorbit-study` and `mission`, and `--version`."""
+`info`, `thesis`, `deorbit-study` and `mission`, and `--version`.
+
+Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
+re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
+file and line, component or variable); 3 an unexpected error; 130 interrupted by Ctrl-C (SIGINT),
+143 by SIGTERM. A run that fails or is interrupted writes what it had recorded to
+<output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
+"""
 import argparse
+import signal
 import sys
+import traceback
 
 from . import __version__
-from .apps import deorbit_study, mission, thesis
-from .errors import SSPError
+from .apps import add_console_arguments, console_settings, deorbit_study, mission, thesis
+from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 
 APPS = {"thesis": thesis, "deorbit-study": deorbit_study, "mission": mission}
@@ -30,16 +39,16 @@ def _parser():
     r.add_argument("--step-multiple", action="append", default=[], metavar="COMP=K")
     r.add_argument("--stop-when", action="append", default=None, metavar="COMP.VAR",
                    help="Boolean output that stops the run when true (repeatable)")
-    r.add_argument("--output", help="CSV results file")
+    r.add_argument("--output", help="results file: .csv (units in <name>.units.json) or .parquet")
     r.add_argument("--outputs", help="signals to record, comma-separated component.variable")
     r.add_argument("--record-every", type=int, default=1)
-    r.add_argument("--no-progress", action="store_true")
     r.add_argument("--print-final", action="store_true", help="print all final values")
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
     r.add_argument("--profile", action="store_true",
                    help="with an nc:Schedule: print wall time per component and for the master itself")
+    add_console_arguments(r)
     i = sub.add_parser("info", help="describe a system")
     i.add_argument("path")
     i.add_argument("--no-validate", action="store_true")
@@ -73,35 +82,69 @@ def _parse_multiples(items):
     return out
 
 
+class Terminated(BaseException):
+    """SIGTERM outside a run (a run stops at its next communication point instead): unwinds like
+    Ctrl-C, so temporary folders and half-written files are cleaned up."""
+
+
+def _terminate(signum, frame):
+    raise Terminated()
+
+
 def main(argv=None):
+    """The command line; returns the exit code (see the module docstring)."""
     argv = sys.argv[1:] if argv is None else list(argv)
-    if argv[:1] and argv[0] in APPS:
-        try:
-            return APPS[argv[0]].main(argv[1:])
-        except SSPError as exc:
-            print(f"error: {exc}", file=sys.stderr)
-            return 2
-    args = _parser().parse_args(argv)
+    debug = "--log-level=debug" in argv or any(a == "--log-level" and argv[k + 1:k + 2] == ["debug"]
+                                                 for k, a in enumerate(argv))
+    previous = signal.signal(signal.SIGTERM, _terminate)
     try:
-        with System(args.path, validate=not args.no_validate) as system:
-            if args.command == "info":
-                print(system.info())
-                return 0
-            result = system.run(
-                stop_time=args.stop_time, step_size=args.step_size, start_time=args.start_time,
-                parameters=_parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
-                algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
-                stop_when=args.stop_when, output_file=args.output, progress=not args.no_progress,
-                record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile)
+        if argv[:1] and argv[0] in APPS:
+            return APPS[argv[0]].main(argv[1:])
+        return _run_or_info(argv)
+    except RunInterrupted as exc:
+        print(exc, file=sys.stderr)
+        _say_partial(exc)
+        return 128 + exc.signal
     except SSPError as exc:
         print(f"error: {exc}", file=sys.stderr)
+        if isinstance(exc, SimulationError):
+            _say_partial(exc)
         return 2
     except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+        print("interrupted (SIGINT)", file=sys.stderr)
         return 130
-    except Exception as exc:  # unexpected: still no traceback for users
-        print(f"error: unexpected {type(exc).__name__}: {exc}", file=sys.stderr)
+    except Terminated:
+        print("interrupted (SIGTERM)", file=sys.stderr)
+        return 143
+    except Exception as exc:  # unexpected: one line, the traceback only with --log-level debug
+        if debug:
+            traceback.print_exc()
+        print(f"error: unexpected {type(exc).__name__}: {exc} (--log-level debug shows where)", file=sys.stderr)
         return 3
+    finally:
+        signal.signal(signal.SIGTERM, previous)
+
+
+def _say_partial(exc):
+    r = exc.result
+    if exc.partial_file is not None:
+        rows = f"{len(r.data)} rows to t = {r.stop_time:g} s " if r is not None else ""
+        print(f"partial results ({rows}recorded before it stopped): {exc.partial_file}", file=sys.stderr)
+
+
+def _run_or_info(argv):
+    args = _parser().parse_args(argv)
+    with System(args.path, validate=not args.no_validate) as system:
+        if args.command == "info":
+            print(system.info())
+            return 0
+        progress = console_settings(args)
+        result = system.run(
+            stop_time=args.stop_time, step_size=args.step_size, start_time=args.start_time,
+            parameters=_parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
+            algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
+            stop_when=args.stop_when, output_file=args.output, progress=progress,
+            record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile)
     print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
     h = f"h = {result.step_size:g} s" if result.step_size is not None else "steps per nc:Schedule mode"
     print(f"steps:       {result.steps} ({h}, {result.algorithm}, order {' '.join(result.order)})")

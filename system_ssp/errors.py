@@ -8,9 +8,30 @@ class SSPError(Exception):
     """
 
 
-class SimulationError(SSPError):
+class _Stopped(SSPError):
+    """A run that ended before its stop time; what it had computed travels with it.
+
+    result:       a Result with the rows recorded so far (`result.partial` is True), or None when
+                  the run stopped before its first row (instantiation, initialization).
+    partial_file: where those rows were written (System.run with an output file), or None.
+    """
+    result = None
+    partial_file = None
+
+
+class SimulationError(_Stopped):
     """An FMU failed while the system was being instantiated, initialized or stepped.
 
     The message names the component, the FMI call, the simulation time and includes the
     messages the FMU logged (for pythonfmu FMUs, the Python exception text).
     """
+
+
+class RunInterrupted(_Stopped):
+    """The run was stopped by SIGINT (Ctrl-C) or SIGTERM at a communication point.
+
+    signal: the signal number (exit code 128 + signal in the command line)."""
+
+    def __init__(self, message, signal):
+        super().__init__(message)
+        self.signal = signal

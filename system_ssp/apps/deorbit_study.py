@@ -26,11 +26,11 @@ from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
 
-from ..atomic import atomic_write, write_text_atomic
-from ..errors import SSPError
-from ..master import System, write_csv_atomic
+from ..atomic import StagedFolder, atomic_write, write_text_atomic
+from ..errors import RunInterrupted, SimulationError, SSPError
+from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 KM = 1000.0
 SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
@@ -63,17 +63,43 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
     overrides = {"orbit.density_model": density, "atmosphere.density_model": density,
                  "orbit.space_weather_file": space_weather_file, "atmosphere.space_weather_file": space_weather_file}
-    out = Path(out) if out is not None else None
-    if out is not None:
-        out.mkdir(parents=True, exist_ok=True)
+    staged = StagedFolder(out) if out is not None else None  # refused now, not after the runs
+    try:
+        summary = _run_all(ssp, scenarios, model, density, overrides, max_years, progress,
+                           staged.path if staged else None)
+    except (SimulationError, RunInterrupted) as err:
+        if staged is not None:
+            if err.result is not None:
+                write_result(err.result.data, staged.path / f"{err.run}.partial.csv", err.result.units)
+            err.partial_file = staged.commit_partial(str(err))
+        raise
+    except BaseException:
+        if staged is not None:
+            staged.discard()
+        raise
+    if staged is not None:
+        write_text_atomic(staged.path / "summary.json", json.dumps(summary, indent=1))
+        write_text_atomic(staged.path / "table.md", table(summary))
+        plot(summary, staged.path)
+        staged.commit()
+    return summary
+
+
+def _run_all(ssp, scenarios, model, density, overrides, max_years, progress, out):
+    """The runs of the study, each run's CSV written into `out` (if given) as it finishes; a
+    failed or interrupted run's error says which run it was (err.run)."""
     summary = {}
     with System(ssp) as system:
         for name in scenarios:
             for burn in (True, False):
                 run = name + ("" if burn else "_no_burn")
                 ssv = PARAMETERS_DIR / f"deorbit_{run}.ssv"
-                r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
-                               outputs=RECORD, progress=progress)
+                try:
+                    r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
+                                   outputs=RECORD, progress=progress)
+                except (SimulationError, RunInterrupted) as err:
+                    err.run = run
+                    raise
                 reentered = bool(r.final["orbit.reentered"])
                 ref = THESIS[name]
                 s = {"scenario": name, "burn": burn, "model": model, "density_model": density,
@@ -93,11 +119,7 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
                     s["perigee_after_burn_km"] = float(r.data["orbit.perigee_altitude"][i_end]) / KM
                 summary[run] = s
                 if out is not None:
-                    write_csv_atomic(r.data, out / f"{run}.csv")
-    if out is not None:
-        write_text_atomic(out / "summary.json", json.dumps(summary, indent=1))
-        write_text_atomic(out / "table.md", table(summary))
-        plot(summary, out)
+                    write_result(r.data, out / f"{run}.csv", r.units)
     return summary
 
 
@@ -169,10 +191,11 @@ def main(argv=None):
     ap.add_argument("--max-years", type=float, default=150.0)
     ap.add_argument("--out", default="results/deorbit_study")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
-    ap.add_argument("--progress", action="store_true")
+    add_console_arguments(ap)
     args = ap.parse_args(argv)
+    progress = console_settings(args)
     summary = run_study(args.model, args.density, [s for s in args.scenarios.split(",") if s], args.ssp_dir,
-                        args.out, args.max_years, args.space_weather, args.progress)
+                        args.out, args.max_years, args.space_weather, progress)
     print(table(summary), end="")
     total = sum(s["wall_time_s"] for s in summary.values())
     print(f"wall time: {total:.1f} s for {len(summary)} runs; results in {args.out}")

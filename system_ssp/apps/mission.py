@@ -6,11 +6,14 @@ figures and a summary beside the published numbers.
 Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
 minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
 set (system_ssp/systems/parameters/neighbor_mission_<scenario>.ssv), and writes into --out:
-- timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode);
+- timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode), their units
+                   in timeseries.units.json;
 - summary.json     every computed figure beside the thesis' (also printed as a table);
 - altitude.png (Fig. 11), detumble.png (Fig. 20-22), slew.png (Fig. 27-29), tracking.png
   (Fig. 43-44), battery.png (Fig. 46), data.png (Fig. 47).
-`--profile` adds the wall time per component and of the master to the summary.
+`--profile` adds the wall time per component and of the master to the summary. The folder is
+written as one unit (replacing an earlier one only when complete); a failed or interrupted run
+leaves <out>.partial with the rows so far and PARTIAL.txt saying why.
 """
 import argparse
 import json
@@ -22,11 +25,11 @@ import numpy as np
 from components.core.constants import DAY, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
 
-from ..atomic import atomic_write, write_text_atomic
-from ..errors import SSPError
-from ..master import System, write_csv_atomic
+from ..atomic import StagedFolder, atomic_write, write_text_atomic
+from ..errors import RunInterrupted, SimulationError, SSPError
+from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
@@ -56,17 +59,35 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
     ssp = Path(ssp_dir) / f"{SYSTEMS[orbit]}.ssp"
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
+    if not (max_years > 0 and np.isfinite(max_years)):
+        raise SSPError(f"--max-years {max_years:g}: must be a positive number of years (the longest the mission "
+                       "may run before re-entry)")
     ssv = PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"
-    with System(ssp) as system:
-        r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
-                       outputs=RECORD, profile=profile, progress=progress)
+    staged = StagedFolder(out) if out is not None else None  # refused now, not after the run
+    try:
+        with System(ssp) as system:
+            r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
+                           outputs=RECORD, profile=profile, progress=progress)
+    except (SimulationError, RunInterrupted) as err:
+        if staged is not None:
+            if err.result is not None:
+                write_result(err.result.data, staged.path / "timeseries.csv", err.result.units)
+            err.partial_file = staged.commit_partial(str(err))
+        raise
+    except BaseException:
+        if staged is not None:
+            staged.discard()
+        raise
     s = summarize(r, scenario, orbit)
-    if out is not None:
-        out = Path(out)
-        out.mkdir(parents=True, exist_ok=True)
-        write_csv_atomic(r.data, out / "timeseries.csv")
-        write_text_atomic(out / "summary.json", json.dumps(s, indent=1))
-        plot(r.data, s, out)
+    if staged is not None:
+        try:
+            write_result(r.data, staged.path / "timeseries.csv", r.units)
+            write_text_atomic(staged.path / "summary.json", json.dumps(s, indent=1))
+            plot(r.data, s, staged.path)
+        except BaseException:
+            staged.discard()
+            raise
+        staged.commit()
     return s, r
 
 
@@ -253,10 +274,11 @@ def main(argv=None):
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)
     ap.add_argument("--profile", action="store_true")
-    ap.add_argument("--progress", action="store_true")
+    add_console_arguments(ap)
     args = ap.parse_args(argv)
+    progress = console_settings(args)
     s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years, profile=args.profile,
-                       progress=args.progress)
+                       progress=progress)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:
@@ -265,7 +287,10 @@ def main(argv=None):
             print(f"  {name:<12} {sec:8.2f} s")
         print(f"  {'(master)':<12} {prof['master']:8.2f} s")
     print(f"results in {args.out}")
-    return 0 if "error" not in s else 1
+    if "error" in s:
+        print(f"mission incomplete: {s['error']} within --max-years {args.max_years:g}", file=sys.stderr)
+        return 1
+    return 0
 
 
 if __name__ == "__main__":

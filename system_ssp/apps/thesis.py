@@ -24,7 +24,7 @@ from pathlib import Path
 from components.core import rotations
 
 from ..master import System
-from . import DEFAULT_SSP_DIR
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
@@ -159,7 +159,9 @@ def main(argv=None):
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--slew-stop-time", type=float, default=None,
                     help="limit of each slew run in s (default: the SSD's 1500 s, Appendix G)")
+    add_console_arguments(ap, progress=False)
     args = ap.parse_args(argv)
+    console_settings(args)
     results = run_cases(args.ssp_dir, args.integrator, args.slew_stop_time)
     print(report(results, args.integrator))
     return 0 if all(r.converged for r in results.values()) else 1

@@ -8,7 +8,7 @@
 - `observers`: recording, stop conditions, progress and profiling, called once per macro step;
 - `execution`: one run from instantiation to the `Result` (`result`).
 """
-from .result import Result, write_csv_atomic
+from .result import Result, write_csv_atomic, write_result
 from .system import System, simulate
 
-__all__ = ["System", "simulate", "Result", "write_csv_atomic"]
+__all__ = ["System", "simulate", "Result", "write_csv_atomic", "write_result"]

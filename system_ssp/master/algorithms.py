@@ -107,7 +107,7 @@ class _Mode:
 
 class _Signal:
     """One scalar output read straight through the FMI functions (schedule conditions, events)."""
-    __slots__ = ("fn", "c", "vr", "buf", "ci", "name")
+    __slots__ = ("fn", "c", "vr", "buf", "ci", "name", "var", "call")
 
     def __init__(self, table, ci, var, kind):
         comps = table.system.comps
@@ -117,11 +117,12 @@ class _Signal:
         self.c = table.instances[ci].fmu.component
         self.ci = ci
         self.name = f"{comps[ci].name}.{var}"
+        self.var, self.call = var, GET[kind]
 
     def read(self):
         s = self.fn(self.c, self.vr, 1, self.buf)
         if s > 1:
-            raise StepFailed(self.ci, self.name, s)
+            raise StepFailed(self.ci, self.call, s, (self.var,))
         return self.buf[0]
 
 

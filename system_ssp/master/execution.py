@@ -1,7 +1,12 @@
 """One run of a loaded system: instances, initialization, the algorithm's loop under its
-observers, the result; the instances are freed whatever happens."""
+observers, the result; the instances are freed whatever happens. A run that fails or is
+interrupted raises with the rows recorded so far (`err.result`)."""
+import signal
+
+from ..errors import RunInterrupted, SimulationError
 from .algorithms import FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
+from .interrupts import Interrupted, Interruption, SignalWatch
 from .observers import Observer, ProgressBar, Profiler, Recorder, StepInfo, StopConditions
 from .result import Result
 
@@ -10,10 +15,40 @@ def execute(system, plan, progress=False):
     """Run `plan` on `system` with fresh FMU instances; returns a Result (wall_time 0: the
     caller measures it)."""
     table = InstanceTable(system, plan)
-    try:
-        table.instantiate()
-        table.prepare()
-        table.initialize()
+    run = _Run(system, plan, table)
+    with SignalWatch() as watch:
+        try:
+            table.instantiate()
+            table.prepare()
+            table.initialize()
+            return run.loop(progress, watch)
+        except StepFailed as f:
+            err = table.error(f.ci, f.call, status=f.status, names=f.names)
+            err.result = run.partial(f"failed at t={table.t:g} s")
+            raise err from None
+        except SimulationError as err:
+            err.result = run.partial(f"failed at t={table.t:g} s")
+            raise
+        except Interrupted as stop:
+            name = signal.Signals(stop.signum).name
+            run.record_last()
+            err = RunInterrupted(f"interrupted ({name}) at t = {run.info.t:g} s", stop.signum)
+            err.result = run.partial(f"interrupted ({name}) at t={run.info.t:g} s")
+            raise err from None
+        finally:
+            table.free()
+
+
+class _Run:
+    """The observers and step info of one run, kept so that a failure can report what the run
+    had recorded."""
+
+    def __init__(self, system, plan, table):
+        self.system, self.plan, self.table = system, plan, table
+        self.recorder = self.info = None
+
+    def loop(self, progress, watch):
+        system, plan, table = self.system, self.plan, self.table
         algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
@@ -27,7 +62,9 @@ def execute(system, plan, progress=False):
         if plan.profile and plan.schedule is not None:
             profiler = Profiler(algorithm, [c.name for c in system.comps])
             observers.append(profiler)
+        observers.append(Interruption(watch))  # last: the row of this step is recorded first
         info = StepInfo(plan.start, plan.record_every)
+        self.recorder, self.info = recorder, info
         algorithm.start(info)
         try:
             for obs in observers:
@@ -44,8 +81,30 @@ def execute(system, plan, progress=False):
                       final=table.final(), wall_time=0.0, start_time=plan.start,
                       step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
                       order=[system.comps[i].name for i in plan.order], messages=table.messages(),
-                      modes=algorithm.statistics(), profile=profiler.report() if profiler else None)
-    except StepFailed as f:
-        raise table.error(f.ci, f.call, status=f.status) from None
-    finally:
-        table.free()
+                      modes=algorithm.statistics(), profile=profiler.report() if profiler else None,
+                      units=self.units())
+
+    def record_last(self):
+        """Record the communication point reached (the FMUs are healthy: an interruption)."""
+        r, info = self.recorder, self.info
+        if r is not None and r.count and r.times[r.count - 1] != info.t:
+            r.record(info.t)
+
+    def partial(self, reason):
+        """A Result with the rows recorded so far, or None before the first row."""
+        r, info, plan = self.recorder, self.info, self.plan
+        if r is None or r.count == 0:
+            return None
+        data = r.data()
+        return Result(data=data, stop_time=float(data["time"][-1]), stop_reason=reason, steps=info.steps, final={},
+                      wall_time=0.0, start_time=plan.start,
+                      step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
+                      order=[self.system.comps[i].name for i in plan.order], messages=self.table.messages(),
+                      units=self.units(), partial=True)
+
+    def units(self):
+        comps = self.system.comps
+        units = {"time": "s"}
+        for ci, var in self.plan.record:
+            units[f"{comps[ci].name}.{var}"] = self.system.var_unit(comps[ci], var)
+        return units

@@ -9,6 +9,7 @@ functions with value-reference arrays and value buffers built once per run.
 """
 import ctypes
 import itertools
+import logging
 import os
 import weakref
 
@@ -27,14 +28,18 @@ NPTYPE = {"Real": np.float64, "Integer": np.int32, "Boolean": np.int32}
 GET = {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean"}
 SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean"}
 STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
+# FMU messages also go to Python logging ("system_ssp.fmu"), at these levels per FMI status; with
+# INFO enabled there, the FMUs are instantiated with logging on.
+FMU_LOG = logging.getLogger("system_ssp.fmu")
+LOG_LEVEL = [logging.INFO, logging.WARNING, logging.WARNING, logging.ERROR, logging.CRITICAL, logging.INFO]
 
 
 class StepFailed(Exception):
     """An FMI call returned error or fatal (turned into a SimulationError with the FMU's messages)."""
 
-    def __init__(self, ci, call, status):
+    def __init__(self, ci, call, status, names=()):
         super().__init__(ci, call, status)
-        self.ci, self.call, self.status = ci, call, status
+        self.ci, self.call, self.status, self.names = ci, call, status, names
 
 
 class _Messages:
@@ -67,6 +72,8 @@ class _Messages:
             inst.messages.append((label, cat, text))
             if len(inst.messages) > 200:
                 del inst.messages[:100]
+            FMU_LOG.log(LOG_LEVEL[status] if 0 <= status < len(LOG_LEVEL) else logging.WARNING, "%s: %s",
+                        inst.name, text.strip())
         except Exception:  # never let a logging problem propagate into C
             pass
 
@@ -149,15 +156,16 @@ class FmuInstance:
 class GetOp:
     """fmi2Get* of a block of one component's connected outputs of one type, into the shared
     buffer. `run()` makes the call (a closure over these fields: the hot loop's fast path)."""
-    __slots__ = ("fn", "c", "vr", "n", "buf", "ci", "call", "run")
+    __slots__ = ("fn", "c", "vr", "n", "buf", "ci", "call", "names", "run")
 
-    def __init__(self, fn, c, vr, n, buf, ci, call):
+    def __init__(self, fn, c, vr, n, buf, ci, call, names):
         self.fn, self.c, self.vr, self.n, self.buf, self.ci, self.call = fn, c, vr, n, buf, ci, call
+        self.names = names
 
         def run():
             s = fn(c, vr, n, buf)
             if s > 1:
-                raise StepFailed(ci, call, s)
+                raise StepFailed(ci, call, s, names)
 
         self.run = run
 
@@ -167,12 +175,13 @@ class SetOp:
     `G` at `idx`, mapped (affine `factor`/`offset`, or `post` for Integer/Boolean mappings); not
     sent again when the bytes equal the ones last sent (FMU inputs keep their values, and a call
     into a pythonfmu FMU costs about 10 us, which a byte comparison saves). `run()` does it."""
-    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "G", "idx", "factor", "offset", "post", "ci", "call", "run")
+    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "G", "idx", "factor", "offset", "post", "ci", "call", "names",
+                 "run")
 
-    def __init__(self, fn, c, vr, n, buf, view, G, idx, factor, offset, post, ci, call):
+    def __init__(self, fn, c, vr, n, buf, view, G, idx, factor, offset, post, ci, call, names):
         self.fn, self.c, self.vr, self.n, self.buf, self.view = fn, c, vr, n, buf, view
         self.G, self.idx, self.factor, self.offset, self.post = G, idx, factor, offset, post
-        self.ci, self.call = ci, call
+        self.ci, self.call, self.names = ci, call, names
         take, multiply, add = np.take, np.multiply, np.add
         last = [None]  # the bytes last sent
 
@@ -188,7 +197,7 @@ class SetOp:
                 return
             s = fn(c, vr, n, buf)
             if s > 1:
-                raise StepFailed(ci, call, s)
+                raise StepFailed(ci, call, s, names)
             last[0] = sent
 
         self.run = run
@@ -214,7 +223,7 @@ def _nothing():
 
 class ReadOp:
     """fmi2Get* of a block of variables of one component and type (recording, stop conditions)."""
-    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "ci", "call", "names")
+    __slots__ = ("fn", "c", "vr", "n", "buf", "view", "ci", "call", "names", "vars")
 
     def __init__(self, instance, ci, kind, variables, vrefs, names):
         m = len(vrefs)
@@ -226,13 +235,14 @@ class ReadOp:
         self.view = np.ctypeslib.as_array(self.buf)
         self.ci = ci
         self.call = GET[kind]
-        self.names = names
+        self.names = names  # "component.variable", the result's columns
+        self.vars = tuple(variables)
 
     def read(self):
         """Read the block into self.view; StepFailed on error."""
         s = self.fn(self.c, self.vr, self.n, self.buf)
         if s > 1:
-            raise StepFailed(self.ci, self.call, s)
+            raise StepFailed(self.ci, self.call, s, self.vars)
         return self.view
 
 
@@ -259,18 +269,21 @@ class InstanceTable:
     def __init__(self, system, plan):
         self.system = system
         self.plan = plan
-        self.debug = False
+        self.debug = FMU_LOG.isEnabledFor(logging.INFO)  # FMUs instantiated with logging on
         self.instances = []
         self.t = plan.start  # the time error messages name
 
     # ---- errors -------------------------------------------------------------------------
-    def error(self, ci, call, exc=None, status=None):
-        """A SimulationError for a failed call of component ci, with the messages it logged."""
+    def error(self, ci, call, exc=None, status=None, names=()):
+        """A SimulationError for a failed call of component ci (of its variables `names`, for a
+        get or set), with the messages it logged."""
         inst = self.instances[ci]
         if inst.failed_status is None:
             inst.failed_status = status if status is not None and status > 2 else 3
         texts = []
-        for _, _, m in inst.take_messages():
+        for label, _, m in inst.take_messages():
+            if label == "ok":
+                continue
             if "PyObject_CallMethod\n" in m:  # pythonfmu: keep the Python exception text
                 m = m.split("PyObject_CallMethod\n", 1)[1]
             if m and m not in texts:
@@ -283,16 +296,19 @@ class InstanceTable:
         else:
             what = "failed"
         detail = f": {text}" if text else ""
+        if names:
+            shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
+            call = f"{call} of {shown}"
         return SimulationError(f"component {inst.name!r}: {call} {what} at t={self.t:g} s{detail}")
 
-    def call(self, ci, call, fn, *args):
+    def call(self, ci, call, fn, *args, names=()):
         """Call an fmpy method; wrap failures with the component's logged messages."""
         try:
             return fn(*args)
         except SSPError:
             raise
         except Exception as exc:
-            raise self.error(ci, call, exc) from None
+            raise self.error(ci, call, exc, names=names) from None
 
     # ---- life cycle ---------------------------------------------------------------------
     def instantiate(self):
@@ -307,7 +323,7 @@ class InstanceTable:
                                       f"({self.system.namer(info.decl.fmu_path)}): {exc}") from None
             self.instances.append(inst)
             ci = len(self.instances) - 1
-            self.call(ci, "fmi2Instantiate", inst.fmu.instantiate, False, inst.callbacks, True)
+            self.call(ci, "fmi2Instantiate", inst.fmu.instantiate, False, inst.callbacks, self.debug)
             inst.instantiated = True
         for ci, inst in enumerate(self.instances):
             self.call(ci, "fmi2SetupExperiment", inst.fmu.setupExperiment, None, p.start, p.stop)
@@ -316,14 +332,15 @@ class InstanceTable:
         per = {}
         for (ci, var), value in p.params.items():
             v = self.system.comps[ci].vars[var]
-            per.setdefault((ci, v.type), ([], []))
+            per.setdefault((ci, v.type), ([], [], []))
             per[(ci, v.type)][0].append(v.valueReference)
             per[(ci, v.type)][1].append(value)
-        for (ci, vtype), (vrs, values) in sorted(per.items()):
+            per[(ci, v.type)][2].append(var)
+        for (ci, vtype), (vrs, values, names) in sorted(per.items()):
             fmu = self.instances[ci].fmu
             setter = {"Real": fmu.setReal, "Integer": fmu.setInteger, "Enumeration": fmu.setInteger,
                       "Boolean": fmu.setBoolean, "String": fmu.setString}[vtype]
-            self.call(ci, f"setting parameters/start values ({vtype})", setter, vrs, values)
+            self.call(ci, f"setting parameters/start values ({vtype})", setter, vrs, values, names=tuple(names))
 
     def free(self):
         """Free every instance and unload the libraries that may be unloaded (see FmuInstance.free)."""
@@ -362,7 +379,8 @@ class InstanceTable:
                 vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
                 buf = (CTYPE[kind] * m).from_address(G.ctypes.data + pos * G.itemsize)
                 inst = self.instances[ci]
-                self.gets[ci].append(GetOp(inst.fn[GET[kind]], inst.fmu.component, vr, m, buf, ci, GET[kind]))
+                self.gets[ci].append(GetOp(inst.fn[GET[kind]], inst.fmu.component, vr, m, buf, ci, GET[kind],
+                                           tuple(vars_)))
                 pos += m
         self.sets = [[] for _ in range(n)]
         by_dst = {}
@@ -379,7 +397,8 @@ class InstanceTable:
             inst = self.instances[ci]
             self.sets[ci].append(SetOp(inst.fn[SET[kind]], inst.fmu.component, vr, m, buf,
                                        np.ctypeslib.as_array(buf), self.G[kind], idx, fac if affine else None,
-                                       off if affine else None, _mapper(kind, lks), ci, SET[kind]))
+                                       off if affine else None, _mapper(kind, lks), ci, SET[kind],
+                                       tuple(lk.dst_var for lk in lks)))
         # the hot loop's calls, one function per component
         self.getters = [_sequence([op.run for op in ops]) for ops in self.gets]
         self.setters = [_sequence([op.run for op in ops]) for ops in self.sets]
@@ -457,7 +476,8 @@ class InstanceTable:
             for kind, vs in groups.items():
                 getter = {"Real": inst.fmu.getReal, "Integer": inst.fmu.getInteger,
                           "Boolean": inst.fmu.getBoolean}[kind]
-                vals = self.call(ci, GET[kind], getter, [v.valueReference for v in vs])
+                vals = self.call(ci, GET[kind], getter, [v.valueReference for v in vs],
+                                 names=tuple(v.name for v in vs))
                 for v, x in zip(vs, vals):
                     final[f"{inst.name}.{v.name}"] = bool(x) if kind == "Boolean" else (
                         int(x) if kind == "Integer" else float(x))

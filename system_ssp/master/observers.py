@@ -9,6 +9,8 @@ import time
 
 import numpy as np
 
+from components.core.constants import DAY, YEAR
+
 from .instances import read_ops
 
 RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_}
@@ -120,14 +122,20 @@ class Recorder(Observer):
 
 
 class ProgressBar(Observer):
-    """tqdm on stderr: communication steps of a fixed-step run (from 2000 steps on), simulated
-    seconds of a scheduled one."""
+    """tqdm on stderr in simulated time, in the unit the span reads best in (s, days or years):
+    of the stop time for runs that end there; without a total (no percentage, no ETA to a time
+    the run may never reach) when a stop condition may end the run first. The ETA is the average
+    rate since the start (smoothing 0: stable for runs whose speed changes with the mode), and
+    the bar shows only once a run has lasted a second."""
 
-    MIN_STEPS = 2000
+    UNITS = ((2 * YEAR, "yr", YEAR), (2 * DAY, "d", DAY), (0.0, "s", 1.0))
 
     def __init__(self, plan):
         self.plan = plan
         self.bar = None
+        span = plan.stop - plan.start
+        _, self.unit, self.scale = next(u for u in self.UNITS if span >= u[0])
+        self.chunk = 1 if plan.schedule is not None else max(1, plan.n_steps // 500)
 
     def start(self, info):
         try:
@@ -135,20 +143,15 @@ class ProgressBar(Observer):
         except ImportError:
             return
         p = self.plan
-        if p.schedule is not None:
-            self.bar = tqdm(total=p.stop - p.start, file=sys.stderr, unit="s", leave=False, mininterval=0.5)
-        elif p.n_steps >= self.MIN_STEPS:
-            self.chunk = max(1, p.n_steps // 200)
-            self.bar = tqdm(total=p.n_steps, file=sys.stderr, unit="step", leave=False, mininterval=0.5)
+        total = None if p.stops else (p.stop - p.start) / self.scale
+        self.bar = tqdm(total=total, file=sys.stderr, unit=self.unit, leave=False, mininterval=0.5, delay=1.0,
+                        smoothing=0.0, dynamic_ncols=True, bar_format=None if total else
+                        "{desc}{n:.3g} {unit} simulated [{elapsed}, {rate_fmt}]")
 
     def step(self, info):
         bar = self.bar
-        if bar is None:
-            return
-        if self.plan.schedule is not None:
-            bar.update(info.t - self.plan.start - bar.n)
-        elif info.steps % self.chunk == 0:
-            bar.update(info.steps - bar.n)
+        if bar is not None and info.steps % self.chunk == 0:
+            bar.update((info.t - self.plan.start) / self.scale - bar.n)
 
     def close(self):
         if self.bar is not None:

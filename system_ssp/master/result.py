@@ -1,5 +1,10 @@
-"""The outcome of a run, and writing it as CSV."""
+"""The outcome of a run, and writing it: CSV (RFC 4180, units in a sidecar JSON) or Parquet
+(units in the schema metadata)."""
+import csv
+import json
+import os
 from pathlib import Path
+import tempfile
 from typing import Optional
 
 import numpy as np
@@ -20,11 +25,15 @@ class Result:
     wall_time:   seconds spent in run() (instantiation to freeing).
     modes:       scheduled runs: {mode: {"steps", "simulated_time"}}, else None.
     profile:     profile=True on a scheduled run: {"components": {name: s}, "loop": s, "master": s}.
+    units:       {column: unit or None} ("time": "s"; the unit of the FMU's value, None when the
+                 FMU and the SSD declare none).
+    partial:     True for the rows of a run that failed or was interrupted (err.result).
     """
 
     def __init__(self, data: np.ndarray, stop_time: float, stop_reason: str, steps: int, final: dict,
                  wall_time: float, start_time: float, step_size: Optional[float], algorithm: str, order: list,
-                 messages: dict, modes: Optional[dict] = None, profile: Optional[dict] = None):
+                 messages: dict, modes: Optional[dict] = None, profile: Optional[dict] = None,
+                 units: Optional[dict] = None, partial: bool = False):
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -38,6 +47,8 @@ class Result:
         self.messages = messages
         self.modes = modes
         self.profile = profile
+        self.units = units or {}
+        self.partial = partial
 
     @property
     def names(self) -> list:
@@ -51,23 +62,94 @@ class Result:
                 f"signals={len(self.data.dtype.names) - 1}, wall_time={self.wall_time:.3f})")
 
     def write_csv(self, path) -> None:
-        write_csv_atomic(self.data, path)
+        write_csv_atomic(self.data, path, self.units)
+
+    def write(self, path) -> None:
+        """Write the rows to `path`: Parquet for .parquet, otherwise CSV (see write_result)."""
+        write_result(self.data, path, self.units)
 
 
-def write_csv_atomic(data: np.ndarray, path) -> None:
-    """Write `data` as CSV (header `time,component.variable,...`; Booleans as 0/1; Reals as their
-    shortest round-trip repr) via a temporary file in the same folder, renamed on success."""
+FORMATS = (".csv", ".parquet")
+
+
+def check_output_file(path, what="output file") -> Path:
+    """Refuse, before a run starts, an output file the run could not write: its folder missing or
+    not a folder, the path a folder, or no file creatable in the folder (tried)."""
+    path = Path(path)
+    folder = path.parent if str(path.parent) else Path(".")
+    if path.suffix.lower() not in FORMATS and path.suffix:
+        raise SSPError(f"{what} {path}: unknown format {path.suffix!r} (expected .csv or .parquet)")
+    if not folder.exists():
+        raise SSPError(f"{what} {path}: folder {folder} does not exist")
+    if not folder.is_dir():
+        raise SSPError(f"{what} {path}: {folder} is not a folder")
+    if path.is_dir():
+        raise SSPError(f"{what} {path}: is a folder")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=folder)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise SSPError(f"{what} {path}: cannot write in {folder} ({exc.strerror or exc})") from None
+    return path
+
+
+def partial_path(path) -> Path:
+    """Where the rows of a failed or interrupted run go: x.csv -> x.partial.csv."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.partial{path.suffix or '.csv'}")
+
+
+def units_path(path) -> Path:
+    """The units sidecar of a CSV file: x.csv -> x.units.json."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.units.json")
+
+
+def write_result(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+    """Write `data` to `path`: `.parquet` as Parquet, anything else as CSV (write_csv_atomic)."""
+    if Path(path).suffix.lower() == ".parquet":
+        write_parquet_atomic(data, path, units)
+    else:
+        write_csv_atomic(data, path, units)
+
+
+def write_csv_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+    """Write `data` as CSV, RFC 4180 (comma-separated, names such as `dcm_BN[1,1]` quoted, CRLF
+    line ends): header `time,component.variable,...`, Booleans as 0/1, Reals as their shortest
+    round-trip repr. With `units`, the sidecar x.units.json holds {column: unit or null}. Each
+    file goes through a temporary file in its folder, renamed on success."""
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise SSPError(f"output file {path}: folder {folder} does not exist")
+    names = data.dtype.names
+    cols = [data[n].astype(np.int64) if data.dtype[n].kind == "b" else data[n] for n in names]
     with atomic_write(path, "w", newline="") as f:
-        names = data.dtype.names
-        f.write(",".join(names) + "\n")
-        fmts = ["%d" if data.dtype[n].kind in "iub" else "%s" for n in names]  # %s: shortest repr
-        cols = [data[n].astype(np.int64) if data.dtype[n].kind == "b" else data[n] for n in names]
-        if len(data):
-            table = np.empty(len(data), dtype=[(str(i), c.dtype) for i, c in enumerate(cols)])
-            for i, c in enumerate(cols):
-                table[str(i)] = c
-            np.savetxt(f, table, fmt=fmts, delimiter=",")
+        w = csv.writer(f)  # the default dialect is RFC 4180's: minimal quoting, CRLF
+        w.writerow(names)
+        w.writerows(zip(*(c.tolist() for c in cols)))
+    if units is not None:
+        with atomic_write(units_path(path), "w", newline="") as f:
+            json.dump({n: units.get(n) for n in names}, f, indent=1)
+            f.write("\n")
+
+
+def write_parquet_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+    """Write `data` as Parquet (pyarrow): one column per field, Booleans as bool; each field's
+    unit in its metadata (b"unit") and all of them in the schema metadata
+    (b"neighbor-cosim.units", JSON {column: unit or null})."""
+    try:
+        import pyarrow as pa
+        import pyarrow.parquet as pq
+    except ImportError:
+        raise SSPError(f"output file {path}: writing Parquet needs pyarrow (pip install pyarrow)") from None
+    path = Path(path)
+    units = units or {}
+    names = data.dtype.names
+    fields = [pa.field(n, pa.from_numpy_dtype(data.dtype[n]),
+                       metadata={b"unit": units[n].encode()} if units.get(n) else None) for n in names]
+    meta = {b"neighbor-cosim.units": json.dumps({n: units.get(n) for n in names}).encode()}
+    table = pa.table([pa.array(data[n]) for n in names], schema=pa.schema(fields, metadata=meta))
+    with atomic_write(path, "wb") as f:
+        pq.write_table(table, f)

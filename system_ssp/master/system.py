@@ -1,5 +1,6 @@
 """A loaded SSP system: `System(path)` reads and checks it once; `run()` simulates it any
 number of times, each with fresh FMU instances."""
+import logging
 from pathlib import Path
 import shutil
 import tempfile
@@ -7,18 +8,19 @@ import time
 from typing import Iterable, Mapping, Optional, Sequence, Union
 import zipfile
 
-from ..errors import SSPError
+from ..errors import RunInterrupted, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
-from .connections import FeedthroughGraph, UnitTable, resolve_connections
+from .connections import FeedthroughGraph, UnitTable, check_connector_units, resolve_connections
 from .execution import execute
 from .info import describe_system
 from .names import split_name
 from .parameters import collect_parameters
 from .planning import make_plan
-from .result import Result, write_csv_atomic
+from .result import Result, check_output_file, partial_path, write_result
 
 PathLike = Union[str, Path]
+LOG = logging.getLogger("system_ssp.master")
 
 
 class System:
@@ -73,6 +75,7 @@ class System:
         self.comps = load_components(self.desc, self._tmp / "fmu", self.namer, validate)
         self.by_name = {c.name: c for c in self.comps}
         self.units = UnitTable(self.desc, self.comps)
+        check_connector_units(self.comps, self.units)
         self.links = resolve_connections(self.desc, self.comps, self.by_name, self.units)
         self.graph = FeedthroughGraph(self.comps, self.links)
 
@@ -111,10 +114,25 @@ class System:
         wall0 = time.perf_counter()
         plan = make_plan(self, stop_time, step_size, start_time, parameters, parameter_sets, outputs, algorithm,
                          order, step_multiples, stop_when, record_every, schedule, profile)
-        result = execute(self, plan, progress)
-        result.wall_time = time.perf_counter() - wall0
         if output_file is not None:
-            write_csv_atomic(result.data, output_file)
+            check_output_file(output_file)  # before the first step, not after the whole run
+        LOG.info("%s: %d components, %s, t = %g .. %g s%s", self.desc.display, len(self.comps), plan.algorithm,
+                 plan.start, plan.stop, f", {plan.n_steps} steps of {plan.step_size:g} s" if plan.schedule is None
+                 else ", nc:Schedule")
+        try:
+            result = execute(self, plan, progress)
+        except (SimulationError, RunInterrupted) as err:
+            if err.result is not None:
+                err.result.wall_time = time.perf_counter() - wall0
+                if output_file is not None:
+                    err.partial_file = partial_path(output_file)
+                    write_result(err.result.data, err.partial_file, err.result.units)
+            raise
+        result.wall_time = time.perf_counter() - wall0
+        LOG.info("%s: %s after %d steps, %.3f s wall", self.desc.display, result.stop_reason, result.steps,
+                 result.wall_time)
+        if output_file is not None:
+            write_result(result.data, output_file, result.units)
         return result
 
     # ---- cleanup ------------------------------------------------------------------------

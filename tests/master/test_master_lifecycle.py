@@ -1,12 +1,24 @@
 """The master's life cycle under stress: memory over many runs, failures, interruptions and
 output locations (issue 15)."""
+import csv
 import gc
+import json
+import os
+from pathlib import Path
+import re
+import signal
+import subprocess
+import sys
+import time
 
+import numpy as np
 import pytest
 
 from master_fixtures import helpers as h
+from paths import REPO
 import system_ssp
-from system_ssp import SimulationError
+from system_ssp import SimulationError, SSPError
+from system_ssp.atomic import StagedFolder, atomic_write
 from system_ssp.master import instances
 from test_master_core import loop_system
 
@@ -55,3 +67,157 @@ def test_memory_flat_over_150_runs(fmus, tmp_path):
     assert _alive_instances() == 0
     assert growth < 6000, f"RSS grew by {growth} kB over 150 runs"
     assert _mapped(folder) == 0
+
+
+# ---- a failed run keeps what it computed (defect 4) -------------------------------------------
+def test_failed_run_keeps_its_rows(fmus, tmp_path):
+    """An FMU raising in its step from t = 0.5 s: the error carries the rows to 0.5 s (the last
+    communication point reached) and the run's output file
+    gets them as <name>.partial.csv (before: nothing, the 0.5 s computed were lost)."""
+    ssd = loop_system(tmp_path, fmus)
+    out = tmp_path / "res.csv"
+    with pytest.raises(SimulationError, match=r"component 'integ'.*fixture failure at t=0.5 s") as err:
+        system_ssp.simulate(ssd, step_size=0.1, stop_time=1.0, outputs=["integ.x"], output_file=out,
+                            parameters={"integ.fail_at": 0.5})
+    r = err.value.result
+    assert r is not None and r.partial and "failed at t=0.5 s" in r.stop_reason
+    np.testing.assert_allclose(r.data["time"], np.arange(6) * 0.1, atol=1e-12)
+    np.testing.assert_allclose(r.data["integ.x"], 1.1 ** np.arange(6), rtol=1e-12)
+    assert err.value.partial_file == tmp_path / "res.partial.csv"
+    assert not out.exists()
+    lines = (tmp_path / "res.partial.csv").read_text().splitlines()
+    assert lines[0] == "time,integ.x" and len(lines) == 7
+    assert json.loads((tmp_path / "res.partial.units.json").read_text()) == {"time": "s", "integ.x": None}
+
+
+# ---- Ctrl-C and SIGTERM (defect 2) ------------------------------------------------------------
+def _cli_env(tmpdir):
+    return dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), TMPDIR=str(tmpdir))
+
+
+@pytest.mark.parametrize("signum, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
+def test_signal_stops_at_a_communication_point(fmus, tmp_path, signum, code, name):
+    """A signal in the middle of a run (while a model's Python code runs) stops it at the next
+    communication point: exit 128 + signal, 'interrupted at t = ...', the rows so far in
+    .partial.csv, no output file, no temporary folder or file left (before: 'component ...
+    fmi2GetReal returned status fatal', exit 2, 41 MB left in $TMPDIR)."""
+    ssd = loop_system(tmp_path / "sys", fmus)
+    tmpdir = tmp_path / "tmp"
+    tmpdir.mkdir()
+    started = tmp_path / "started"
+    out = tmp_path / "res.csv"
+    proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "run", str(ssd), "--step-size", "0.01",
+                             "--stop-time", "1000", "--output", str(out), "--quiet",
+                             "--set", "integ.step_delay=0.002", "--set", f"integ.touch_file={started}"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=_cli_env(tmpdir))
+    try:
+        deadline = time.monotonic() + 60
+        while not started.exists() and proc.poll() is None and time.monotonic() < deadline:
+            time.sleep(0.02)
+        time.sleep(0.2)
+        proc.send_signal(signum)
+        stdout, stderr = proc.communicate(timeout=60)
+    finally:
+        proc.kill()
+    assert proc.returncode == code, stderr
+    m = re.search(rf"interrupted \({name}\) at t = ([0-9.e+-]+) s", stderr)
+    assert m and "Traceback" not in stderr and "fmi2" not in stderr, stderr
+    partial = tmp_path / "res.partial.csv"
+    assert "partial results" in stderr and str(partial) in stderr
+    rows = partial.read_text().splitlines()
+    assert len(rows) > 2 and float(rows[-1].split(",")[0]) == pytest.approx(float(m.group(1)))
+    assert not out.exists()
+    assert list(tmpdir.iterdir()) == []
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["res.partial.csv", "res.partial.units.json", "started",
+                                                          "sys", "tmp"]
+
+
+# ---- output locations are checked before the run (defect 1) -----------------------------------
+def test_unwritable_output_refused_before_the_run(fmus, tmp_path):
+    """Missing folder, a folder as the file, a file as the folder, an unwritable folder: one line,
+    exit 2, before the first step (before: after the whole run, 'unexpected PermissionError')."""
+    ssd = loop_system(tmp_path / "sys", fmus)
+    (tmp_path / "afile").write_text("x")
+    (tmp_path / "adir").mkdir()
+    cases = [(tmp_path / "missing" / "r.csv", "folder .*missing does not exist"),
+             (tmp_path / "adir", "is a folder"),
+             (tmp_path / "afile" / "r.csv", "afile is not a folder"),
+             (Path("/proc/r.csv"), "cannot write in /proc"),
+             (tmp_path / "r.xlsx", "unknown format '.xlsx'")]
+    for out, pattern in cases:
+        with pytest.raises(SSPError, match=pattern):
+            # a stop time whose run would take minutes: the refusal comes first
+            system_ssp.simulate(ssd, step_size=0.01, stop_time=1e5, output_file=out,
+                                parameters={"integ.step_delay": 0.01})
+    p = subprocess.run([sys.executable, "-m", "system_ssp", "run", str(ssd), "--step-size", "0.01", "--output",
+                        str(tmp_path / "missing" / "r.csv")], capture_output=True, text=True,
+                       env=_cli_env(tmp_path), timeout=60)
+    assert p.returncode == 2 and len(p.stderr.strip().splitlines()) == 1 and "does not exist" in p.stderr
+
+
+# ---- CSV a spreadsheet reads, units, Parquet (defect 7) ---------------------------------------
+def test_csv_quoted_with_units_and_parquet(fmus, tmp_path):
+    """Names with commas are quoted (RFC 4180: every row has as many fields as the header); the
+    units go to a sidecar JSON and, for Parquet, into the schema metadata."""
+    ssd = loop_system(tmp_path / "sys", fmus, units='<ssc:Unit name="m"><ssc:BaseUnit m="1"/></ssc:Unit>',
+                      gain_conn='<ssd:Connector name="u" kind="input"><ssc:Real unit="m"/></ssd:Connector>'
+                                '<ssd:Connector name="y" kind="output"><ssc:Real/></ssd:Connector>')
+    with system_ssp.System(ssd) as system:
+        r = system.run(step_size=0.1, outputs=["integ.x", "gain.u", "thr.done"])
+    renamed = r.data.copy()
+    renamed.dtype.names = ("time", "dcm_BN[1,1]", 'say "hi"', "thr.done")
+    units = {"time": "s", "dcm_BN[1,1]": None, 'say "hi"': "m", "thr.done": None}
+    csv_file = tmp_path / "r.csv"
+    system_ssp.write_result(renamed, csv_file, units)
+    with open(csv_file, newline="") as f:
+        rows = list(csv.reader(f))
+    assert rows[0] == ["time", "dcm_BN[1,1]", 'say "hi"', "thr.done"]
+    assert all(len(row) == 4 for row in rows) and len(rows) == 12
+    assert csv_file.read_bytes().startswith(b'time,"dcm_BN[1,1]","say ""hi""",thr.done\r\n')
+    assert json.loads((tmp_path / "r.units.json").read_text()) == units
+    assert r.units["gain.u"] == "m" and r.units["time"] == "s"
+    pq = pytest.importorskip("pyarrow.parquet")
+    pq_file = tmp_path / "r.parquet"
+    with system_ssp.System(ssd) as system:
+        r = system.run(step_size=0.1, outputs=["integ.x", "gain.u", "thr.done"], output_file=pq_file)
+    table = pq.read_table(pq_file)
+    assert table.column_names == ["time", "integ.x", "gain.u", "thr.done"]
+    np.testing.assert_array_equal(table.column("integ.x").to_numpy(), r.data["integ.x"])
+    assert str(table.schema.field("thr.done").type) == "bool"
+    assert table.schema.field("gain.u").metadata == {b"unit": b"m"}
+    assert json.loads(table.schema.metadata[b"neighbor-cosim.units"])["gain.u"] == "m"
+
+
+# ---- results folders as one unit (defect 6) ---------------------------------------------------
+def test_staged_folder_replaces_as_one_unit(tmp_path):
+    """A results folder appears complete or not at all; an earlier folder stays until the new one
+    is complete; a stopped run's folder goes to <target>.partial, marked; modes follow the umask."""
+    target = tmp_path / "results"
+    target.mkdir()
+    (target / "summary.json").write_text("old")
+    (target / "old_only.png").write_text("old")
+    staged = StagedFolder(target)
+    with atomic_write(staged.path / "timeseries.csv") as f:
+        f.write("new")
+    assert (target / "summary.json").read_text() == "old"  # untouched while the new one is written
+    staged.commit()
+    assert sorted(p.name for p in target.iterdir()) == ["timeseries.csv"]
+    old_umask = os.umask(0o022)
+    try:
+        staged = StagedFolder(target)
+        with atomic_write(staged.path / "timeseries.csv") as f:
+            f.write("part")
+        partial = staged.commit_partial("interrupted (SIGINT) at t = 5 s")
+    finally:
+        os.umask(old_umask)
+    assert partial == tmp_path / "results.partial"
+    assert "interrupted (SIGINT) at t = 5 s" in (partial / "PARTIAL.txt").read_text()
+    assert (partial / "timeseries.csv").stat().st_mode & 0o777 == 0o644
+    assert partial.stat().st_mode & 0o777 == 0o755
+    assert (target / "timeseries.csv").read_text() == "new"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["results", "results.partial"]
+    with pytest.raises(SSPError, match=r"results folder /proc/x: cannot write in /proc"):
+        StagedFolder("/proc/x")
+    (tmp_path / "afile").write_text("")
+    with pytest.raises(SSPError, match="exists and is not a folder"):
+        StagedFolder(tmp_path / "afile")

@@ -1,10 +1,16 @@
 """The NEIGHBOR mission from deployment to re-entry through the master: one run of
 the 420 km scenario (orbit-averaged orbit; about 2 minutes), checked against the thesis."""
 import json
+import os
+import signal
+import subprocess
+import sys
+import time
 
 import pytest
 
-from system_ssp import SimulationError, SSPError, System
+from paths import REPO
+from system_ssp import SimulationError, SSPError, System, cli
 from system_ssp.apps import mission
 
 THESIS = mission.THESIS
@@ -104,3 +110,58 @@ def test_unknown_parameter_in_a_scenario_file(ssp_paths, tmp_path):
     with System(ssp_paths["neighbor_mission_lifetime"]) as system:
         with pytest.raises(SSPError, match="grace_periode"):
             system.run(stop_time=1.0, parameter_sets=[str(bad)])
+
+
+def test_results_folder_units_and_modes(run):
+    _, _, out = run
+    units = json.loads((out / "timeseries.units.json").read_text())
+    assert units["time"] == "s" and units["orbit.sma"] == "m" and units["mission.mode"] is None
+    umask = os.umask(0)
+    os.umask(umask)
+    for f in out.iterdir():  # before: every CSV 0600
+        assert f.stat().st_mode & 0o777 == 0o666 & ~umask, f.name
+    assert [p.name for p in out.parent.iterdir() if p.name.startswith(f".{out.name}.")] == []  # no staging left
+
+
+@pytest.mark.parametrize("args, pattern", [
+    (["--out", "/proc/mission"], "results folder /proc/mission: cannot write in /proc"),
+    (["--max-years", "0"], "--max-years 0: must be a positive number of years"),
+])
+def test_mission_command_refuses_before_the_run(ssp_paths, tmp_path, capsys, args, pattern):
+    """Refused in one line, exit 2, before the system is even loaded (before: an unwritable --out
+    ran the whole mission and aborted with exit 134; --max-years 0 exited 1 saying nothing)."""
+    argv = ["mission", "--ssp-dir", str(ssp_paths["neighbor_mission"].parent), "--out", str(tmp_path / "m")] + args
+    assert cli.main(argv) == 2
+    err = capsys.readouterr().err
+    assert pattern in err and len(err.strip().splitlines()) == 1
+    assert not (tmp_path / "m").exists()
+
+
+def test_interrupted_mission_leaves_a_marked_partial_folder(ssp_paths, tmp_path):
+    """Ctrl-C during the mission: exit 130, the earlier results folder untouched, the rows so far
+    in <out>.partial/ with PARTIAL.txt (before: a killed run mixed its timeseries into the
+    previous run's folder)."""
+    out = tmp_path / "m"
+    out.mkdir()
+    (out / "summary.json").write_text("previous run")
+    env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
+    proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "mission", "--out", str(out), "--quiet",
+                             "--ssp-dir", str(ssp_paths["neighbor_mission"].parent), "--log-level", "info"],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
+    try:
+        for line in proc.stderr:  # the master logs the run's start once the system is loaded
+            if "system_ssp.master" in line:
+                break
+        time.sleep(0.5)
+        proc.send_signal(signal.SIGINT)
+        _, err = proc.communicate(timeout=120)
+    finally:
+        proc.kill()
+    assert proc.returncode == 130, err
+    assert "interrupted (SIGINT) at t = " in err and "Traceback" not in err
+    assert sorted(p.name for p in out.iterdir()) == ["summary.json"]
+    assert (out / "summary.json").read_text() == "previous run"
+    partial = tmp_path / "m.partial"
+    assert "interrupted (SIGINT)" in (partial / "PARTIAL.txt").read_text()
+    assert (partial / "timeseries.csv").read_text().startswith("time,mission.mode")
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["m", "m.partial"]

@@ -1,0 +1,63 @@
+"""Ctrl-C and SIGTERM stop a run at the next communication point.
+
+Python runs signal handlers between bytecodes, which, with FMUs that run Python in this
+interpreter, can be inside a model's doStep: a KeyboardInterrupt raised there would come back as
+that component's fmi2Error. While a run executes, SIGINT and SIGTERM only set a flag, which the
+`Interruption` observer reads after every macro step (only in the main thread: elsewhere signals
+cannot be caught and the run is not interruptible this way)."""
+import signal
+import threading
+
+from .observers import Observer
+
+SIGNALS = (signal.SIGINT, signal.SIGTERM)
+
+
+class SignalWatch:
+    """`with SignalWatch() as watch:` SIGINT/SIGTERM set `watch.received` (the first signal's
+    number) instead of their usual action; the earlier handlers come back on exit."""
+
+    def __init__(self):
+        self.received = None
+        self.saved = {}
+
+    def _handler(self, signum, frame):
+        if self.received is None:
+            self.received = signum
+
+    def __enter__(self):
+        if threading.current_thread() is threading.main_thread():
+            for sig in SIGNALS:
+                try:
+                    self.saved[sig] = signal.signal(sig, self._handler)
+                except (ValueError, OSError):  # not allowed here (embedded interpreter)
+                    pass
+        return self
+
+    def __exit__(self, *exc):
+        for sig, old in self.saved.items():
+            signal.signal(sig, old)
+        self.saved = {}
+
+
+class Interrupted(Exception):
+    """Raised by the Interruption observer; the execution turns it into RunInterrupted."""
+
+    def __init__(self, signum):
+        super().__init__(signum)
+        self.signum = signum
+
+
+class Interruption(Observer):
+    """Ends the run at the communication point after a signal arrived (last observer: the
+    others have seen the step)."""
+
+    def __init__(self, watch):
+        self.watch = watch
+
+    def start(self, info):
+        self.step(info)
+
+    def step(self, info):
+        if self.watch.received is not None:
+            raise Interrupted(self.watch.received)
