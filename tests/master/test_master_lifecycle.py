@@ -1,8 +1,10 @@
 """The master's life cycle under stress: memory over many runs, failures, interruptions and
 output locations (issue 15)."""
+import argparse
 import csv
 import gc
 import json
+import logging
 import os
 from pathlib import Path
 import re
@@ -18,8 +20,11 @@ from master_fixtures import helpers as h
 from paths import REPO
 import system_ssp
 from system_ssp import SimulationError, SSPError
+from system_ssp.apps import add_console_arguments, console_settings
 from system_ssp.atomic import StagedFolder, atomic_write
 from system_ssp.master import instances
+from system_ssp.master.observers import ProgressBar, StepInfo
+from system_ssp.master.planning import make_plan
 from test_master_core import loop_system
 
 
@@ -221,3 +226,44 @@ def test_staged_folder_replaces_as_one_unit(tmp_path):
     (tmp_path / "afile").write_text("")
     with pytest.raises(SSPError, match="exists and is not a folder"):
         StagedFolder(tmp_path / "afile")
+
+
+# ---- the progress bar speaks the user's units (defect 9) --------------------------------------
+def test_progress_bar_units_and_totals(fmus, tmp_path):
+    """Simulated time in s, days or years by the span; a total (and so a percentage and an ETA)
+    only when the run will reach its stop time; the ETA from the average rate (smoothing 0)."""
+    ssd = loop_system(tmp_path, fmus)
+    with system_ssp.System(ssd) as system:
+        for stop, step, unit in ((100.0, 0.1, "s"), (10 * 86400.0, 3600.0, "d"), (5 * 3.15576e7, 86400.0, "yr")):
+            bar = ProgressBar(make_plan(system, stop_time=stop, step_size=step))
+            bar.start(StepInfo(0.0, 1))
+            try:
+                assert bar.unit == unit and bar.bar.total == pytest.approx(stop / bar.scale)
+                assert bar.bar.smoothing == 0
+                info = StepInfo(stop / 2, 1)
+                info.steps = bar.chunk
+                bar.step(info)
+                assert bar.bar.n == pytest.approx(stop / 2 / bar.scale)
+            finally:
+                bar.close()
+        bar = ProgressBar(make_plan(system, stop_time=100.0, step_size=0.1, stop_when=["thr.done"]))
+        bar.start(StepInfo(0.0, 1))
+        try:
+            assert bar.bar.total is None  # may stop before 100 s: no percentage, no ETA
+        finally:
+            bar.close()
+
+
+def test_progress_default_follows_the_terminal(monkeypatch):
+    ap = argparse.ArgumentParser()
+    add_console_arguments(ap)
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: True, raising=False)
+    assert console_settings(ap.parse_args([])) is True
+    assert console_settings(ap.parse_args(["--quiet"])) is False
+    monkeypatch.setattr(sys.stderr, "isatty", lambda: False, raising=False)
+    assert console_settings(ap.parse_args([])) is False
+    assert console_settings(ap.parse_args(["--progress"])) is True
+    assert console_settings(ap.parse_args(["--log-level", "info"])) is False
+    assert logging.getLogger("system_ssp").level == logging.INFO
+    console_settings(ap.parse_args([]))
+    assert logging.getLogger("system_ssp").level == logging.WARNING
