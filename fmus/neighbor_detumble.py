@@ -30,8 +30,6 @@ class DetumbleController(NeighborSlave):
                        "False: done when |omega - omega_d| <= tol on every axis; true: Appendix D's literal one-sided "
                        "test omega - omega_d <= tol (the thesis cases)",
                        bool)
-        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
-        self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2", "Angular acceleration of the last step")
         self.thruster_controller_interface(
             self._command, self._done, RATE_INPUTS + ACCEL_INPUTS, RATE_INPUTS,
             "Detumble complete: rates within tolerance (Appendix D stop test)")

@@ -124,12 +124,19 @@ class NeighborSlave(Fmi2Slave):
                         f"{description} (component {i + 1})", kind, depends_on)
 
     def thruster_controller_interface(self, command, done, inputs, done_inputs, done_description):
-        """The connectors every RCS attitude controller shares, so that a system swaps one
-        controller for another by replacing a component: an `enabled` input (false: zero
-        command), the quantized `torque_cmd_B[3]`, the pair signals `thrust_flag[3]` and `done`.
+        """The connectors every RCS attitude controller shares (the controller interface family:
+        detumble, slew, tracking), so that a system swaps one controller for another by
+        replacing a component: the attitude knowledge `q_BN[4]`, `omega_BN_B[3]`,
+        `omega_dot_BN_B[3]` (each controller reads the ones its law needs), an `enabled` input
+        (false: zero command), the quantized `torque_cmd_B[3]`, the pair signals `thrust_flag[3]`
+        and `done`.
 
         `command()` returns (torque, flags) from the current inputs, `done()` the stop test;
         `inputs` / `done_inputs` are the input names they read (their output dependencies)."""
+        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
+        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
+        self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2",
+                         "Angular acceleration of the last step (read by laws with a derivative term)")
         self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
 
         def gated():

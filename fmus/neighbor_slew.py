@@ -31,8 +31,6 @@ class SlewController(NeighborSlave):
         self.parameter("accept_antipodal", False, None,
                        "True: done also when each element matches -q_d (Appendix G); false: q_d only (Appendix E)",
                        bool)
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
-        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
         self.thruster_controller_interface(
             self._command, self._done, Q_INPUTS + RATE_INPUTS, Q_INPUTS + RATE_INPUTS,
             "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test)")

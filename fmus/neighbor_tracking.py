@@ -39,8 +39,6 @@ class TrackingController(NeighborSlave):
         self.inertia_parameters("Spacecraft mass for the box inertia the law uses (Eq. 4)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
-        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
         self.thruster_controller_interface(
             self._command, self._done, Q_INPUTS + RATE_INPUTS, Q_INPUTS + RATE_INPUTS,
             "Tracking converged: every sliding-vector component within its threshold e (the burn itself "

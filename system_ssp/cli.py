@@ -1,5 +1,5 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `thesis`, `deorbit-study` and `mission`, and `--version`.
+`info`, `replace`, `compare`, `thesis`, `deorbit-study` and `mission`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
@@ -8,16 +8,20 @@ file and line, component or variable); 3 an unexpected error; 130 interrupted by
 <output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
 """
 import argparse
+import json
 import signal
 import sys
 import traceback
 
 from . import __version__
-from .apps import add_console_arguments, console_settings, deorbit_study, mission, thesis
+from .apps import add_console_arguments, console_settings, deorbit_study, mission, replace, thesis
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
+from .master.info import system_info
+from .ssp.interface import FmuInterface, describe_fmu
 
-APPS = {"thesis": thesis, "deorbit-study": deorbit_study, "mission": mission}
+APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
+        "replace": replace.main_replace, "compare": replace.main_compare}
 
 
 def _parser():
@@ -49,9 +53,14 @@ def _parser():
     r.add_argument("--profile", action="store_true",
                    help="with an nc:Schedule: print wall time per component and for the master itself")
     add_console_arguments(r)
-    i = sub.add_parser("info", help="describe a system")
+    i = sub.add_parser("info", help="describe a system (.ssp/.ssd) or an FMU: every variable, where parameters "
+                       "are bound")
     i.add_argument("path")
+    i.add_argument("--json", action="store_true", help="the same as JSON, for tools")
     i.add_argument("--no-validate", action="store_true")
+    sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
+                   "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
+    sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")
     sub.add_parser("thesis", add_help=False,
                    help="run the NEIGHBOR thesis validation cases and compare with the published numbers")
     sub.add_parser("deorbit-study", add_help=False,
@@ -99,7 +108,7 @@ def main(argv=None):
     previous = signal.signal(signal.SIGTERM, _terminate)
     try:
         if argv[:1] and argv[0] in APPS:
-            return APPS[argv[0]].main(argv[1:])
+            return APPS[argv[0]](argv[1:])
         return _run_or_info(argv)
     except RunInterrupted as exc:
         print(exc, file=sys.stderr)
@@ -134,9 +143,13 @@ def _say_partial(exc):
 
 def _run_or_info(argv):
     args = _parser().parse_args(argv)
+    if args.command == "info" and args.path.lower().endswith(".fmu"):
+        fmu = FmuInterface.read(args.path)
+        print(json.dumps(fmu.as_dict(), indent=1) if args.json else describe_fmu(fmu))
+        return 0
     with System(args.path, validate=not args.no_validate) as system:
         if args.command == "info":
-            print(system.info())
+            print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
             return 0
         progress = console_settings(args)
         result = system.run(

@@ -43,7 +43,7 @@ THESIS = {"420km": dict(h0=420.0, target=350.0, delta_v=19.84, propellant=0.564,
           "525km": dict(h0=525.0, target=300.0, delta_v=63.21, propellant=1.707, burn_min=117.20,
                         life_no_burn=97.41, life_burn=3.19, figure=13)}
 RECORD = ["orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",
-          "orbit.reentered", "atmosphere.density", "propulsion.mass", "propulsion.propellant_used",
+          "orbit.reentered", "orbit.density", "propulsion.mass", "propulsion.propellant_used",
           "propulsion.burn_time", "propulsion.burning"]
 
 
@@ -61,8 +61,7 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
     ssp = Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
-    overrides = {"orbit.density_model": density, "atmosphere.density_model": density,
-                 "orbit.space_weather_file": space_weather_file, "atmosphere.space_weather_file": space_weather_file}
+    overrides = {"orbit.density_model": density, "orbit.space_weather_file": space_weather_file}
     staged = StagedFolder(out) if out is not None else None  # refused now, not after the runs
     try:
         summary = _run_all(ssp, scenarios, model, density, overrides, max_years, progress,

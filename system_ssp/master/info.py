@@ -1,5 +1,11 @@
-"""The text `python -m system_ssp info` prints for a loaded system."""
+"""What `neighbor-cosim info` prints for a loaded system: the experiment, the master settings,
+every component's variables (inputs, outputs and all parameters with start value, unit, range,
+description, and where each parameter is bound), the connections; `system_info` is the same as
+data (`--json`)."""
+import dataclasses
+
 from ..errors import SSPError
+from ..ssp.interface import FmuInterface, variable_line
 
 
 def describe_system(system):
@@ -26,14 +32,19 @@ def describe_system(system):
         lines.append("default Gauss-Seidel order: " + ", ".join(system.default_order()))
     except SSPError as exc:
         lines.append(f"default Gauss-Seidel order: none ({exc})")
+    bound = bindings(system)
     for c in system.comps:
         lines.append(f"component {c.name}: {c.decl.source} (model {c.md.modelName})")
-        for v in c.md.modelVariables:
-            if v.causality in ("input", "output"):
+        fmu = FmuInterface.from_model_description(c.md, c.decl.fmu_path)
+        for v in fmu.variables.values():
+            if v.causality in ("input", "output"):  # the unit the connection sees (FMU or SSD connector)
                 u = system.var_unit(c, v.name)
-                lines.append(f"  {v.causality:6s} {v.name} : {v.type}{f' [{u}]' if u else ''}")
-        for pv in c.decl.parameters:
-            lines.append(f"  bound  {pv.name} = {pv.value!r}{f' {pv.unit}' if pv.unit else ''}  ({pv.origin})")
+                lines.append(f"  {v.causality:6s} " + variable_line(dataclasses.replace(v, unit=u)))
+        for v in fmu.variables.values():
+            if v.causality == "parameter":
+                where = bound.get((c.name, v.name))
+                text = f"{where[0]!r} at {where[1]}" if where else None
+                lines.append("  param  " + variable_line(v, text, where is not None))
     for pv in d.parameters:
         lines.append(f"system binding {pv.name} = {pv.value!r}{f' {pv.unit}' if pv.unit else ''}  ({pv.origin})")
     lines.append("connections:")
@@ -43,3 +54,44 @@ def describe_system(system):
             extra = f"  (x{lk.factor:g}{lk.offset:+g})"
         lines.append(f"  {system.comps[lk.src].name}.{lk.src_var} -> {system.comps[lk.dst].name}.{lk.dst_var}{extra}")
     return "\n".join(lines)
+
+
+def bindings(system):
+    """{(component, variable): (value, where)} of every value the SSD binds (component bindings,
+    then the root system's, later ones winning)."""
+    out = {}
+    for c in system.comps:
+        for pv in c.decl.parameters:
+            out[(c.name, pv.name)] = (pv.value, pv.origin)
+    for pv in system.desc.parameters:
+        comp, _, var = pv.name.partition(".")
+        out[(comp, var)] = (pv.value, pv.origin)
+    return out
+
+
+def system_info(system):
+    """The system as data: experiment, master settings, components with every variable (bound
+    parameters with their value and where), connections."""
+    d, m = system.desc, system.desc.master
+    bound = bindings(system)
+    comps = []
+    for c in system.comps:
+        fmu = FmuInterface.from_model_description(c.md, c.decl.fmu_path)
+        variables = []
+        for v in fmu.variables.values():
+            item = v.as_dict()
+            if v.causality in ("input", "output"):
+                item["unit"] = system.var_unit(c, v.name)
+            if v.causality == "parameter":
+                value, where = bound.get((c.name, v.name), (None, None))
+                item.update(bound=where, value=value)
+            variables.append(item)
+        comps.append({"name": c.name, "source": c.decl.source, "model": c.md.modelName, "guid": c.md.guid,
+                      "variables": variables})
+    return {"name": d.name, "file": d.display, "start_time": d.start_time, "stop_time": d.stop_time,
+            "master": {"step_size": m.step_size, "algorithm": m.algorithm, "order": m.order,
+                       "stop_conditions": [list(s) if isinstance(s, tuple) else s for s in m.stop_conditions]},
+            "components": comps,
+            "connections": [{"from": f"{system.comps[lk.src].name}.{lk.src_var}",
+                             "to": f"{system.comps[lk.dst].name}.{lk.dst_var}", "factor": lk.factor,
+                             "offset": lk.offset} for lk in system.links]}

@@ -9,8 +9,10 @@ Two systems with the same wiring, differing in one component (a fidelity swap):
                       drift), fast enough for century-long lifetimes.
 Both: propulsion (the main de-orbit thrusters, burning from t = 0 until the scenario's
 propellant budget is spent, thrust along -v through orbit.retrograde since no attitude is
-simulated) and atmosphere (the standalone density FMU on orbit.r_BN_N, so density is a
-recorded signal). The run stops at orbit.reentered (geodetic altitude, or mean perigee for the
+simulated). The orbit evaluates the density itself, at every integrator stage (its `density`
+output is the recorded signal): a separate Atmosphere FMU here would only be sampled at the
+communication points and change nothing, so it is not in these systems (it is in acs_modes and
+sun_eclipse). The run stops at orbit.reentered (geodetic altitude, or mean perigee for the
 averaged model, below 250 km: the thesis' re-entry point).
 
 Steps (nc:Schedule): 0.5 s while propulsion.burning (the thesis' manoeuvre step, Section 3.2),
@@ -55,14 +57,12 @@ def scenario(h0_km, target_km, burn):
 def system(orbit_fmu, coast_step):
     return {
         "description": f"NEIGHBOR de-orbit: {orbit_fmu} orbit, main de-orbit thrusters (retrograde burn to the "
-                       "propellant budget), atmosphere density; stops at re-entry (250 km)",
+                       "propellant budget); stops at re-entry (250 km)",
         "components": [("propulsion", "Propulsion", ["deorbit_propulsion"]),
-                       ("orbit", orbit_fmu, ["deorbit_orbit"]),
-                       ("atmosphere", "Atmosphere", ["deorbit_atmosphere"])],
+                       ("orbit", orbit_fmu, ["deorbit_orbit"])],
         "connections": [("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
-                        ("propulsion", "mass", "orbit", "mass", 0),
-                        ("orbit", "r_BN_N", "atmosphere", "r_BN_N", 3)],
-        "order": ["propulsion", "orbit", "atmosphere"],
+                        ("propulsion", "mass", "orbit", "mass", 0)],
+        "order": ["propulsion", "orbit"],
         "stop": [("orbit", "reentered")],
         "stop_time": STOP_TIME,
         "step_size": coast_step,
@@ -76,9 +76,6 @@ def generate(writer):
     writer.ssv("deorbit_orbit",
                "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
                "space weather); retrograde thrust since no attitude is simulated", orbit)
-    writer.ssv("deorbit_atmosphere",
-               "Density signal: the same model and space weather as the orbit",
-               {k: ORBIT[k] for k in ("epoch", "density_model", "space_weather_file", "use_constant_space_weather")})
     dv = propulsion.deorbit_scenario(420.0 * KM, 350.0 * KM)
     writer.ssv("deorbit_propulsion",
                "Main de-orbit thrusters (4 x 25 mN, Isp 42 s, g0 9.81; thesis Section 3.2, Appendix A), 12 kg, "
