@@ -9,6 +9,7 @@ file and line, component or variable); 3 an unexpected error; 130 interrupted by
 """
 import argparse
 import json
+import os
 import signal
 import sys
 import traceback
@@ -125,6 +126,9 @@ def main(argv=None):
     except Terminated:
         print("interrupted (SIGTERM)", file=sys.stderr)
         return 143
+    except BrokenPipeError:  # the reader went away (| head): not an error of ours
+        sys.stdout = open(os.devnull, "w")
+        return 0
     except Exception as exc:  # unexpected: one line, the traceback only with --log-level debug
         if debug:
             traceback.print_exc()

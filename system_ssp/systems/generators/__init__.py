@@ -5,8 +5,8 @@ The written files are committed (system_ssp/systems/); `python -m system_ssp.sys
 regenerates them into a temporary folder and fails on any difference, so the committed systems
 always match their generators and the FMUs they were generated from.
 """
-from . import (acs_modes, air_bearing, attitude_determination, deorbit, maneuvers, mission, sun_avoidance,
-               sun_eclipse, sunline)
+from . import (acs_modes, air_bearing, atmosphere, attitude_determination, deorbit, maneuvers, mission,
+               sun_avoidance, sun_eclipse, sunline)
 
 # name -> module, in the order they are written
 GENERATORS = {
@@ -18,6 +18,7 @@ GENERATORS = {
     "air_bearing": air_bearing,
     "acs_modes": acs_modes,
     "deorbit": deorbit,
+    "atmosphere": atmosphere,
     "mission": mission,
 }
 
