@@ -1,5 +1,5 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `replace`, `compare`, `thesis`, `deorbit-study` and `mission`, and `--version`.
+`info`, `replace`, `compare`, `campaign`, `thesis`, `deorbit-study` and `mission`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
@@ -15,14 +15,14 @@ import sys
 import traceback
 
 from . import __version__
-from .apps import add_console_arguments, console_settings, deorbit_study, mission, replace, thesis
+from .apps import add_console_arguments, campaign, console_settings, deorbit_study, mission, replace, thesis
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
-        "replace": replace.main_replace, "compare": replace.main_compare}
+        "replace": replace.main_replace, "compare": replace.main_compare, "campaign": campaign.main}
 
 
 def _parser():
@@ -62,6 +62,8 @@ def _parser():
     sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
                    "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
     sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")
+    sub.add_parser("campaign", add_help=False, help="a sweep or Monte Carlo campaign on Dask (campaign SPEC.toml "
+                   "--out DIR [--workers N] [--scheduler ADDRESS])")
     sub.add_parser("thesis", add_help=False,
                    help="run the NEIGHBOR thesis validation cases and compare with the published numbers")
     sub.add_parser("deorbit-study", add_help=False,

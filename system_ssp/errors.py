@@ -35,3 +35,8 @@ class RunInterrupted(_Stopped):
     def __init__(self, message, signal):
         super().__init__(message)
         self.signal = signal
+
+
+class RunTimedOut(_Stopped):
+    """The run passed its wall-clock limit (`System.run(timeout=...)`) and was stopped at a
+    communication point."""

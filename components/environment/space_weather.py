@@ -334,3 +334,39 @@ class SpaceWeather(_IndexSource):
         if "OBSERVED" not in counts or not dates:
             fail(len(lines), "no OBSERVED section with entries")
         return cls(np.array(dates), np.array(rows), path)
+
+
+# F10.7 fields of a CSSI line (format 1.2): adjusted, its centred and last 81-day means, then the
+# same three observed
+F107_FIELDS = ((92, 98), (100, 106), (106, 112), (112, 118), (118, 124), (124, 130))
+
+
+def scaled_copy(factor, dest, source=None):
+    """Write a copy of the CSSI file `source` (default: the bundled one) to `dest` with every
+    F10.7 value (observed and adjusted, daily and 81-day means) multiplied by `factor` (capped at
+    the format's 999.9): a solar cycle `factor` times as strong, for dispersing solar activity.
+    Geomagnetic indices unchanged."""
+    factor = float(factor)
+    if not (math.isfinite(factor) and 0.1 <= factor <= 10.0):
+        raise ValueError(f"F10.7 scale factor {factor!r} must be in [0.1, 10]")
+    source = BUNDLED_FILE if source in (None, "") else os.fspath(source)
+    with open(source, encoding="ascii") as f:
+        lines = f.read().splitlines()
+    out, section = [], None
+    for line in lines:
+        if line.startswith("BEGIN "):
+            section = line.split()[1]
+        elif line.startswith("END "):
+            section = None
+        elif section is not None and len(line) >= 130:
+            chars = list(line)
+            for a, b in F107_FIELDS:
+                text = line[a:b].strip()
+                if text:
+                    # the format holds 999.9 at most (a flare day of 924 sfu scaled up would not fit)
+                    chars[a:b] = f"{min(float(text) * factor, 999.9):{b - a}.1f}"
+            line = "".join(chars)
+        out.append(line)
+    with open(dest, "w", encoding="ascii") as f:
+        f.write("\n".join(out) + "\n")
+    return dest

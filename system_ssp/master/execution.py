@@ -3,17 +3,17 @@ observers, the result; the instances are freed whatever happens. A run that fail
 interrupted raises with the rows recorded so far (`err.result`)."""
 import signal
 
-from ..errors import RunInterrupted, SimulationError
+from ..errors import RunInterrupted, RunTimedOut, SimulationError
 from .algorithms import FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
-from .interrupts import Interrupted, Interruption, SignalWatch
+from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallClockLimit
 from .observers import Observer, ProgressBar, Profiler, Recorder, StepInfo, StopConditions
 from .result import Result
 
 
-def execute(system, plan, progress=False):
+def execute(system, plan, progress=False, timeout=None):
     """Run `plan` on `system` with fresh FMU instances; returns a Result (wall_time 0: the
-    caller measures it)."""
+    caller measures it). `timeout`: seconds of wall time from the first step, or None."""
     table = InstanceTable(system, plan)
     run = _Run(system, plan, table)
     with SignalWatch() as watch:
@@ -21,7 +21,7 @@ def execute(system, plan, progress=False):
             table.instantiate()
             table.prepare()
             table.initialize()
-            return run.loop(progress, watch)
+            return run.loop(progress, watch, timeout)
         except StepFailed as f:
             err = table.error(f.ci, f.call, status=f.status, names=f.names)
             err.result = run.partial(f"failed at t={table.t:g} s")
@@ -29,6 +29,11 @@ def execute(system, plan, progress=False):
         except SimulationError as err:
             err.result = run.partial(f"failed at t={table.t:g} s")
             raise
+        except TimedOut:
+            run.record_last()
+            err = RunTimedOut(f"wall-clock limit of {timeout:g} s reached at t = {run.info.t:g} s")
+            err.result = run.partial(f"timed out at t={run.info.t:g} s")
+            raise err from None
         except Interrupted as stop:
             name = signal.Signals(stop.signum).name
             run.record_last()
@@ -47,7 +52,7 @@ class _Run:
         self.system, self.plan, self.table = system, plan, table
         self.recorder = self.info = None
 
-    def loop(self, progress, watch):
+    def loop(self, progress, watch, timeout=None):
         system, plan, table = self.system, self.plan, self.table
         algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
@@ -62,6 +67,8 @@ class _Run:
         if plan.profile and plan.schedule is not None:
             profiler = Profiler(algorithm, [c.name for c in system.comps])
             observers.append(profiler)
+        if timeout is not None:
+            observers.append(WallClockLimit(timeout))
         observers.append(Interruption(watch))  # last: the row of this step is recorded first
         info = StepInfo(plan.start, plan.record_every)
         self.recorder, self.info = recorder, info

@@ -7,6 +7,7 @@ that component's fmi2Error. While a run executes, SIGINT and SIGTERM only set a 
 cannot be caught and the run is not interruptible this way)."""
 import signal
 import threading
+import time
 
 from .observers import Observer
 
@@ -61,3 +62,20 @@ class Interruption(Observer):
     def step(self, info):
         if self.watch.received is not None:
             raise Interrupted(self.watch.received)
+
+
+class TimedOut(Exception):
+    """Raised by the WallClockLimit observer; the execution turns it into RunTimedOut."""
+
+
+class WallClockLimit(Observer):
+    """Ends the run at the first communication point after `seconds` of wall time (checked
+    every few steps: reading the clock costs about as much as a cheap FMU call)."""
+
+    def __init__(self, seconds):
+        self.deadline = time.perf_counter() + seconds
+        self.seconds = seconds
+
+    def step(self, info):
+        if info.steps % 16 == 0 and time.perf_counter() > self.deadline:
+            raise TimedOut()

@@ -8,7 +8,7 @@ import time
 from typing import Iterable, Mapping, Optional, Sequence, Union
 import zipfile
 
-from ..errors import RunInterrupted, SimulationError, SSPError
+from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
 from .connections import FeedthroughGraph, UnitTable, check_connector_units, resolve_connections
@@ -108,9 +108,10 @@ class System:
             algorithm: Optional[str] = None, order: Union[None, str, Sequence[str]] = None,
             step_multiples: Optional[Mapping[str, int]] = None, stop_when: Optional[Sequence[str]] = None,
             output_file: Optional[PathLike] = None, progress: bool = False, record_every: int = 1,
-            schedule: bool = True, profile: bool = False) -> Result:
+            schedule: bool = True, profile: bool = False, timeout: Optional[float] = None) -> Result:
         """Run one simulation with fresh FMU instances; see `system_ssp.simulate` for the
-        arguments. schedule=False runs a system that has an nc:Schedule with the fixed step."""
+        arguments. schedule=False runs a system that has an nc:Schedule with the fixed step;
+        `timeout` (s of wall time) stops the run with RunTimedOut (rows so far in err.result)."""
         wall0 = time.perf_counter()
         plan = make_plan(self, stop_time, step_size, start_time, parameters, parameter_sets, outputs, algorithm,
                          order, step_multiples, stop_when, record_every, schedule, profile)
@@ -120,8 +121,8 @@ class System:
                  plan.start, plan.stop, f", {plan.n_steps} steps of {plan.step_size:g} s" if plan.schedule is None
                  else ", nc:Schedule")
         try:
-            result = execute(self, plan, progress)
-        except (SimulationError, RunInterrupted) as err:
+            result = execute(self, plan, progress, timeout)
+        except (SimulationError, RunInterrupted, RunTimedOut) as err:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
                 if output_file is not None:

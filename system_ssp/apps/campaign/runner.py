@@ -1,0 +1,306 @@
+"""Running a campaign on Dask and keeping its results.
+
+    neighbor-cosim campaign SPEC.toml --out DIR [--workers N] [--scheduler ADDRESS]
+
+Without --scheduler a LocalCluster of N worker processes (default: this machine's cores, one
+thread each); with --scheduler any running Dask cluster (dask-jobqueue on SLURM/PBS, Kubernetes,
+`dask scheduler` + `dask worker`). The folder DIR holds:
+
+- spec.toml and environment.json: the spec as given and the software versions;
+- runs/part-*.parquet: one row per run (run, seed, each swept and dispersed value, each metric,
+  status, error, wall_s), written as runs finish (at most every 2 s), so an interrupted campaign
+  loses at most the runs in flight; the same spec into the same folder resumes, skipping the
+  runs already recorded;
+- runs.parquet: all rows in run order, summary.json (success rate, per metric mean, std and
+  percentiles, probabilities with 95 % Wilson intervals; also printed) and figures/.
+
+A run that fails or passes timeout_s is a row with its status and error; a worker process that
+dies (an FMU that crashes it) is restarted by its nanny and its run recorded as failed.
+"""
+import argparse
+import json
+import math
+import os
+from pathlib import Path
+import platform
+import sys
+import time
+
+import numpy as np
+
+from ... import __version__
+from ...atomic import atomic_write, write_text_atomic
+from ...errors import SSPError
+from .. import add_console_arguments, console_settings
+from .spec import load_spec
+from .worker import run_one
+
+FLUSH_SECONDS = 2.0
+
+
+def _read_rows(out):
+    """Every row recorded in out/runs/ (parts in any order)."""
+    import pyarrow.parquet as pq
+
+    rows = []
+    for part in sorted((out / "runs").glob("part-*.parquet")):
+        rows += pq.read_table(part).to_pylist()
+    return rows
+
+
+def _write_rows(path, rows, columns):
+    import pyarrow as pa
+    import pyarrow.parquet as pq
+
+    table = pa.Table.from_pylist([{c: r.get(c) for c in columns} for r in rows])
+    with atomic_write(path, "wb") as f:
+        pq.write_table(table, f)
+
+
+def _columns(spec):
+    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
+    return ["run", "seed"] + inputs + [m.name for m in spec.metrics] + ["status", "error", "wall_s"]
+
+
+def _prepare_folder(spec, out):
+    """Create `out`, or check that it holds the same campaign (resume); store spec and versions."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise SSPError(f"--out {out}: exists and is not a folder")
+    try:
+        (out / "runs").mkdir(parents=True, exist_ok=True)
+    except OSError as exc:
+        raise SSPError(f"--out {out}: cannot create it ({exc.strerror or exc})") from None
+    stored = out / "spec.toml"
+    if stored.is_file() and stored.read_text(encoding="utf-8") != spec.text:
+        raise SSPError(f"--out {out}: holds the results of another campaign spec (spec.toml differs): use another "
+                       "folder, or the same spec to resume")
+    write_text_atomic(stored, spec.text)
+    import dask
+    import fmpy
+
+    env = {"neighbor_cosim": __version__, "python": platform.python_version(), "numpy": np.__version__,
+           "fmpy": fmpy.__version__, "dask": dask.__version__, "platform": platform.platform(),
+           "system": str(spec.system)}
+    write_text_atomic(out / "environment.json", json.dumps(env, indent=1) + "\n")
+    return out
+
+
+def _client(workers, scheduler):
+    import dask
+    from dask.distributed import Client, LocalCluster
+
+    # a task whose worker dies is not retried by Dask (it would crash the next one too; the
+    # runner resubmits it once itself), and a worker holds one task at a time, so that a crash
+    # takes no queued run with it
+    dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.scheduler.worker-saturation": 1.0})
+    if scheduler:
+        return Client(scheduler), None
+    n = workers or os.cpu_count() or 1
+    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    return Client(cluster), cluster
+
+
+def run_campaign(spec, out, workers=None, scheduler=None, progress=False):
+    """Run (or resume) campaign `spec` (a CampaignSpec or a spec path) into folder `out`; returns
+    the summary dict."""
+    from dask.distributed import as_completed
+
+    if not hasattr(spec, "inputs"):
+        spec = load_spec(spec)
+    out = _prepare_folder(spec, out)
+    columns = _columns(spec)
+    done = {r["run"] for r in _read_rows(out)}
+    todo = [i for i in range(spec.total_runs) if i not in done]
+    if todo:
+        client, cluster = _client(workers, scheduler)
+        try:
+            _run(client, spec, out, todo, columns, progress, as_completed)
+        finally:
+            client.close()
+            if cluster is not None:
+                cluster.close()
+    rows = sorted(_read_rows(out), key=lambda r: r["run"])
+    _write_rows(out / "runs.parquet", rows, columns)
+    summary = summarize(spec, rows)
+    summary["resumed_from"] = len(done)
+    write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, default=_json) + "\n")
+    figures(spec, rows, out / "figures")
+    return summary
+
+
+def _run(client, spec, out, todo, columns, progress, as_completed):
+    spec_future = client.scatter(spec, broadcast=True)
+    futures = {client.submit(run_one, spec_future, i, pure=False, key=f"run-{i}-{time.time_ns()}"): i for i in todo}
+    buffer, last = [], time.monotonic()
+    bar = None
+    if progress:
+        from tqdm import tqdm
+        bar = tqdm(total=spec.total_runs, initial=spec.total_runs - len(todo), unit="run", file=sys.stderr,
+                   smoothing=0.0)
+
+    def flush():
+        if buffer:
+            first = min(r["run"] for r in buffer)
+            _write_rows(out / "runs" / f"part-{first:07d}-{time.time_ns()}.parquet", buffer, columns)
+            buffer.clear()
+
+    retried = set()
+    try:
+        pending = as_completed(futures)
+        for fut in pending:
+            i = futures[fut]
+            try:
+                row = fut.result()
+            except Exception as exc:  # the worker died (KilledWorker) or could not run the task
+                if i not in retried:  # once more: it may have been queued beside the run that crashed
+                    retried.add(i)
+                    again = client.submit(run_one, spec_future, i, pure=False, key=f"run-{i}-{time.time_ns()}")
+                    futures[again] = i
+                    pending.add(again)
+                    continue
+                seed, values = spec.inputs(i)
+                row = {"run": i, "seed": seed, **values, "status": "failed",
+                       "error": f"the worker running it died ({type(exc).__name__}: {exc}); an FMU may have "
+                                "crashed its process", "wall_s": math.nan}
+            buffer.append(row)
+            if bar is not None:
+                bar.update(1)
+            if time.monotonic() - last > FLUSH_SECONDS:
+                flush()
+                last = time.monotonic()
+    finally:  # also on Ctrl-C: what finished is kept, the rest is cancelled
+        flush()
+        if bar is not None:
+            bar.close()
+        client.cancel(list(futures))
+
+
+def _json(x):
+    if isinstance(x, float) and not math.isfinite(x):
+        return None
+    return str(x)
+
+
+def wilson(k, n, z=1.959963984540054):
+    """95 % Wilson score interval of a proportion k/n."""
+    if n == 0:
+        return (math.nan, math.nan)
+    p = k / n
+    d = 1 + z * z / n
+    c = (p + z * z / (2 * n)) / d
+    h = z * math.sqrt(p * (1 - p) / n + z * z / (4 * n * n)) / d
+    return (max(0.0, c - h), min(1.0, c + h))
+
+
+def summarize(spec, rows):
+    """Success rate, per-metric statistics over the successful runs, probabilities."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    s = {"campaign": str(spec.path), "system": str(spec.system), "runs": len(rows), "ok": len(ok),
+         "failed": sum(r["status"] == "failed" for r in rows), "timeout": sum(r["status"] == "timeout" for r in rows),
+         "success_rate": len(ok) / len(rows) if rows else math.nan, "metrics": {}, "probabilities": {}}
+    for m in spec.metrics:
+        vals = np.array([r[m.name] for r in ok if isinstance(r[m.name], (int, float))], dtype=float)
+        vals = vals[np.isfinite(vals)] if vals.size else vals
+        if vals.size:
+            p5, p50, p95 = np.percentile(vals, [5, 50, 95])
+            s["metrics"][m.name] = {"n": int(vals.size), "mean": float(vals.mean()), "std": float(vals.std()),
+                                    "min": float(vals.min()), "p5": float(p5), "p50": float(p50), "p95": float(p95),
+                                    "max": float(vals.max())}
+        else:
+            values = sorted({str(r[m.name]) for r in ok})
+            s["metrics"][m.name] = {"n": len(ok), "values": values[:20]}
+    ops = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal}
+    for name, metric, op, threshold in spec.probabilities:
+        vals = [r[metric] for r in ok if r[metric] is not None]
+        k = int(sum(bool(ops[op](v, threshold)) for v in vals))
+        lo, hi = wilson(k, len(vals))
+        s["probabilities"][name] = {"condition": f"{metric} {op} {threshold}", "k": k, "n": len(vals),
+                                    "p": k / len(vals) if vals else math.nan, "ci95": [lo, hi]}
+    return s
+
+
+def table(s):
+    lines = [f"{s['runs']} runs: {s['ok']} ok, {s['failed']} failed, {s['timeout']} timed out "
+             f"(success rate {100 * s['success_rate']:.1f} %)"]
+    for name, m in s["metrics"].items():
+        if "mean" in m:
+            lines.append(f"  {name:<24} mean {m['mean']:<12.6g} std {m['std']:<11.4g} p5 {m['p5']:<11.6g} "
+                         f"p50 {m['p50']:<11.6g} p95 {m['p95']:.6g}")
+        else:
+            lines.append(f"  {name:<24} {', '.join(m['values'])}")
+    for name, p in s["probabilities"].items():
+        lines.append(f"  P({p['condition']}) = {p['p']:.3f}  [{p['ci95'][0]:.3f}, {p['ci95'][1]:.3f}] 95 % "
+                     f"({p['k']}/{p['n']})  {name}")
+    return "\n".join(lines)
+
+
+def figures(spec, rows, folder):
+    """A histogram per numeric metric and a scatter of each input against each metric."""
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    ok = [r for r in rows if r["status"] == "ok"]
+    metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) for r in ok)]
+    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
+    inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)]
+    if not metrics:
+        return
+    folder.mkdir(exist_ok=True)
+    for name in metrics:
+        vals = [float(r[name]) for r in ok if math.isfinite(float(r[name]))]
+        if not vals:
+            continue
+        fig, ax = plt.subplots(figsize=(6, 4))
+        ax.hist(vals, bins=min(40, max(5, len(vals) // 5)), color="tab:blue")
+        ax.set_xlabel(name)
+        ax.set_ylabel("runs")
+        ax.set_title(f"{name}: {len(ok)} successful runs")
+        ax.grid(alpha=0.3)
+        _save(fig, folder / f"hist_{_safe(name)}.png")
+    if inputs:
+        fig, axes = plt.subplots(len(metrics), len(inputs), figsize=(3.2 * len(inputs), 2.8 * len(metrics)),
+                                 squeeze=False)
+        for a, m in enumerate(metrics):
+            for b, x in enumerate(inputs):
+                ax = axes[a][b]
+                ax.scatter([r[x] for r in ok], [r[m] for r in ok], s=8)
+                ax.set_xlabel(x)
+                ax.set_ylabel(m)
+                ax.grid(alpha=0.3)
+        _save(fig, folder / "scatter.png")
+
+
+def _safe(name):
+    return "".join(c if c.isalnum() or c in "._-" else "_" for c in name)
+
+
+def _save(fig, path):
+    import matplotlib.pyplot as plt
+
+    fig.tight_layout()
+    with atomic_write(path, "wb") as f:
+        fig.savefig(f, dpi=100, format="png")
+    plt.close(fig)
+
+
+def main(argv=None):
+    ap = argparse.ArgumentParser(prog="neighbor-cosim campaign", description="Run a parameter sweep or Monte Carlo "
+                                 "campaign on Dask (see docs/campaigns.md).")
+    ap.add_argument("spec", help="the campaign spec (TOML)")
+    ap.add_argument("--out", required=True, help="results folder (the same spec into the same folder resumes)")
+    ap.add_argument("--workers", type=int, help="local worker processes (default: the machine's cores)")
+    ap.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786) instead")
+    add_console_arguments(ap)
+    args = ap.parse_args(argv)
+    progress = console_settings(args)
+    if args.workers is not None and args.workers < 1:
+        raise SSPError(f"--workers {args.workers}: expected a number >= 1")
+    spec = load_spec(args.spec)
+    print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {args.out}", file=sys.stderr)
+    s = run_campaign(spec, args.out, args.workers, args.scheduler, progress)
+    print(table(s))
+    print(f"results in {args.out} (runs.parquet, summary.json, figures/)")
+    return 0

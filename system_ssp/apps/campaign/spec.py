@@ -1,0 +1,268 @@
+"""A campaign spec (TOML): the system, the runs, fixed parameters, dispersions, sweeps, metrics
+and probabilities, checked when it is loaded (errors name the file, the key and what is
+allowed); and what run `i` gets: its seed and parameter values, from the campaign seed and `i`
+alone (numpy SeedSequence), so a run draws the same values on any worker in any order."""
+from dataclasses import dataclass, field
+import itertools
+import math
+from pathlib import Path
+import re
+import sys
+from typing import Optional
+
+import numpy as np
+
+from ...errors import SSPError
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10
+    import tomli as tomllib
+
+DISTRIBUTIONS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
+                 "truncnormal": ("mean", "std", "low", "high"), "choice": ("values",)}
+METRIC_KINDS = ("stop_time", "stop_reason", "steps", "final", "min", "max", "time_when")
+HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f107_scale and points the "
+                             "orbit's space_weather_file at the scaled copy"}
+PROBABILITY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>|==)\s*([-+0-9.eE]+|true|false)\s*$")
+CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_size", "timeout_s", "helper",
+                 "description"}
+TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities"}
+
+
+@dataclass(frozen=True)
+class Dispersion:
+    name: str
+    kind: str
+    args: dict
+    also: tuple = ()  # other parameters that get the same drawn value
+
+    def draw(self, rng):
+        a = self.args
+        if self.kind == "uniform":
+            return float(rng.uniform(a["low"], a["high"]))
+        if self.kind == "normal":
+            return float(rng.normal(a["mean"], a["std"]))
+        if self.kind == "truncnormal":
+            for _ in range(10000):  # rejection: exact for any bounds with mass
+                x = rng.normal(a["mean"], a["std"])
+                if a["low"] <= x <= a["high"]:
+                    return float(x)
+            raise SSPError(f"dispersion {self.name}: truncnormal bounds hold almost no probability")
+        values = a["values"]
+        return values[int(rng.integers(len(values)))]
+
+
+@dataclass(frozen=True)
+class Metric:
+    name: str
+    kind: str
+    variable: Optional[str] = None
+
+
+@dataclass
+class CampaignSpec:
+    path: Path
+    system: Path
+    runs: int
+    seed: int
+    parameter_sets: list = field(default_factory=list)
+    stop_time: Optional[float] = None
+    step_size: Optional[float] = None
+    timeout_s: Optional[float] = None
+    helper: Optional[str] = None
+    description: str = ""
+    parameters: dict = field(default_factory=dict)
+    dispersions: list = field(default_factory=list)  # [Dispersion], in spec order
+    sweeps: list = field(default_factory=list)  # [(name, [values])]
+    metrics: list = field(default_factory=list)  # [Metric]
+    probabilities: list = field(default_factory=list)  # [(name, metric, op, threshold)]
+    text: str = ""  # the spec file as read (stored beside the results)
+
+    @property
+    def points(self):
+        """The sweep's full-factorial points: [{name: value}] (one empty point without sweeps)."""
+        names = [n for n, _ in self.sweeps]
+        return [dict(zip(names, combo)) for combo in itertools.product(*[v for _, v in self.sweeps])]
+
+    @property
+    def total_runs(self):
+        return self.runs * len(self.points)
+
+    def inputs(self, index):
+        """(seed entropy, {parameter: value} swept and dispersed) of run `index`: sweep point
+        index // runs, draws from SeedSequence(seed, spawn_key=(index,))."""
+        if not 0 <= index < self.total_runs:
+            raise IndexError(index)
+        values = dict(self.points[index // self.runs])
+        ss = np.random.SeedSequence(self.seed, spawn_key=(index,))
+        rng = np.random.default_rng(ss)
+        for d in self.dispersions:
+            values[d.name] = d.draw(rng)
+        return int(ss.generate_state(1)[0]), values
+
+    def overrides(self, values):
+        """The system parameters for a run's drawn values: fixed parameters, then the values (and
+        the names that share them); helper inputs (@name) are left to the helper."""
+        out = dict(self.parameters)
+        for d in self.dispersions:
+            for other in d.also:
+                out[other] = values[d.name]
+        out.update({k: v for k, v in values.items() if not k.startswith("@")})
+        return out
+
+
+def _where(path, key):
+    return f"{path}: [{key}]" if "." not in key else f"{path}: {key}"
+
+
+def _number(path, key, value, low=-math.inf, integer=False, positive=False):
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    if ok and integer:
+        ok = float(value).is_integer()
+    if ok and (value < low or (positive and value <= 0)):
+        ok = False
+    if not ok:
+        need = "an integer" if integer else "a finite number"
+        if positive:
+            need += " > 0"
+        elif low > -math.inf:
+            need += f" >= {low:g}"
+        raise SSPError(f"{path}: {key} = {value!r}: expected {need}")
+    return int(value) if integer else float(value)
+
+
+def load_spec(path):
+    """Read and check a campaign spec; SSPError naming the file, the key and what is allowed."""
+    path = Path(path)
+    try:
+        text = path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SSPError(f"{path}: cannot read the campaign spec ({exc.strerror or exc})") from None
+    try:
+        doc = tomllib.loads(text)
+    except tomllib.TOMLDecodeError as exc:
+        raise SSPError(f"{path}: not valid TOML: {exc}") from None
+    unknown = sorted(set(doc) - TOP_KEYS)
+    if unknown:
+        raise SSPError(f"{path}: unknown table(s) {', '.join(unknown)} (allowed: {', '.join(sorted(TOP_KEYS))})")
+    spec = _campaign_table(path, doc.get("campaign"), text)
+    params = doc.get("parameters", {})
+    if not isinstance(params, dict) or any(isinstance(v, (dict, list)) for v in params.values()):
+        raise SSPError(f"{path}: [parameters] holds component.variable = value pairs")
+    spec.parameters = dict(params)
+    for name, d in doc.get("dispersions", {}).items():
+        spec.dispersions.append(_dispersion(path, name, d, spec.helper))
+    for name, s in doc.get("sweep", {}).items():
+        key = f"sweep.{name!r}"
+        if not isinstance(s, dict) or set(s) != {"values"} or not isinstance(s["values"], list) or not s["values"]:
+            raise SSPError(f"{path}: [{key}] needs exactly values = [a non-empty list]")
+        spec.sweeps.append((name, list(s["values"])))
+    names = [d.name for d in spec.dispersions] + [n for n, _ in spec.sweeps]
+    twice = sorted({n for n in names if names.count(n) > 1} | (set(names) & set(spec.parameters)))
+    if twice:
+        raise SSPError(f"{path}: {', '.join(twice)}: set more than once (parameters, dispersions, sweeps)")
+    metrics = doc.get("metrics", {})
+    if not metrics:
+        raise SSPError(f"{path}: needs a [metrics] table (name = \"stop_time\", \"final:comp.var\", ...)")
+    for name, m in metrics.items():
+        spec.metrics.append(_metric(path, name, m))
+    mnames = {m.name for m in spec.metrics}
+    for name, expr in doc.get("probabilities", {}).items():
+        match = PROBABILITY.match(expr) if isinstance(expr, str) else None
+        if match is None or match.group(1) not in mnames:
+            raise SSPError(f"{path}: probabilities.{name} = {expr!r}: expected \"<metric> <op> <number>\" with a "
+                           f"metric of [metrics] ({', '.join(sorted(mnames))}) and op one of < <= > >= ==")
+        threshold = match.group(3)
+        spec.probabilities.append((name, match.group(1), match.group(2),
+                                   threshold == "true" if threshold in ("true", "false") else float(threshold)))
+    return spec
+
+
+def _campaign_table(path, c, text):
+    """The [campaign] table as a CampaignSpec (the other tables added by load_spec)."""
+    if not isinstance(c, dict):
+        raise SSPError(f"{path}: needs a [campaign] table with system, runs and seed")
+    unknown = sorted(set(c) - CAMPAIGN_KEYS)
+    if unknown:
+        raise SSPError(f"{path}: [campaign] has unknown key(s) {', '.join(unknown)} (allowed: "
+                       f"{', '.join(sorted(CAMPAIGN_KEYS))})")
+    for key in ("system", "runs", "seed"):
+        if key not in c:
+            raise SSPError(f"{path}: [campaign] needs {key}")
+    if not isinstance(c["system"], str) or not c["system"]:
+        raise SSPError(f"{path}: campaign.system = {c['system']!r}: expected a path or a built system's name")
+    spec = CampaignSpec(path=path, system=resolve_system(c["system"], path),
+                        runs=_number(path, "campaign.runs", c["runs"], integer=True, positive=True),
+                        seed=_number(path, "campaign.seed", c["seed"], low=0, integer=True), text=text)
+    ps = c.get("parameter_sets", [])
+    if not isinstance(ps, list) or not all(isinstance(p, str) for p in ps):
+        raise SSPError(f"{path}: campaign.parameter_sets = {ps!r}: expected a list of file names")
+    spec.parameter_sets = ps
+    if c.get("stop_time") is not None:
+        spec.stop_time = _number(path, "campaign.stop_time", c["stop_time"], positive=True)
+    if c.get("step_size") is not None:
+        spec.step_size = _number(path, "campaign.step_size", c["step_size"], positive=True)
+    if c.get("timeout_s") is not None:
+        spec.timeout_s = _number(path, "campaign.timeout_s", c["timeout_s"], positive=True)
+    if c.get("helper") is not None:
+        if c["helper"] not in HELPERS:
+            raise SSPError(f"{path}: campaign.helper = {c['helper']!r}: expected one of {', '.join(HELPERS)}")
+        spec.helper = c["helper"]
+    spec.description = str(c.get("description", ""))
+    return spec
+
+
+def _dispersion(path, name, d, helper):
+    key = f"dispersions.{name!r}"
+    if not isinstance(d, dict) or "distribution" not in d:
+        raise SSPError(f"{path}: [{key}] needs distribution = one of {', '.join(DISTRIBUTIONS)}")
+    kind = d["distribution"]
+    if kind not in DISTRIBUTIONS:
+        raise SSPError(f"{path}: {key}.distribution = {kind!r}: expected one of {', '.join(DISTRIBUTIONS)}")
+    need = DISTRIBUTIONS[kind]
+    extra = sorted(set(d) - set(need) - {"distribution", "also"})
+    missing = [k for k in need if k not in d]
+    if missing or extra:
+        raise SSPError(f"{path}: [{key}] ({kind}) needs {', '.join(need)}"
+                       + (f"; missing {', '.join(missing)}" if missing else "")
+                       + (f"; unknown {', '.join(extra)}" if extra else ""))
+    if name.startswith("@") and helper is None:
+        raise SSPError(f"{path}: [{key}]: {name} is a helper input, but campaign.helper is not set")
+    if kind == "choice":
+        if not isinstance(d["values"], list) or not d["values"]:
+            raise SSPError(f"{path}: {key}.values: expected a non-empty list")
+        args = {"values": list(d["values"])}
+    else:
+        args = {k: _number(path, f"{key}.{k}", d[k]) for k in need}
+        if "std" in args and args["std"] < 0:
+            raise SSPError(f"{path}: {key}.std = {args['std']!r}: expected a number >= 0")
+        if "low" in args and not args["low"] < args["high"]:
+            raise SSPError(f"{path}: [{key}]: low {args['low']!r} must be below high {args['high']!r}")
+    also = d.get("also", [])
+    if not isinstance(also, list) or not all(isinstance(a, str) for a in also):
+        raise SSPError(f"{path}: {key}.also: expected a list of component.variable names")
+    return Dispersion(name, kind, args, tuple(also))
+
+
+def _metric(path, name, m):
+    if not isinstance(m, str):
+        raise SSPError(f"{path}: metrics.{name} = {m!r}: expected a string")
+    kind, _, var = m.partition(":")
+    if kind not in METRIC_KINDS or (kind in ("final", "min", "max", "time_when")) != bool(var):
+        raise SSPError(f"{path}: metrics.{name} = {m!r}: expected \"stop_time\", \"stop_reason\", \"steps\" or "
+                       "\"final:comp.var\", \"min:comp.var\", \"max:comp.var\", \"time_when:comp.var\"")
+    return Metric(name, kind, var or None)
+
+
+def resolve_system(name, spec_path):
+    """A campaign's system: a path (relative to the spec's folder or the working directory), or
+    the name of a built system (build/ssp/<name>.ssp)."""
+    from .. import DEFAULT_SSP_DIR
+
+    for candidate in (Path(name), Path(spec_path).parent / name, DEFAULT_SSP_DIR / f"{name}.ssp",
+                      DEFAULT_SSP_DIR / name):
+        if candidate.exists():
+            return candidate.resolve()
+    raise SSPError(f"{spec_path}: campaign.system = {name!r}: no such file here, beside the spec or in "
+                   f"{DEFAULT_SSP_DIR} (build the systems with python build_fmus.py)")

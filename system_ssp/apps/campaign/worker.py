@@ -1,0 +1,96 @@
+"""One campaign run, as a Dask worker executes it: the system is loaded once per worker process
+and reused by every run the worker gets (no per-run extraction, schema check or compilation);
+the run's values come from the spec and its index alone; any failure becomes a row."""
+import math
+import os
+import tempfile
+import time
+
+import numpy as np
+
+from ...errors import RunTimedOut, SSPError
+from ...master import System
+
+_SYSTEMS = {}  # system path -> System, for the life of this process
+
+
+def _system(path):
+    key = str(path)
+    if key not in _SYSTEMS:
+        _SYSTEMS[key] = System(path)
+    return _SYSTEMS[key]
+
+
+def _solar_activity(values, workdir):
+    """Helper `solar_activity`: a copy of the space-weather file with F10.7 scaled by @f107_scale,
+    given to the orbit (and any atmosphere) FMU; returns (parameters, files to delete after)."""
+    from components.environment import space_weather
+
+    scale = values.get("@f107_scale", 1.0)
+    path = os.path.join(workdir, f"neighbor_cssi_{os.getpid()}_x{scale!r}.txt")
+    space_weather.scaled_copy(scale, path)
+    return {"orbit.space_weather_file": path, "orbit.use_constant_space_weather": False}, [path]
+
+
+HELPERS = {"solar_activity": _solar_activity}
+
+
+def metric_values(spec, result):
+    """{metric name: value} of a finished run."""
+    out = {}
+    data = result.data
+    for m in spec.metrics:
+        if m.kind == "stop_time":
+            out[m.name] = float(result.stop_time)
+        elif m.kind == "stop_reason":
+            out[m.name] = result.stop_reason
+        elif m.kind == "steps":
+            out[m.name] = int(result.steps)
+        elif m.kind == "final":
+            value = result.final.get(m.variable, data[m.variable][-1] if m.variable in data.dtype.names else None)
+            out[m.name] = value.item() if isinstance(value, np.generic) else value
+        elif m.kind in ("min", "max"):
+            col = data[m.variable].astype(float)
+            out[m.name] = float(col.min() if m.kind == "min" else col.max())
+        else:  # time_when: the first recorded time the signal is true (non-zero); NaN if never
+            hit = np.flatnonzero(data[m.variable] != 0)
+            out[m.name] = float(data["time"][hit[0]]) if len(hit) else math.nan
+    return out
+
+
+def run_one(spec, index):
+    """The result row of run `index`: run, seed, the swept and dispersed values (one column each),
+    every metric, status ("ok", "failed", "timeout"), error, wall_s."""
+    seed, values = spec.inputs(index)
+    row = {"run": index, "seed": seed}
+    row.update({name: (v.item() if isinstance(v, np.generic) else v) for name, v in values.items()})
+    for m in spec.metrics:
+        row[m.name] = None
+    w0 = time.perf_counter()
+    cleanup = []
+    try:
+        system = _system(spec.system)
+        params = spec.overrides(values)
+        if spec.helper is not None:
+            extra, cleanup = HELPERS[spec.helper](values, tempfile.gettempdir())
+            params.update(extra)
+        record = sorted({m.variable for m in spec.metrics if m.variable})
+        result = system.run(stop_time=spec.stop_time, step_size=spec.step_size, parameter_sets=spec.parameter_sets,
+                            parameters=params,
+                            outputs=record, timeout=spec.timeout_s)
+        row.update(metric_values(spec, result))
+        row.update(status="ok", error="")
+    except RunTimedOut as exc:
+        row.update(status="timeout", error=str(exc))
+    except SSPError as exc:
+        row.update(status="failed", error=str(exc))
+    except Exception as exc:  # a model or master bug: recorded, the campaign goes on
+        row.update(status="failed", error=f"unexpected {type(exc).__name__}: {exc}")
+    finally:
+        for path in cleanup:
+            try:
+                os.unlink(path)
+            except OSError:
+                pass
+    row["wall_s"] = time.perf_counter() - w0
+    return row
