@@ -14,9 +14,11 @@ from pathlib import Path
 import sys
 
 from fmpy import read_model_description
+from lxml import etree
 
 from ..atomic import write_text_atomic
 from ..ssp.interface import FmuInterface
+from ..ssp.reader import NS
 from ..systems import SYSTEMS_DIR
 
 REPO = Path(__file__).resolve().parents[2]
@@ -38,10 +40,6 @@ def wrappers():
 
 def users():
     """{FMU file name: [system names]} from the committed SSDs."""
-    from lxml import etree
-
-    from ..ssp.reader import NS
-
     out = {}
     for ssd in sorted(SYSTEMS_DIR.glob("*.ssd")):
         root = etree.parse(str(ssd)).getroot()

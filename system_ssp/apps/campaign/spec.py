@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
+from .. import DEFAULT_SSP_DIR
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -258,8 +259,6 @@ def _metric(path, name, m):
 def resolve_system(name, spec_path):
     """A campaign's system: a path (relative to the spec's folder or the working directory), or
     the name of a built system (build/ssp/<name>.ssp)."""
-    from .. import DEFAULT_SSP_DIR
-
     for candidate in (Path(name), Path(spec_path).parent / name, DEFAULT_SSP_DIR / f"{name}.ssp",
                       DEFAULT_SSP_DIR / name):
         if candidate.exists():

@@ -8,6 +8,8 @@ import time
 
 import numpy as np
 
+from components.environment import space_weather
+
 from ...errors import RunTimedOut, SSPError
 from ...master import System
 
@@ -24,8 +26,6 @@ def _system(path):
 def _solar_activity(values, workdir):
     """Helper `solar_activity`: a copy of the space-weather file with F10.7 scaled by @f107_scale,
     given to the orbit (and any atmosphere) FMU; returns (parameters, files to delete after)."""
-    from components.environment import space_weather
-
     scale = values.get("@f107_scale", 1.0)
     path = os.path.join(workdir, f"neighbor_cssi_{os.getpid()}_x{scale!r}.txt")
     space_weather.scaled_copy(scale, path)
