@@ -1,9 +1,14 @@
 """The product's applications on top of the master: the thesis validation cases (`thesis`), the
 de-orbit lifetime study (`deorbit_study`) and the NEIGHBOR mission (`mission`). Each has a
 `main(argv)` behind a subcommand of `neighbor-cosim` / `python -m system_ssp`."""
+from contextlib import contextmanager
 import logging
 from pathlib import Path
 import sys
+
+from ..atomic import StagedFolder
+from ..errors import RunInterrupted, RunTimedOut, SimulationError
+from ..master import write_result
 
 # Where `python build_fmus.py` packs the systems, in a source checkout (the documented install).
 DEFAULT_SSP_DIR = Path(__file__).resolve().parents[2] / "build" / "ssp"
@@ -42,3 +47,24 @@ def console_settings(args):
     if args.quiet:
         return False
     return bool(args.progress) or sys.stderr.isatty()
+
+
+@contextmanager
+def staged_results(out, partial_name):
+    """An application's results folder as one unit: a StagedFolder for `out` (None without `out`),
+    created now so that an unwritable place is refused before any run. The body writes into its
+    `.path` and calls `.commit()`. A run that stops (failed, interrupted, timed out) leaves its
+    rows in `partial_name(err)` inside <out>.partial; any other failure removes the staging."""
+    staged = StagedFolder(out) if out is not None else None
+    try:
+        yield staged
+    except (SimulationError, RunInterrupted, RunTimedOut) as err:
+        if staged is not None:
+            if err.result is not None:
+                write_result(err.result.data, staged.path / partial_name(err), err.result.units)
+            err.partial_file = staged.commit_partial(str(err))
+        raise
+    except BaseException:
+        if staged is not None:
+            staged.discard()
+        raise

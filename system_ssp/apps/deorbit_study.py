@@ -26,11 +26,11 @@ from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
 
-from ..atomic import StagedFolder, atomic_write, write_text_atomic
-from ..errors import RunInterrupted, SimulationError, SSPError
+from ..atomic import atomic_write, write_text_atomic
+from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
 
 KM = 1000.0
 SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
@@ -62,25 +62,14 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
     overrides = {"orbit.density_model": density, "orbit.space_weather_file": space_weather_file}
-    staged = StagedFolder(out) if out is not None else None  # refused now, not after the runs
-    try:
+    with staged_results(out, lambda err: f"{err.run}.partial.csv") as staged:
         summary = _run_all(ssp, scenarios, model, density, overrides, max_years, progress,
                            staged.path if staged else None)
-    except (SimulationError, RunInterrupted) as err:
         if staged is not None:
-            if err.result is not None:
-                write_result(err.result.data, staged.path / f"{err.run}.partial.csv", err.result.units)
-            err.partial_file = staged.commit_partial(str(err))
-        raise
-    except BaseException:
-        if staged is not None:
-            staged.discard()
-        raise
-    if staged is not None:
-        write_text_atomic(staged.path / "summary.json", json.dumps(summary, indent=1))
-        write_text_atomic(staged.path / "table.md", table(summary))
-        plot(summary, staged.path)
-        staged.commit()
+            write_text_atomic(staged.path / "summary.json", json.dumps(summary, indent=1))
+            write_text_atomic(staged.path / "table.md", table(summary))
+            plot(summary, staged.path)
+            staged.commit()
     return summary
 
 
@@ -96,7 +85,7 @@ def _run_all(ssp, scenarios, model, density, overrides, max_years, progress, out
                 try:
                     r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
                                    outputs=RECORD, progress=progress)
-                except (SimulationError, RunInterrupted) as err:
+                except (SimulationError, RunInterrupted, RunTimedOut) as err:
                     err.run = run
                     raise
                 reentered = bool(r.final["orbit.reentered"])

@@ -25,11 +25,11 @@ import numpy as np
 from components.core.constants import DAY, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
 
-from ..atomic import StagedFolder, atomic_write, write_text_atomic
-from ..errors import RunInterrupted, SimulationError, SSPError
+from ..atomic import atomic_write, write_text_atomic
+from ..errors import SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
@@ -63,31 +63,16 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
         raise SSPError(f"--max-years {max_years:g}: must be a positive number of years (the longest the mission "
                        "may run before re-entry)")
     ssv = PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"
-    staged = StagedFolder(out) if out is not None else None  # refused now, not after the run
-    try:
+    with staged_results(out, lambda err: "timeseries.csv") as staged:
         with System(ssp) as system:
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
                            outputs=RECORD, profile=profile, progress=progress)
-    except (SimulationError, RunInterrupted) as err:
+        s = summarize(r, scenario, orbit)
         if staged is not None:
-            if err.result is not None:
-                write_result(err.result.data, staged.path / "timeseries.csv", err.result.units)
-            err.partial_file = staged.commit_partial(str(err))
-        raise
-    except BaseException:
-        if staged is not None:
-            staged.discard()
-        raise
-    s = summarize(r, scenario, orbit)
-    if staged is not None:
-        try:
             write_result(r.data, staged.path / "timeseries.csv", r.units)
             write_text_atomic(staged.path / "summary.json", json.dumps(s, indent=1))
             plot(r.data, s, staged.path)
-        except BaseException:
-            staged.discard()
-            raise
-        staged.commit()
+            staged.commit()
     return s, r
 
 

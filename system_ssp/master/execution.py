@@ -84,12 +84,8 @@ class _Run:
                 bar.close()  # also when a step failed
         algorithm.finish(info)
         reason = f"stop condition {info.fired} at t={info.t:g} s" if info.fired is not None else "reached stop time"
-        return Result(data=recorder.data(), stop_time=info.t, stop_reason=reason, steps=info.steps,
-                      final=table.final(), wall_time=0.0, start_time=plan.start,
-                      step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
-                      order=[system.comps[i].name for i in plan.order], messages=table.messages(),
-                      modes=algorithm.statistics(), profile=profiler.report() if profiler else None,
-                      units=self.units())
+        return self.result(recorder.data(), info.t, reason, final=table.final(), modes=algorithm.statistics(),
+                           profile=profiler.report() if profiler else None)
 
     def record_last(self):
         """Record the communication point reached (the FMUs are healthy: an interruption)."""
@@ -99,15 +95,20 @@ class _Run:
 
     def partial(self, reason):
         """A Result with the rows recorded so far, or None before the first row."""
-        r, info, plan = self.recorder, self.info, self.plan
+        r = self.recorder
         if r is None or r.count == 0:
             return None
         data = r.data()
-        return Result(data=data, stop_time=float(data["time"][-1]), stop_reason=reason, steps=info.steps, final={},
+        return self.result(data, float(data["time"][-1]), reason, final={}, partial=True)
+
+    def result(self, data, stop_time, reason, final, **extra):
+        """A Result of this run (wall_time 0: the caller measures it)."""
+        plan = self.plan
+        return Result(data=data, stop_time=stop_time, stop_reason=reason, steps=self.info.steps, final=final,
                       wall_time=0.0, start_time=plan.start,
                       step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
                       order=[self.system.comps[i].name for i in plan.order], messages=self.table.messages(),
-                      units=self.units(), partial=True)
+                      units=self.units(), **extra)
 
     def units(self):
         comps = self.system.comps
