@@ -15,7 +15,8 @@ import sys
 import traceback
 
 from . import __version__
-from .apps import add_console_arguments, campaign, console_settings, deorbit_study, mission, replace, thesis
+from .apps import (add_console_arguments, campaign, console_settings, deorbit_study, mission, parse_sets, replace,
+                   thesis)
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.info import system_info
@@ -71,16 +72,6 @@ def _parser():
     sub.add_parser("mission", add_help=False,
                    help="run the NEIGHBOR mission from deployment to re-entry and write its figures")
     return ap
-
-
-def _parse_sets(items):
-    out = {}
-    for s in items:
-        if "=" not in s:
-            raise SSPError(f"--set {s!r}: expected component.variable=value")
-        k, v = s.split("=", 1)
-        out[k.strip()] = v.strip()
-    return out
 
 
 def _parse_multiples(items):
@@ -160,7 +151,7 @@ def _run_or_info(argv):
         progress = console_settings(args)
         result = system.run(
             stop_time=args.stop_time, step_size=args.step_size, start_time=args.start_time,
-            parameters=_parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
+            parameters=parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
             algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
             stop_when=args.stop_when, output_file=args.output, progress=progress,
             record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile)

@@ -7,7 +7,7 @@ from pathlib import Path
 import sys
 
 from ..atomic import StagedFolder
-from ..errors import RunInterrupted, RunTimedOut, SimulationError
+from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import write_result
 
 # Where `python build_fmus.py` packs the systems, in a source checkout (the documented install).
@@ -68,3 +68,14 @@ def staged_results(out, partial_name):
         if staged is not None:
             staged.discard()
         raise
+
+
+def parse_sets(items):
+    """--set COMP.VAR=VALUE arguments as {name: value text} (the master converts and checks)."""
+    out = {}
+    for item in items:
+        if "=" not in item:
+            raise SSPError(f"--set {item!r}: expected component.variable=value")
+        k, v = item.split("=", 1)
+        out[k.strip()] = v.strip()
+    return out

@@ -2,6 +2,7 @@
 figures and a summary beside the published numbers.
 
     neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell] [--out results/mission]
+                           [--ssv FILE] [--set COMP.VAR=VALUE]
 
 Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
 minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
@@ -29,7 +30,7 @@ from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
@@ -50,8 +51,10 @@ RECORD = (["mission.mode", "mission.phase", "host.heartbeat", "orbit.sma", "orbi
 
 
 def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
-                parameters=None, profile=False, progress=False):
-    """Run the mission; returns (summary dict, Result). Writes the results folder if `out`."""
+                parameters=None, profile=False, progress=False, parameter_sets=()):
+    """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
+    `parameter_sets` (files, names component.variable) apply after the scenario's set and
+    `parameters` ({component.variable: value}) after them."""
     if orbit not in SYSTEMS:
         raise SSPError(f"unknown orbit model {orbit!r} (expected one of: {', '.join(SYSTEMS)})")
     if scenario not in SCENARIOS:
@@ -65,7 +68,8 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
     ssv = PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"
     with staged_results(out, lambda err: "timeseries.csv") as staged:
         with System(ssp) as system:
-            r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=parameters or {},
+            r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv), *parameter_sets],
+                           parameters=parameters or {},
                            outputs=RECORD, profile=profile, progress=progress)
         s = summarize(r, scenario, orbit)
         if staged is not None:
@@ -259,11 +263,16 @@ def main(argv=None):
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)
     ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--ssv", action="append", default=[], metavar="FILE",
+                    help="extra parameter set after the scenario's, names component.variable (repeatable)")
+    ap.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
+                    help="override a parameter or start value, after every parameter set (repeatable)")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
-    s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years, profile=args.profile,
-                       progress=progress)
+    s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years,
+                       parameters=parse_sets(args.set), profile=args.profile, progress=progress,
+                       parameter_sets=args.ssv)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:

@@ -12,6 +12,7 @@ import pytest
 from paths import REPO
 from system_ssp import SimulationError, SSPError, System, cli
 from system_ssp.apps import mission
+from system_ssp.systems import PARAMETERS_DIR
 
 THESIS = mission.THESIS
 
@@ -165,3 +166,32 @@ def test_interrupted_mission_leaves_a_marked_partial_folder(ssp_paths, tmp_path)
     assert "interrupted (SIGINT)" in (partial / "PARTIAL.txt").read_text()
     assert (partial / "timeseries.csv").read_text().startswith("time,mission.mode")
     assert sorted(p.name for p in tmp_path.iterdir()) == ["m", "m.partial"]
+
+
+def mission_power_capacity():
+    text = (PARAMETERS_DIR / "mission_power.ssv").read_text()
+    return float(text.split('name="capacity"><ssv:Real value="')[1].split('"')[0])
+
+
+def test_mission_command_takes_set_and_ssv(ssp_paths, tmp_path, capsys):
+    """--ssv applies after the scenario's parameter set and --set after both, as on `run`:
+    a value each one sets reaches the run (a bad one is refused at initialization, naming it)."""
+    extra = tmp_path / "extra.ssv"
+    extra.write_text('<?xml version="1.0" encoding="UTF-8"?>\n<ssv:ParameterSet xmlns:ssv="http://ssp-standard.org/'
+                     'SSP1/SystemStructureParameterValues" version="1.0" name="extra"><ssv:Parameters>'
+                     '<ssv:Parameter name="power.capacity"><ssv:Real value="-5"/></ssv:Parameter>'
+                     '</ssv:Parameters></ssv:ParameterSet>\n')
+    base = ["mission", "--ssp-dir", str(ssp_paths["neighbor_mission"].parent), "--out", str(tmp_path / "m"),
+            "--max-years", "0.0001", "--quiet"]
+    assert cli.main(base + ["--ssv", str(extra)]) == 2
+    assert "capacity" in capsys.readouterr().err
+    assert cli.main(base + ["--ssv", str(extra), "--set", "power.capacity=20", "--set", "mission.grace_period=-1"]) == 2
+    err = capsys.readouterr().err
+    assert "grace_period" in err and "capacity" not in err  # --set overrode the set's bad capacity
+    _, r = mission.run_mission("420km", ssp_dir=ssp_paths["neighbor_mission"].parent, max_years=0.0001,
+                               parameter_sets=[str(extra)], parameters={"power.capacity": "33000"})
+    # the overriding capacity, not the scenario's
+    assert r.data["power.energy"][0] == pytest.approx(33000.0 * r.data["power.state_of_charge"][0])
+    assert mission_power_capacity() != 33000.0
+    assert cli.main(base + ["--set", "power.capacity"]) == 2
+    assert "--set 'power.capacity': expected component.variable=value" in capsys.readouterr().err
