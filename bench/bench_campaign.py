@@ -57,7 +57,12 @@ def _warm(spec):
     run_one(spec, 0)
 
 
-def campaign_time(spec, workers, folder):
+def in_worker_run_time(folder):
+    """Sum of the runs' own wall times as the workers measured them (the rows' wall_s)."""
+    return sum(r["wall_s"] for r in runner._read_rows(Path(folder)))
+
+
+def campaign_time(spec, workers, folder, batch=1):
     """(cluster start-up s, each worker's first load and run s, campaign s with warm workers)."""
     t0 = time.perf_counter()
     client, cluster = runner._client(workers, None)
@@ -71,7 +76,8 @@ def campaign_time(spec, workers, folder):
     t0 = time.perf_counter()
     try:
         out = runner._prepare_folder(spec, folder)
-        runner._run(client, spec, out, list(range(spec.total_runs)), runner._columns(spec), False, as_completed)
+        runner._run(client, spec, out, list(range(spec.total_runs)), runner._columns(spec), False, as_completed,
+                    batch)
     finally:
         client.close()
         cluster.close()
@@ -83,6 +89,7 @@ def main():
     ap.add_argument("--case", choices=list(CASES), default="deorbit")
     ap.add_argument("--runs", type=int, default=8)
     ap.add_argument("--workers", type=int, default=2)
+    ap.add_argument("--batch", type=int, default=1, help="runs per task (as campaign --batch)")
     args = ap.parse_args()
     with tempfile.TemporaryDirectory() as tmp:
         tmp = Path(tmp)
@@ -100,7 +107,17 @@ def main():
         print(f"campaign, 1 worker:  {t1:.2f} s: {overhead * 1e3:+.1f} ms per run, {100 * overhead / per:+.1f} % of a "
               f"warm run (once per campaign: {start1:.2f} s cluster start-up, {warm1:.2f} s the worker's first "
               "load and run)")
-        startn, warmn, tn = campaign_time(spec, args.workers, tmp / "n")
+        runs1 = in_worker_run_time(tmp / "one")
+        print(f"  of which the runs themselves, timed in the worker: {runs1:.2f} s ({100 * (runs1 / seq - 1):+.1f} % "
+              f"against this process); the machinery (tasks, rows): {(t1 - runs1) / spec.total_runs * 1e3:.1f} ms "
+              "per run")
+        if args.batch > 1:
+            _, _, tb = campaign_time(spec, 1, tmp / "batch", args.batch)
+            runsb = in_worker_run_time(tmp / "batch")
+            n = spec.total_runs
+            print(f"campaign, 1 worker, {args.batch} runs per task: {tb:.2f} s: {(tb - seq) / n * 1e3:+.1f} ms per "
+                  f"run; runs in the worker {runsb:.2f} s, machinery {(tb - runsb) / n * 1e3:.1f} ms per run")
+        startn, warmn, tn = campaign_time(spec, args.workers, tmp / "n", args.batch)
         eff = seq / (args.workers * tn)
         print(f"campaign, {args.workers} workers: {tn:.2f} s: {seq / tn:.2f}x the one process, parallel efficiency "
               f"{100 * eff:.0f} % (once: {startn:.2f} s start-up, {warmn:.2f} s first load and run per worker)")

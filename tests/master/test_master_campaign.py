@@ -44,7 +44,8 @@ values = [0.0, 0.05]
 [metrics]
 x = "final:integ.x"
 """)
-    s = run_campaign(spec, tmp_path / "out", workers=2)
+    # two runs per task: a crash takes its task-mate down, which is then run alone and gets through
+    s = run_campaign(spec, tmp_path / "out", workers=2, batch=2)
     rows = _rows(tmp_path / "out")
     assert len(rows) == 4 and s["runs"] == 4
     for r in rows:

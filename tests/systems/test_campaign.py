@@ -80,7 +80,7 @@ def test_draws_depend_on_seed_and_index_only(ssp_paths, tmp_path):
 def test_one_and_two_workers_give_the_same_rows_and_resume_skips(ssp_paths, tmp_path):
     spec = _spec(tmp_path, DETUMBLE.format(system=ssp_paths["detumble"], runs=3))
     s1 = run_campaign(spec, tmp_path / "one", workers=1)
-    s2 = run_campaign(spec, tmp_path / "two", workers=2)
+    s2 = run_campaign(spec, tmp_path / "two", workers=2, batch=2)  # two runs per task: the same rows
     assert _rows(tmp_path / "one") == _rows(tmp_path / "two")
     rows = _rows(tmp_path / "one")
     assert [r["run"] for r in rows] == list(range(6))

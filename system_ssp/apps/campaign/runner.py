@@ -33,7 +33,7 @@ from ...atomic import atomic_write, write_text_atomic
 from ...errors import SSPError
 from .. import add_console_arguments, console_settings
 from .spec import load_spec
-from .worker import run_one
+from .worker import run_batch
 
 FLUSH_SECONDS = 2.0
 
@@ -103,9 +103,12 @@ def _client(workers, scheduler):
     return Client(cluster), cluster
 
 
-def run_campaign(spec, out, workers=None, scheduler=None, progress=False):
-    """Run (or resume) campaign `spec` (a CampaignSpec or a spec path) into folder `out`; returns
-    the summary dict."""
+def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=1):
+    """Run (or resume) campaign `spec` (a CampaignSpec or a spec path) into folder `out`, `batch`
+    runs per Dask task (more for short runs: each task costs a round trip of about 10 ms);
+    returns the summary dict."""
+    if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
+        raise SSPError(f"--batch {batch!r}: expected an integer >= 1")
     from dask.distributed import as_completed
 
     if not hasattr(spec, "inputs"):
@@ -117,7 +120,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False):
     if todo:
         client, cluster = _client(workers, scheduler)
         try:
-            _run(client, spec, out, todo, columns, progress, as_completed)
+            _run(client, spec, out, todo, columns, progress, as_completed, batch)
         finally:
             client.close()
             if cluster is not None:
@@ -131,9 +134,16 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False):
     return summary
 
 
-def _run(client, spec, out, todo, columns, progress, as_completed):
+def _run(client, spec, out, todo, columns, progress, as_completed, batch=1):
+    """Submit the runs `todo` in tasks of `batch` runs, write their rows as they come. A task
+    whose worker died is split: each of its runs is submitted alone, and a run that kills a
+    worker alone too is a failed row."""
     spec_future = client.scatter(spec, broadcast=True)
-    futures = {client.submit(run_one, spec_future, i, pure=False, key=f"run-{i}-{time.time_ns()}"): i for i in todo}
+
+    def submit(runs):
+        return client.submit(run_batch, spec_future, runs, pure=False, key=f"runs-{runs[0]}-{time.time_ns()}")
+
+    futures = {submit(todo[k:k + batch]): tuple(todo[k:k + batch]) for k in range(0, len(todo), batch)}
     buffer, last = [], time.monotonic()
     bar = None
     if progress:
@@ -147,27 +157,24 @@ def _run(client, spec, out, todo, columns, progress, as_completed):
             _write_rows(out / "runs" / f"part-{first:07d}-{time.time_ns()}.parquet", buffer, columns)
             buffer.clear()
 
-    retried = set()
+    alone = set()  # runs already retried in a task of their own
     try:
         pending = as_completed(futures)
         for fut in pending:
-            i = futures[fut]
+            runs = futures[fut]
             try:
-                row = fut.result()
+                rows = fut.result()
             except Exception as exc:  # the worker died (KilledWorker) or could not run the task
-                if i not in retried:  # once more: it may have been queued beside the run that crashed
-                    retried.add(i)
-                    again = client.submit(run_one, spec_future, i, pure=False, key=f"run-{i}-{time.time_ns()}")
-                    futures[again] = i
+                retry = [i for i in runs if i not in alone]
+                for i in retry:  # alone: a run queued or batched beside the one that crashed gets through
+                    alone.add(i)
+                    again = submit([i])
+                    futures[again] = (i,)
                     pending.add(again)
-                    continue
-                seed, values = spec.inputs(i)
-                row = {"run": i, "seed": seed, **values, "status": "failed",
-                       "error": f"the worker running it died ({type(exc).__name__}: {exc}); an FMU may have "
-                                "crashed its process", "wall_s": math.nan}
-            buffer.append(row)
+                rows = [_died(spec, i, exc) for i in runs if i not in retry]
+            buffer.extend(rows)
             if bar is not None:
-                bar.update(1)
+                bar.update(len(rows))
             if time.monotonic() - last > FLUSH_SECONDS:
                 flush()
                 last = time.monotonic()
@@ -176,6 +183,13 @@ def _run(client, spec, out, todo, columns, progress, as_completed):
         if bar is not None:
             bar.close()
         client.cancel(list(futures))
+
+
+def _died(spec, i, exc):
+    seed, values = spec.inputs(i)
+    return {"run": i, "seed": seed, **values, "status": "failed",
+            "error": f"the worker running it died ({type(exc).__name__}: {exc}); an FMU may have crashed its process",
+            "wall_s": math.nan}
 
 
 def _json(x):
@@ -297,6 +311,8 @@ def main(argv=None):
     ap.add_argument("--out", required=True, help="results folder (the same spec into the same folder resumes)")
     ap.add_argument("--workers", type=int, help="local worker processes (default: the machine's cores)")
     ap.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786) instead")
+    ap.add_argument("--batch", type=int, default=1,
+                    help="runs per Dask task (default 1; more for runs shorter than a second)")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
@@ -304,7 +320,7 @@ def main(argv=None):
         raise SSPError(f"--workers {args.workers}: expected a number >= 1")
     spec = load_spec(args.spec)
     print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {args.out}", file=sys.stderr)
-    s = run_campaign(spec, args.out, args.workers, args.scheduler, progress)
+    s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
     print(table(s))
     print(f"results in {args.out} (runs.parquet, summary.json, figures/)")
     return 0

@@ -94,3 +94,8 @@ def run_one(spec, index):
                 pass
     row["wall_s"] = time.perf_counter() - w0
     return row
+
+
+def run_batch(spec, runs):
+    """The rows of several runs, one after another in this worker (one Dask task)."""
+    return [run_one(spec, i) for i in runs]
