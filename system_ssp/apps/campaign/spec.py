@@ -113,10 +113,6 @@ class CampaignSpec:
         return out
 
 
-def _where(path, key):
-    return f"{path}: [{key}]" if "." not in key else f"{path}: {key}"
-
-
 def _number(path, key, value, low=-math.inf, integer=False, positive=False):
     ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
     if ok and integer:
