@@ -32,6 +32,11 @@ PARAMETERS = (
                                           "radio on only during the contact (Appendix I)"),
     ("beacon_interval", "s", float, "Monitoring: beacon (GPS + UHF) only in a contact starting at least this long "
                                     "after the last contact used (>= 0; 0: every contact, Appendix I)"),
+    ("detumble_timeout", "s", float, "A detumble not done after this long is retried, then the slew follows anyway "
+                                     "(>= 0; 0: no timeout)"),
+    ("slew_timeout", "s", float, "A slew not done after this long is retried, then the burn follows with the "
+                                 "tracking controller holding the attitude (>= 0; 0: no timeout)"),
+    ("phase_retries", None, int, "Retries of a timed-out detumble or slew before the mission moves on (>= 0)"),
 )
 INPUTS = (
     ("heartbeat", None, bool, "Host spacecraft heartbeat present (HostSpacecraft.heartbeat)"),
@@ -81,6 +86,10 @@ class MissionManager(NeighborSlave):
         self.output("next_event_time", lambda: self.model.next_event_time, "s",
                     "Time of the next internal timed event (wake start/end, grace end, end of attitude "
                     "determination); 1e300 if none")
+        self.output("detumble_timeouts", lambda: self.model.detumble_timeouts, None,
+                    "Detumble phases that timed out so far (each retry counts)", int)
+        self.output("slew_timeouts", lambda: self.model.slew_timeouts, None,
+                    "Slew phases that timed out so far (each retry counts)", int)
         self.output("time_in_mode", lambda: self.model.time_in_mode, "s", "Time since the current mode was entered")
         self.output("time_in_phase", lambda: self.model.time_in_phase, "s",
                     "Time since the current de-orbit phase was entered (0 outside the de-orbit mode)")

@@ -17,7 +17,14 @@ Modes (`mode`):
   5 DEORBIT         sub-phases (`phase`): 1 attitude determination (a fixed
                     attitude_determination_duration, 600 s), 2 detumble (until detumble_done),
                     3 slew to the burn attitude (until slew_done), 4 burn with the attitude held
-                    by the tracking controller (until budget_spent) -> MONITORING
+                    by the tracking controller (until budget_spent) -> MONITORING.
+                    Fault management: a detumble or slew that has not finished after
+                    detumble_timeout / slew_timeout (600 s each; 0: none) is retried
+                    (phase_retries times, default 1: the phase starts over with a fresh timer),
+                    then the mission continues with the next phase: a slew from a tumble not
+                    fully damped, or the burn with the tracking controller pulling the attitude
+                    in. Never waiting until the battery is empty; `detumble_timeouts` and
+                    `slew_timeouts` count what happened. The thesis' phases end long before.
   6 MONITORING      microprocessor quiescent; during ground contacts GPS + UHF on to beacon the
                     position (and downlink stored data) until the battery is empty or re-entry.
                     beacon_interval (default 0: every contact, as Appendix I) lets operators
@@ -83,6 +90,9 @@ PARAMETER_DEFAULTS = {
     "initial_phase": ATTITUDE_DETERMINATION,
     "listen_while_awaiting": False,
     "beacon_interval": 0.0,
+    "detumble_timeout": 600.0,
+    "slew_timeout": 600.0,
+    "phase_retries": 1,
 }
 INPUT_DEFAULTS = {
     "heartbeat": True, "ground_contact": False, "ground_command": False, "detumble_done": False,
@@ -104,7 +114,7 @@ def check_parameters(params):
                          f"{sorted(PARAMETER_DEFAULTS)}")
     p = dict(PARAMETER_DEFAULTS, **params)
     for name in ("grace_period", "wake_period", "wake_duration", "wake_offset", "attitude_determination_duration",
-                 "battery_empty_soc", "beacon_interval"):
+                 "battery_empty_soc", "beacon_interval", "detumble_timeout", "slew_timeout"):
         try:
             p[name] = float(p[name])
         except (TypeError, ValueError):
@@ -124,6 +134,12 @@ def check_parameters(params):
         raise ValueError(f"attitude_determination_duration = {p['attitude_determination_duration']!r} s must be >= 0")
     if p["beacon_interval"] < 0:
         raise ValueError(f"beacon_interval = {p['beacon_interval']!r} s must be >= 0 (0: beacon in every contact)")
+    for name in ("detumble_timeout", "slew_timeout"):
+        if p[name] < 0:
+            raise ValueError(f"{name} = {p[name]!r} s must be >= 0 (0: no timeout)")
+    if isinstance(p["phase_retries"], bool) or not float(p["phase_retries"]).is_integer() or p["phase_retries"] < 0:
+        raise ValueError(f"phase_retries = {p['phase_retries']!r} must be an integer >= 0")
+    p["phase_retries"] = int(p["phase_retries"])
     if not 0 <= p["battery_empty_soc"] < 1:
         raise ValueError(f"battery_empty_soc = {p['battery_empty_soc']!r} must be in [0, 1)")
     if p["initial_mode"] not in (IDLE, GRACE, AWAITING, CONTACT, DEORBIT, MONITORING):
@@ -167,6 +183,8 @@ class MissionManager:
         self.contact_seen = False  # monitoring: ground_contact at the last step start
         self.last_beacon = None  # monitoring: start of the last contact used for a beacon
         self.heartbeat_lost_at = NO_EVENT  # time of the check that found the heartbeat missing
+        self.detumble_timeouts = self.slew_timeouts = 0  # phase timeouts so far (retries included)
+        self.attempt = 0  # retries of the current phase
         self.phase_published = t0  # end of the step that first output the current phase
         mode = self.p["initial_mode"]
         self._enter(mode, t0)
@@ -209,7 +227,8 @@ class MissionManager:
         elif mode == DEORBIT:
             self._enter_phase(ATTITUDE_DETERMINATION, t)
 
-    def _enter_phase(self, phase, t):
+    def _enter_phase(self, phase, t, retry=False):
+        self.attempt = self.attempt + 1 if retry else 0
         self.phase, self.phase_entry = phase, t
         self.phase_published = None  # set at the end of this step
         self.att_det_end = t + self.p["attitude_determination_duration"] if phase == ATTITUDE_DETERMINATION \
@@ -287,6 +306,10 @@ class MissionManager:
                 events.append((self.grace_end, 2, "grace_end"))
         elif self.mode == DEORBIT and self.phase == ATTITUDE_DETERMINATION:
             events.append((self.att_det_end, 3, "att_det_end"))
+        elif self.mode == DEORBIT and self.phase in (DETUMBLE, SLEW):
+            limit = self.p["detumble_timeout" if self.phase == DETUMBLE else "slew_timeout"]
+            if limit > 0:
+                events.append((self.phase_entry + limit, 4, "phase_timeout"))
         if not events:
             return NO_EVENT, None
         time, _, kind = min(events)
@@ -330,6 +353,15 @@ class MissionManager:
                 self._enter(AWAITING, te)
             elif kind == "att_det_end":
                 self._enter_phase(DETUMBLE, te)
+            elif kind == "phase_timeout":
+                if self.phase == DETUMBLE:
+                    self.detumble_timeouts += 1
+                else:
+                    self.slew_timeouts += 1
+                if self.attempt < self.p["phase_retries"]:
+                    self._enter_phase(self.phase, te, retry=True)
+                else:  # the documented fallback: on with the next phase
+                    self._enter_phase(SLEW if self.phase == DETUMBLE else BURN, te)
         self.t = max(t_end, self.t)
         if self.phase_published is None:
             self.phase_published = self.t
@@ -370,8 +402,8 @@ class MissionManager:
 
     # ---- state -----------------------------------------------------------------------------
     _STATE = ("t", "mode", "phase", "end_reason", "mode_entry", "phase_entry", "awake", "wake_end", "next_wake_k",
-              "grace_end", "att_det_end", "confirmed", "in_contact", "contact_seen", "last_beacon", "heartbeat_lost_at",
-              "phase_published")
+              "attempt", "detumble_timeouts", "slew_timeouts", "grace_end", "att_det_end", "confirmed", "in_contact",
+              "contact_seen", "last_beacon", "heartbeat_lost_at", "phase_published")
 
     def get_state(self):
         return {k: getattr(self, k) for k in self._STATE}

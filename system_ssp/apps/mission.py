@@ -41,7 +41,8 @@ THESIS = {"soc_after_burn_percent": 79.65, "energy_used_Wh": 2.2, "energy_left_W
           "tracking_propellant_g": 4.75, "detumble_propellant_g": 2.36, "slew_propellant_g": 4.51,
           "total_propellant_kg": 0.587, "burn_time_min": 38.74, "lifetime_with_burn_years": 2.20,
           "detumble_time_s": 9.97, "slew_time_s": 24.84}
-RECORD = (["mission.mode", "mission.phase", "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
+RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
+           "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
            "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
            "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
            "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
@@ -95,6 +96,11 @@ def summarize(r, scenario, orbit):
          "reentered": bool(r.final["orbit.reentered"])}
     if r.profile:
         s["profile_s"] = r.profile
+    timeouts = {"detumble": int(d["mission.detumble_timeouts"][-1]), "slew": int(d["mission.slew_timeouts"][-1])}
+    s["phase_timeouts"] = timeouts
+    s["fault_management"] = "; ".join(
+        f"the {name} timed out {n} time(s): retried, then the mission went on with the next phase"
+        for name, n in timeouts.items() if n) or "none needed"
 
     def phase_start(p):
         i = _first((mode == MissionMode.DEORBIT) & (phase == p))
@@ -103,7 +109,11 @@ def summarize(r, scenario, orbit):
     i_deorbit = _first(mode == MissionMode.DEORBIT)
     i_mon = _first(mode == MissionMode.MONITORING)
     if i_deorbit is None or i_mon is None:
-        s["error"] = "the de-orbit did not complete (no monitoring mode reached)"
+        where = ("it never started" if i_deorbit is None else
+                 f"it was in phase {DeorbitPhase(int(phase[-1])).name.lower()} when the run ended"
+                 if int(mode[-1]) == MissionMode.DEORBIT else f"the mission ended in mode "
+                 f"{MissionMode(int(mode[-1])).name.lower()}")
+        s["error"] = f"the de-orbit did not complete (no monitoring mode reached): {where}"
         return s
     t0 = float(t[i_deorbit])
     starts = {p: phase_start(p) for p in DeorbitPhase if p != DeorbitPhase.NONE}
@@ -168,6 +178,7 @@ def table(s):
         ours = "-" if value is None else fmt.format(value)
         theirs = ref if isinstance(ref, float) else thesis.get(ref) if ref else None
         lines.append(f"| {label} | {ours} | {'-' if theirs is None else theirs} |")
+    lines.append(f"\nfault management: {s.get('fault_management', '-')}")
     return "\n".join(lines) + "\n"
 
 

@@ -28,6 +28,7 @@ def run(ssp_paths, tmp_path_factory):
 def test_mission_reaches_reentry_through_every_mode(run):
     s, r, _ = run
     assert s["reentered"] and "error" not in s
+    assert s["phase_timeouts"] == {"detumble": 0, "slew": 0} and s["fault_management"] == "none needed"
     for mode in ("idle", "awaiting", "contact", "determination", "detumble", "slew", "burn", "monitoring", "decay"):
         assert r.modes[mode]["steps"] > 0, mode
     # heartbeat lost after 1825 days, grace 30 days, then the first contact: de-orbit ~1855 days
@@ -195,3 +196,18 @@ def test_mission_command_takes_set_and_ssv(ssp_paths, tmp_path, capsys):
     assert mission_power_capacity() != 33000.0
     assert cli.main(base + ["--set", "power.capacity"]) == 2
     assert "--set 'power.capacity': expected component.variable=value" in capsys.readouterr().err
+
+
+def test_off_nominal_mission_finishes_through_phase_timeouts(ssp_paths, tmp_path):
+    """At 14 kg the thesis' detumble law never meets its stop window (it limit-cycles): before
+    the phase timeouts the mission sat in the detumble until the battery was empty and never
+    burned. Now the detumble times out (600 s, retried once), the slew and the burn follow, and
+    the host re-enters; the summary says what happened."""
+    mass = {"dynamics.mass": 14.0, "propulsion.mass0": 14.0, "tracking.mass": 14.0}
+    s, r = mission.run_mission("420km", ssp_dir=ssp_paths["neighbor_mission"].parent, parameters=mass)
+    assert "error" not in s and s["reentered"]
+    assert s["phase_timeouts"] == {"detumble": 2, "slew": 0}
+    assert s["detumble_time_s"] == pytest.approx(1200.0, abs=0.1)
+    assert "the detumble timed out 2 time(s)" in s["fault_management"]
+    assert s["burn_time_min"] == pytest.approx(38.74, abs=0.05)
+    assert s["lifetime_with_burn_years"] < 5.0

@@ -368,7 +368,7 @@ def test_mission_fmu(build_one, tmp_path):
     path = build_one("neighbor_mission.py")
     deps = check_declarations(path)
     assert set(deps) == {"mode", "phase", "end_reason", "next_event_time", "time_in_mode", "time_in_phase",
-                         *LOAD_NAMES, *mm.COMMANDS}
+                         "detumble_timeouts", "slew_timeouts", *LOAD_NAMES, *mm.COMMANDS}
     assert all(d == [] for d in deps.values())  # state outputs: no direct feedthrough
     fmu, vr = instantiate(path, tmp_path, "mission", start_time=1000.0)
     fmu.setReal([vr["grace_period"]], [100.0])
@@ -408,3 +408,37 @@ def test_mission_fmu(build_one, tmp_path):
     fmu.enterInitializationMode()
     with pytest.raises(Exception):
         fmu.exitInitializationMode()
+
+
+def _in_phase(phase, **params):
+    return mm.MissionManager(dict({"initial_mode": mm.DEORBIT, "initial_phase": phase}, **params))
+
+
+def test_a_phase_that_never_finishes_times_out_retries_and_moves_on():
+    """A slew that never reports done (the thesis PD law limit-cycling off-nominal): retried once
+    after slew_timeout, then the burn follows; the mission never waits for an empty battery."""
+    m = _in_phase(mm.SLEW, slew_timeout=100.0)
+    assert m.next_event_time == 100.0
+    m.step(0.0, 100.0, {})
+    assert (m.phase, m.slew_timeouts, m.attempt) == (mm.SLEW, 1, 1) and m.phase_entry == 100.0
+    assert m.next_event_time == 200.0
+    m.step(100.0, 50.0, {})
+    m.step(150.0, 60.0, {})  # the second timeout inside the step, at its exact time
+    assert (m.phase, m.slew_timeouts, m.phase_entry) == (mm.BURN, 2, 200.0)
+    assert m.powered()["tracking_enable"] and m.powered()["burn_enable"]
+    # detumble: no retry with phase_retries = 0, then the slew
+    m = _in_phase(mm.DETUMBLE, detumble_timeout=30.0, phase_retries=0)
+    m.step(0.0, 30.0, {})
+    assert (m.phase, m.detumble_timeouts) == (mm.SLEW, 1)
+    # a phase that finishes in time is not touched; 0 switches the timeout off
+    m = _in_phase(mm.SLEW, slew_timeout=100.0)
+    m.step(0.0, 10.0, {})
+    m.step(10.0, 10.0, {"slew_done": True})
+    assert (m.phase, m.slew_timeouts) == (mm.BURN, 0) and m.next_event_time == 1e300
+    m = _in_phase(mm.SLEW, slew_timeout=0.0)
+    m.step(0.0, 1e6, {})
+    assert m.phase == mm.SLEW and m.next_event_time == 1e300
+    with pytest.raises(ValueError, match=r"slew_timeout = -1.0 s must be >= 0"):
+        _in_phase(mm.SLEW, slew_timeout=-1.0)
+    with pytest.raises(ValueError, match=r"phase_retries = 1.5 must be an integer >= 0"):
+        _in_phase(mm.SLEW, phase_retries=1.5)
