@@ -138,10 +138,10 @@ def _run(client, spec, out, todo, columns, progress, as_completed, batch=1):
     """Submit the runs `todo` in tasks of `batch` runs, write their rows as they come. A task
     whose worker died is split: each of its runs is submitted alone, and a run that kills a
     worker alone too is a failed row."""
-    spec_future = client.scatter(spec, broadcast=True)
-
     def submit(runs):
-        return client.submit(run_batch, spec_future, runs, pure=False, key=f"runs-{runs[0]}-{time.time_ns()}")
+        # the spec goes with each task (a few kB): scattered once, it would be lost with a worker
+        # that an FMU crashed, and the retries that need it with it
+        return client.submit(run_batch, spec, runs, pure=False, key=f"runs-{runs[0]}-{time.time_ns()}")
 
     futures = {submit(todo[k:k + batch]): tuple(todo[k:k + batch]) for k in range(0, len(todo), batch)}
     buffer, last = [], time.monotonic()
