@@ -3,7 +3,7 @@ description and the folder the FMU is extracted to."""
 from fmpy import extract, read_model_description
 
 from ..errors import SSPError
-from ..ssp.units import SI_BASE_UNITS, Unit
+from ..ssp.interface import unit_definitions, variable_unit
 from .names import near
 
 
@@ -18,15 +18,7 @@ class ComponentInfo:
         self.md = md
         self.unzipdir = unzipdir
         self.vars = {v.name: v for v in md.modelVariables}
-        self.unit_defs = {}
-        for u in md.unitDefinitions:
-            b = u.baseUnit
-            if b is None:
-                self.unit_defs[u.name] = Unit(u.name, (0,) * len(SI_BASE_UNITS), 1.0, 0.0)
-            else:
-                exps = tuple(int(getattr(b, n, 0) or 0) for n in SI_BASE_UNITS)
-                self.unit_defs[u.name] = Unit(u.name, exps, float(b.factor if b.factor is not None else 1.0),
-                                              float(b.offset if b.offset is not None else 0.0))
+        self.unit_defs = unit_definitions(md)
         # output name -> set of input names it depends on directly (None = all inputs)
         self.deps = {}
         for unknown in md.outputs:
@@ -35,10 +27,7 @@ class ComponentInfo:
         self.inputs = [v.name for v in md.modelVariables if v.causality == "input"]
 
     def fmu_unit(self, v):
-        if getattr(v, "unit", None):
-            return v.unit
-        dt = getattr(v, "declaredType", None)
-        return getattr(dt, "unit", None) if dt is not None else None
+        return variable_unit(v)
 
     def depends_on_inputs(self, out_name, connected_inputs):
         d = self.deps.get(out_name, None)

@@ -66,21 +66,13 @@ class FmuInterface:
         variables = {}
         for v in md.modelVariables:
             dt = v.declaredType
-            unit = getattr(v, "unit", None) or (getattr(dt, "unit", None) if dt is not None else None)
             variables[v.name] = Variable(
-                name=v.name, causality=v.causality, type=v.type, unit=unit if v.type == "Real" else None,
+                name=v.name, causality=v.causality, type=v.type, unit=variable_unit(v) if v.type == "Real" else None,
                 start=None if v.start is None else str(v.start),
                 min=_limit(v, dt, "min"), max=_limit(v, dt, "max"), description=v.description or "",
                 variability=v.variability)
-        units = {}
-        for u in md.unitDefinitions:
-            b = u.baseUnit
-            exps = tuple(int(getattr(b, n, 0) or 0) for n in SI_BASE_UNITS) if b is not None else (0,) * 8
-            factor = float(b.factor) if b is not None and b.factor is not None else 1.0
-            offset = float(b.offset) if b is not None and b.offset is not None else 0.0
-            units[u.name] = Unit(u.name, exps, factor, offset)
         return cls(Path(path), md.modelName, md.coSimulation.modelIdentifier, md.guid, md.description or "", variables,
-                   units)
+                   unit_definitions(md))
 
     def connectors(self):
         """The variables an SSD declares as connectors (inputs, outputs, parameters)."""
@@ -99,6 +91,26 @@ class FmuInterface:
         return {"path": str(self.path), "model_name": self.model_name, "model_identifier": self.model_identifier,
                 "guid": self.guid, "description": self.description,
                 "variables": [v.as_dict() for v in self.variables.values()]}
+
+
+def variable_unit(v):
+    """The unit of an fmpy ScalarVariable: its own, else its declared type's (None if neither)."""
+    if getattr(v, "unit", None):
+        return v.unit
+    dt = getattr(v, "declaredType", None)
+    return getattr(dt, "unit", None) if dt is not None else None
+
+
+def unit_definitions(md):
+    """{unit name: Unit} of an fmpy ModelDescription's UnitDefinitions."""
+    units = {}
+    for u in md.unitDefinitions:
+        b = u.baseUnit
+        exps = tuple(int(getattr(b, n, 0) or 0) for n in SI_BASE_UNITS) if b is not None else (0,) * len(SI_BASE_UNITS)
+        factor = float(b.factor) if b is not None and b.factor is not None else 1.0
+        offset = float(b.offset) if b is not None and b.offset is not None else 0.0
+        units[u.name] = Unit(u.name, exps, factor, offset)
+    return units
 
 
 def _limit(v, dt, which):
