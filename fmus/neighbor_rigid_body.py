@@ -1,7 +1,9 @@
 """FMU `RigidBody` (instance `dynamics` in the systems): rigid-body attitude dynamics.
 
 Wraps components.attitude.rigid_body.RigidBody: Euler's equation and quaternion kinematics (thesis
-Eq. 4-5, 17-29). Outputs are states, so none depends directly on the torque input.
+Eq. 4-5, 17-31). Outputs are states, so none depends directly on the torque input.
+euler_integrated is the thesis' Eq. 31 (rates integrated into "Euler angles"), for comparing
+with its printed triples; euler123 is the attitude's true 1-2-3 angles.
 
 Momentum wheels: the inputs wheel_torque_B (the wheel motors' torque on the wheels; the body
 feels -wheel_torque_B) and wheel_momentum_B (the wheels' momentum relative to the body) turn
@@ -52,11 +54,22 @@ class RigidBody(NeighborSlave):
         self.input_array("wheel_momentum_B", [0.0, 0.0, 0.0], "N.m.s",
                          "Angular momentum of the wheels relative to the body in B at the step start "
                          "(gyroscopic term omega x h_w); 0 without wheels")
+        # Thesis Eq. 30-31 angles, appended after the wheel inputs for the same reason.
+        self.output_array("euler_integrated", 3, lambda: m().euler_integrated, "rad",
+                          "Body rates integrated from the start angles, angles += omega dt (thesis Eq. 31, the "
+                          "'Euler angles' its scripts print), with the attitude's integrator; not an attitude")
+        self.parameter("euler0_from_q0", True, None,
+                       "Start euler_integrated at the 1-2-3 angles of q0 (Eq. 27-30, as the thesis scripts do); "
+                       "false: at euler0", bool)
+        self.parameter_array("euler0", [0.0, 0.0, 0.0], "rad",
+                             "Start of euler_integrated when euler0_from_q0 is false (to continue a previous "
+                             "maneuver's angles, as the thesis' slews continue its detumbles)")
 
     def build_model(self):
         J = self.inertia(rigid_body.box_inertia)
+        euler0 = None if self.values["euler0_from_q0"] else self.vector("euler0", 3)
         return rigid_body.RigidBody(J, self.vector("q0", 4), self.vector("omega0", 3),
-                                    self.values["integrator"], self.values["max_substep"])
+                                    self.values["integrator"], self.values["max_substep"], euler0)
 
     def do_step(self, current_time, step_size):
         self.model.step(self.vector("torque_B", 3), step_size, self.vector("wheel_torque_B", 3),

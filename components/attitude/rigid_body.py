@@ -11,6 +11,14 @@ Two integrators:
   and the quaternion normalized at the end of each communication step. The default.
 The applied torque is held constant over a communication step (zero-order hold).
 
+Integrated Euler angles (Eq. 30-31): the thesis scripts print "Euler angles" that are not the
+1-2-3 angles of q but the body rates integrated, angles += omega dt, from the 1-2-3 angles of
+the start attitude (Eq. 27-29: zero for the identity, Eq. 30). `euler_integrated` carries them
+with the same integrator as the attitude: "euler" adds the new omega times the step after the
+state update, as Appendix C-D do; "rk4" integrates d(angles)/dt = omega within its sub-steps.
+They are not an attitude representation (body rates are not Euler-angle rates); they match
+the thesis' printed triples, e.g. Eq. 34: 22.32, 53.52, 21.71 deg.
+
 Momentum wheels (optional): with wheel_torque_B (the torque the wheel motors apply to the wheels,
 N.m, B) and wheel_momentum_B (h_w, the wheels' angular momentum relative to the body, N.m.s, B)
 Euler's equation becomes the gyrostat equation (Hughes, Spacecraft Attitude Dynamics, 1986,
@@ -64,7 +72,7 @@ class RigidBody:
     """Attitude state (q_BN, omega_BN_B) of a rigid body under a body-frame torque."""
 
     def __init__(self, inertia, q0=(0.0, 0.0, 0.0, 1.0), omega0=(0.0, 0.0, 0.0), integrator="rk4",
-                 max_substep=0.005):
+                 max_substep=0.005, euler0=None):
         J = check_inertia(inertia)
         if integrator not in INTEGRATORS:
             raise ValueError(f"integrator {integrator!r} must be one of {', '.join(INTEGRATORS)}")
@@ -85,6 +93,12 @@ class RigidBody:
         self.q = q0 if integrator == "euler" else unit_q0
         self.omega = omega0
         self.omega_dot = (0.0, 0.0, 0.0)  # no step taken yet (thesis: w_dot = [0; 0; 0])
+        if euler0 is None:  # the start attitude's 1-2-3 angles (Eq. 27-29), as the scripts begin
+            euler0 = rotations.euler123(unit_q0)
+        euler0 = tuple(float(x) for x in euler0)
+        if len(euler0) != 3 or not all(math.isfinite(x) for x in euler0):
+            raise ValueError(f"euler0 {list(euler0)} must be three finite angles in rad")
+        self.euler_integrated = euler0
 
     # ---- dynamics --------------------------------------------------------------------
     def angular_acceleration(self, omega, torque, wheel_torque=ZERO3, h_w=ZERO3):
@@ -120,20 +134,26 @@ class RigidBody:
             self.q = tuple(q[i] + q_dot[i] * h for i in range(4))
             self.omega = tuple(w[i] + w_dot[i] * h for i in range(3))
             self.omega_dot = w_dot
+            # Eq. 31 after StateChange, with the new rates (Appendix C-D)
+            self.euler_integrated = tuple(self.euler_integrated[i] + self.omega[i] * h for i in range(3))
             return
         n = max(1, math.ceil(h / self.max_substep - 1e-9))
         dt = h / n
         q, w = self.q, self.omega
         w_start = w
+        angles = self.euler_integrated
         for k in range(n):
-            q, w = self._rk4(q, w, torque, dt, tw, hw, k * dt)
+            q, w, turned = self._rk4(q, w, torque, dt, tw, hw, k * dt)
+            angles = tuple(angles[i] + turned[i] for i in range(3))
+        self.euler_integrated = angles
         self.q = rotations.normalized(q)
         self.omega = w
         self.omega_dot = tuple((w[i] - w_start[i]) / h for i in range(3))
 
     def _rk4(self, q, w, torque, dt, tw, hw, s0):
         """One RK4 sub-step from s0 (s after the step start); h_w follows the held wheel
-        torque within the step, h_w(s) = h_w + tw s, as the wheel's own exact integration."""
+        torque within the step, h_w(s) = h_w + tw s, as the wheel's own exact integration.
+        Returns q, omega and the integral of omega over the sub-step (Eq. 31's increment)."""
         f_q, f_w = rotations.quaternion_rate, self.angular_acceleration
         h0, hm, h1 = (tuple(hw[i] + tw[i] * s for i in range(3)) for s in (s0, s0 + 0.5 * dt, s0 + dt))
         k1q, k1w = f_q(q, w), f_w(w, torque, tw, h0)
@@ -147,8 +167,9 @@ class RigidBody:
         w4 = tuple(w[i] + dt * k3w[i] for i in range(3))
         k4q, k4w = f_q(q4, w4), f_w(w4, torque, tw, h1)
         q = tuple(q[i] + dt / 6.0 * (k1q[i] + 2 * k2q[i] + 2 * k3q[i] + k4q[i]) for i in range(4))
+        turned = tuple(dt / 6.0 * (w[i] + 2 * w2[i] + 2 * w3[i] + w4[i]) for i in range(3))
         w = tuple(w[i] + dt / 6.0 * (k1w[i] + 2 * k2w[i] + 2 * k3w[i] + k4w[i]) for i in range(3))
-        return q, w
+        return q, w, turned
 
     # ---- derived quantities ------------------------------------------------------------
     def euler123(self):
@@ -170,9 +191,11 @@ class RigidBody:
 
     # ---- full state for FMU get/set state ------------------------------------------------
     def get_state(self):
-        return {"q": list(self.q), "omega": list(self.omega), "omega_dot": list(self.omega_dot)}
+        return {"q": list(self.q), "omega": list(self.omega), "omega_dot": list(self.omega_dot),
+                "euler_integrated": list(self.euler_integrated)}
 
     def set_state(self, state):
         self.q = tuple(state["q"])
         self.omega = tuple(state["omega"])
         self.omega_dot = tuple(state["omega_dot"])
+        self.euler_integrated = tuple(state["euler_integrated"])

@@ -28,23 +28,32 @@ from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
-# omega in deg/s as printed, durations in s, propellant in g.
+# omega in deg/s as printed, the printed "Euler angles" (Eq. 31: rates integrated, deg),
+# durations in s, propellant in g.
 THESIS = {
     "detumble_case1": dict(duration=9.97, propellant=2.36, q=(0.1460, 0.4400, 0.2256, 0.8573),
-                           omega=(0.0019, 0.0013, -0.0003), source="Eq. 34, section 3.3.9"),
+                           omega=(0.0019, 0.0013, -0.0003), euler=(22.32, 53.52, 21.71),
+                           source="Eq. 34, section 3.3.9"),
     "detumble_case2": dict(duration=9.97, propellant=2.36, q=(0.5928, 0.5193, 0.5026, 0.3566),
-                           omega=(0.0019, 0.0013, -0.0003), source="Eq. 38, section 3.3.9"),
+                           omega=(0.0019, 0.0013, -0.0003), euler=(101.83, 97.64, 9.85),
+                           source="Eq. 38, section 3.3.9"),
     "slew_case1": dict(duration=24.84, propellant=4.51, q=(0.00017, 0.00041, 0.00043, 1.00060),
-                       omega=(-0.0053, -0.0054, -0.0021), source="Eq. 47, section 3.3.9"),
+                       omega=(-0.0053, -0.0054, -0.0021), euler=(8.63, 2.19, -9.74),
+                       source="Eq. 47, section 3.3.9"),
     "slew_case2": dict(duration=38.25, propellant=9.96, q=(0.00027, 0.00039, -0.00012, 1.00125),
-                       omega=(-0.0028, -0.0038, -0.0100), source="Eq. 50, section 3.3.9"),
+                       omega=(-0.0028, -0.0038, -0.0100), euler=(20.72, 33.33, -79.84),
+                       source="Eq. 50, section 3.3.9"),
     "slew_case3_x": dict(duration=32.81, propellant=None, q=(0.8585, 0.2267, -0.4405, -0.1451),
-                         omega=(0.0019, -0.0004, -0.0018), source="Eq. 62"),
+                         omega=(0.0019, -0.0004, -0.0018), euler=(202.17, 53.53, 21.68),
+                         source="Eq. 62"),
     "slew_case3_y": dict(duration=82.5, propellant=None, q=(-0.4412, 0.1453, -0.8585, 0.2282),
-                         omega=(0.0001, -0.0004, 0.0028), source="Eq. 64"),
+                         omega=(0.0001, -0.0004, 0.0028), euler=(202.24, -126.57, 21.85),
+                         source="Eq. 64"),
     "slew_case3_z": dict(duration=50.96, propellant=None, q=(0.1460, 0.4413, 0.2254, 0.8601),
-                         omega=(-0.0034, -0.0083, 0.0029), source="Eq. 66"),
-    "slew_case3": dict(duration=166.26, propellant=16.03, q=None, omega=None, source="section 3.3.7, 3.3.9"),
+                         omega=(-0.0034, -0.0083, 0.0029), euler=(202.15, -126.08, 201.56),
+                         source="Eq. 66"),
+    "slew_case3": dict(duration=166.26, propellant=16.03, q=None, omega=None, euler=None,
+    source="section 3.3.7, 3.3.9"),
 }
 
 AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
@@ -58,6 +67,7 @@ class CaseResult:
     propellant: float  # g
     q: tuple = None
     omega_deg: tuple = None
+    euler_deg: tuple = None  # Eq. 31's integrated angles at the end (deg), as the thesis prints them
     steps: int = 0
     wall_time: float = 0.0
     parts: list = field(default_factory=list)
@@ -68,14 +78,20 @@ class CaseResult:
 
 
 def _state(result):
+    """The end state a following maneuver starts from: q, omega and the Eq. 31 angles (rad)."""
     q = tuple(result.final[f"dynamics.q_BN[{i}]"] for i in range(1, 5))
     w = tuple(result.final[f"dynamics.omega_BN_B[{i}]"] for i in range(1, 4))
-    return q, w
+    e = tuple(result.final[f"dynamics.euler_integrated[{i}]"] for i in range(1, 4))
+    return q, w, e
 
 
-def _initial(q, w):
+def _initial(q, w, e):
+    """Start where the previous maneuver ended; the thesis' slews carry on integrating the
+    detumble's angles (Eq. 39 = Eq. 34)."""
     out = {f"dynamics.q0[{i}]": v for i, v in enumerate(q, 1)}
     out.update({f"dynamics.omega0[{i}]": v for i, v in enumerate(w, 1)})
+    out["dynamics.euler0_from_q0"] = False
+    out.update({f"dynamics.euler0[{i}]": v for i, v in enumerate(e, 1)})
     return out
 
 
@@ -83,30 +99,35 @@ def _case(name, system, integrator, stop_time, parameters=None):
     params = {"dynamics.integrator": integrator}
     params.update(parameters or {})
     result = system.run(parameter_sets=[f"parameters/{name}.ssv"], parameters=params, stop_time=stop_time)
-    q, w = _state(result)
+    q, w, e = end = _state(result)
     converged = result.stop_reason.startswith("stop condition")
     duration = result.stop_time - float(result.data["time"][0])
     res = CaseResult(name, converged, duration, result.final["thrusters.propellant_mass"] * 1e3, q,
-                     tuple(math.degrees(x) for x in w), result.steps, result.wall_time)
-    return res, (q, w)
+                     _degrees(w), _degrees(e), result.steps, result.wall_time)
+    return res, end
+
+
+def _degrees(values):
+    return tuple(math.degrees(x) for x in values)
 
 
 def slew_case3(slew, start, integrator="euler", stop_time=None):
     """Appendix G: 180 deg about x, then y, then z; targets from the start attitude (Eq. 57-59)."""
-    q, w = start
-    target = q
+    end = start
+    target = start[0]
     parts = []
     for axis in "xyz":
         target = rotations.circle_cross(rotations.from_axis_angle(AXES[axis], math.pi), target)
-        params = _initial(q, w)
+        params = _initial(*end)
         params.update({f"slew.q_d[{i}]": v for i, v in enumerate(target, 1)})
-        part, (q, w) = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params)
+        part, end = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params)
         parts.append(part)
         if not part.converged:
             break
+    q, w, e = end
     total = CaseResult("slew_case3", all(p.converged for p in parts) and len(parts) == 3,
                        sum(p.duration for p in parts), sum(p.propellant for p in parts), q,
-                       tuple(math.degrees(x) for x in w), sum(p.steps for p in parts),
+                       _degrees(w), _degrees(e), sum(p.steps for p in parts),
                        sum(p.wall_time for p in parts), parts)
     return total
 
@@ -141,7 +162,8 @@ def _fmt(values, digits):
 def report(results, integrator):
     lines = [f"NEIGHBOR thesis attitude validation cases, integrator={integrator}, 15 ms Gauss-Seidel steps",
              f"{'case':<15}{'done':<6}{'time s':>9}{'thesis':>9}{'prop g':>8}{'thesis':>8}  final q / thesis q;"
-             " final omega deg/s / thesis"]
+             " final omega deg/s / thesis;",
+             f"{'':<55}  Eq. 31 angles deg (rates integrated, not the attitude's 1-2-3 angles) / thesis"]
     for name, r in results.items():
         t = r.thesis
         digits = 5 if name in ("slew_case1", "slew_case2") else 4
@@ -150,6 +172,8 @@ def report(results, integrator):
                      f"{r.propellant:>8.3f}{prop:>8}  {_fmt(r.q, digits)} / {_fmt(t['q'], digits)}")
         if t["omega"] is not None:
             lines.append(f"{'':<55}  {_fmt(r.omega_deg, 4)} / {_fmt(t['omega'], 4)}")
+        if t["euler"] is not None:
+            lines.append(f"{'':<55}  {_fmt(r.euler_deg, 2)} / {_fmt(t['euler'], 2)}")
     return "\n".join(lines)
 
 

@@ -32,6 +32,8 @@ def test_euler_cosimulation_reproduces_thesis(euler_cases, name, q_decimals):
     np.testing.assert_allclose(r.q, t["q"], rtol=0, atol=q_tol)
     np.testing.assert_allclose(r.omega_deg, t["omega"], rtol=0, atol=0.5e-4 + 1e-12)
     assert abs(r.duration - t["duration"]) <= 0.015 + 1e-9
+    # the printed "Euler angles": body rates integrated (Eq. 31), to the printed 0.01 deg
+    np.testing.assert_allclose(r.euler_deg, t["euler"], rtol=0, atol=0.005 + 1e-9)
     if t["propellant"] is not None:
         assert r.propellant == pytest.approx(t["propellant"], abs=0.005)
 
@@ -59,6 +61,8 @@ def test_slew_case_files_start_from_the_cosimulated_detumble_end(euler_cases, ss
                       if p.tag.endswith("}Parameter") and p[0].tag.endswith("}Real")}
             q0 = [values[f"dynamics.q0[{i}]"] for i in range(1, 5)]
             assert q0 == list(euler_cases[det].q), case
+            euler0 = [math.degrees(values[f"dynamics.euler0[{i}]"]) for i in range(1, 4)]
+            np.testing.assert_allclose(euler0, euler_cases[det].euler_deg, rtol=1e-13)
 
 
 def test_rk4_detumble_converges_like_the_thesis(ssp_paths):

@@ -57,15 +57,22 @@ def detumble_end_state(q0):
         cmd, _ = ctrl.command(body.omega, body.omega_dot)
         pairs.step(cmd, DT)
         body.step(pairs.applied_torque(cmd), DT)
-    return list(body.q), list(body.omega)
+    return list(body.q), list(body.omega), list(body.euler_integrated)
 
 
 DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD = [100.0] * 3, [1.0] * 3
 # Appendix D's stop test as printed (omega - omega_d <= tol, no absolute value): the thesis cases
 # use it; everything else the controller's default, |omega - omega_d| <= tol (same end here).
 THESIS_STOP_TEST = {"signed_stop_test": True}
-Q_END_1, W_END_1 = detumble_end_state([0.0, 0.0, 0.0, 1.0])
-Q_END_2, W_END_2 = detumble_end_state(Q0_CASE2)
+Q_END_1, W_END_1, E_END_1 = detumble_end_state([0.0, 0.0, 0.0, 1.0])
+Q_END_2, W_END_2, E_END_2 = detumble_end_state(Q0_CASE2)
+
+
+def continued_angles(euler):
+    """The slews carry on integrating the detumble's Eq. 31 angles (Eq. 39 = Eq. 34)."""
+    return {"euler0_from_q0": False, **vec("euler0", euler)}
+
+
 
 CASES = {
     "detumble_case1": {"description": "Thesis detumble validation case 1 (Eq. 6-7, 32-34)",
@@ -77,11 +84,13 @@ CASES = {
                        "detumble": THESIS_STOP_TEST},
     "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47): from the end state of detumble "
                                   "case 1 (full precision; Eq. 39 prints it to 4 decimals)",
-                   "dynamics": {**vec("q0", Q_END_1), **vec("omega0", W_END_1), "integrator": "euler"},
+                   "dynamics": {**vec("q0", Q_END_1), **vec("omega0", W_END_1), "integrator": "euler",
+                                **continued_angles(E_END_1)},
                    "slew": {**vec("Kd", [17.5] * 3)}},
     "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50): from the end state of detumble "
                                   "case 2 (full precision; Eq. 48 prints it to 4 decimals)",
-                   "dynamics": {**vec("q0", Q_END_2), **vec("omega0", W_END_2), "integrator": "euler"},
+                   "dynamics": {**vec("q0", Q_END_2), **vec("omega0", W_END_2), "integrator": "euler",
+                                **continued_angles(E_END_2)},
                    "slew": {**vec("Kd", [22.5] * 3)}},
 }
 # Slew case 3 (Eq. 51-66, Appendix G): three 180 deg rotations from the end state of
@@ -95,7 +104,8 @@ for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.it
     _target = rotations.circle_cross(_rot, _target)
     CASES[f"slew_case3_{axis}"] = {
         "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 57-66, Appendix G)",
-        "dynamics": ({**vec("q0", Q_END_1), **vec("omega0", W_END_1)} if axis == "x" else {}) | {"integrator": "euler"},
+        "dynamics": ({**vec("q0", Q_END_1), **vec("omega0", W_END_1), **continued_angles(E_END_1)}
+                     if axis == "x" else {}) | {"integrator": "euler"},
         "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), **vec("q_d", list(_target)),
                  "accept_antipodal": True}}
 

@@ -212,3 +212,34 @@ def test_quantize_and_thruster_rounding():
     assert pairs.propellant_mass() == pytest.approx(2 * 0.025 * 3 * DT / (42 * 9.81), rel=1e-15)  # Eq. 74
     with pytest.raises(ValueError, match=r"torque_cmd_B\[2\] = nan must be finite"):
         pairs.flags([0.0, float("nan"), 0.0])
+
+
+def test_integrated_euler_angles_are_eq31():
+    """Eq. 31: angles += omega_new dt after each StateChange (Appendix D), starting from the
+    1-2-3 angles of q0 (Eq. 30 for the identity, Eq. 37 for detumble case 2's q0)."""
+    assert RigidBody(J).euler_integrated == (0.0, 0.0, 0.0)
+    q2 = (0.5597, 0.3484, 0.1653, math.sqrt(1 - 0.5597 ** 2 - 0.3484 ** 2 - 0.1653 ** 2))  # Eq. 36
+    np.testing.assert_allclose(np.degrees(RigidBody(J, q2).euler_integrated), (79.51, 44.12, -11.86), atol=0.005)
+    body = RigidBody(J, (0, 0, 0, 1), (0.1, -0.2, 0.3), "euler", euler0=(1.0, 2.0, 3.0))
+    angles = np.array([1.0, 2.0, 3.0])
+    for _ in range(50):
+        body.step((0.001, -0.002, 0.0025), DT)
+        angles += np.array(body.omega) * DT
+    np.testing.assert_allclose(body.euler_integrated, angles, rtol=0, atol=1e-14)
+
+
+def test_rk4_integrated_angles_follow_a_spin_exactly():
+    """Under rk4 the angles integrate omega with the same stages: a torque-free spin about a
+    principal axis turns by w t exactly, and a constant torque about it gives w0 t + a t^2 / 2."""
+    body = RigidBody(J, (0, 0, 0, 1), (0, 0, 0.2), "rk4")
+    for _ in range(100):
+        body.step((0, 0, 0), DT)
+    np.testing.assert_allclose(body.euler_integrated, (0, 0, 0.2 * 100 * DT), atol=1e-13)
+    body = RigidBody(J, (0, 0, 0, 1), (0, 0, 0.2), "rk4")
+    L = 1e-3
+    for _ in range(100):
+        body.step((0, 0, L), DT)
+    t = 100 * DT
+    assert body.euler_integrated[2] == pytest.approx(0.2 * t + 0.5 * L / J[2][2] * t * t, rel=1e-12)
+    with pytest.raises(ValueError, match="euler0"):
+        RigidBody(J, euler0=(0.0, math.nan, 0.0))
