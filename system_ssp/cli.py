@@ -1,5 +1,6 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `replace`, `compare`, `campaign`, `thesis`, `deorbit-study` and `mission`, and `--version`.
+`info`, `replace`, `compare`, `campaign`, `thesis`, `deorbit-study`, `mission`, `propulsion` and
+`validation`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
@@ -16,14 +17,15 @@ import traceback
 
 from . import __version__
 from .apps import (add_console_arguments, campaign, console_settings, deorbit_study, mission, parse_sets, replace,
-                   thesis)
+                   thesis, validation)
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
-        "replace": replace.main_replace, "compare": replace.main_compare, "campaign": campaign.main}
+        "replace": replace.main_replace, "compare": replace.main_compare, "campaign": campaign.main,
+        "propulsion": mission.main_propulsion, "validation": validation.main}
 
 
 def _parser():
@@ -71,6 +73,12 @@ def _parser():
                    help="run the thesis de-orbit lifetime study (3 scenarios, with and without the burn)")
     sub.add_parser("mission", add_help=False,
                    help="run the NEIGHBOR mission from deployment to re-entry and write its figures")
+    sub.add_parser("propulsion", add_help=False,
+                   help="the propulsion budget (delta-V, propellant, tank, feed lines, assembly mass) from simulated "
+                   "maneuvers, beside the thesis")
+    sub.add_parser("validation", add_help=False,
+                   help="every published thesis number the product reproduces: published, ours, difference, "
+                   "tolerance, and the test that guards it")
     return ap
 
 

@@ -57,3 +57,39 @@ def fmu_paths(built):
 @pytest.fixture(scope="session")
 def ssp_paths(built):
     return built[1]
+
+
+@pytest.fixture(scope="session")
+def thesis_cases(ssp_paths):
+    """The thesis' detumble and slew cases (euler), run once for every test that reads them."""
+    from system_ssp.apps import thesis
+
+    return thesis.run_cases(ssp_paths["detumble"].parent, "euler")
+
+
+@pytest.fixture(scope="session")
+def mission_420km(ssp_paths, tmp_path_factory):
+    """(summary, result, results folder) of one 420 km mission run (orbit-averaged, about a minute)."""
+    from system_ssp.apps import mission
+
+    out = tmp_path_factory.mktemp("mission")
+    summary, result = mission.run_mission("420km", "averaged", ssp_dir=ssp_paths["neighbor_mission"].parent, out=out)
+    return summary, result, out
+
+
+def pytest_sessionfinish(session, exitstatus):
+    """The validation table's guard: every published number whose guarding test ran in this
+    session must have been checked by that test (system_ssp.apps.validation.assert_reproduces)."""
+    from system_ssp.apps import validation
+
+    ran = {item.nodeid.split("[")[0] for item in session.items}
+    missing = []
+    for number in validation.NUMBERS:
+        if number.test not in ran:
+            continue  # a partial run (-k, one file): not this session's business
+        if not any(nodeid.split("[")[0] == number.test for nodeid in validation.CHECKED.get(number.key, ())):
+            missing.append(f"{number.key} (by {number.test})")
+    if missing:
+        session.config.get_terminal_writer().line(
+            "validation table: not checked by the test that guards it: " + ", ".join(missing), red=True)
+        session.exitstatus = 1

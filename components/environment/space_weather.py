@@ -370,3 +370,62 @@ def scaled_copy(factor, dest, source=None):
     with open(dest, "w", encoding="ascii") as f:
         f.write("\n".join(out) + "\n")
     return dest
+
+
+# ap -> Kp x 10 (the standard 28-step conversion, Kp 0o..9o), for writing held geomagnetic levels
+AP_TO_KP10 = {0: 0, 2: 3, 3: 7, 4: 10, 5: 13, 6: 17, 7: 20, 9: 23, 12: 27, 15: 30, 18: 33, 22: 37, 27: 40, 32: 43,
+              39: 47, 48: 50, 56: 53, 67: 57, 80: 60, 94: 63, 111: 67, 132: 70, 154: 73, 179: 77, 207: 80, 236: 83,
+              300: 87, 400: 90}
+
+
+def held_copy(dest, levels, source=None):
+    """Write a CSSI file made of the history of `source` (default: the bundled file) before the
+    first of `levels`, then one entry per level: `levels` is [(date 'YYYY-MM-DD', F10.7 sfu, ap),
+    ...] in date order, F10.7 used for the daily and 81-day means (observed and adjusted) and ap
+    for every 3 h (one of AP_TO_KP10's values). An entry holds until the next one, and the last
+    is held after the file's end (FreeFlyer's behaviour). Stands in for an older file: its
+    predictions as levels, then the last entry it held. Prediction sections are left empty."""
+    if not levels:
+        raise ValueError("held_copy needs at least one (date, F10.7, ap) level")
+    steps, prev = [], -math.inf
+    for date, f107, ap in levels:
+        year, month, day = (int(x) for x in str(date).split("-"))
+        jd = _jd_of_date(year, month, day)
+        f107 = float(f107)
+        if jd <= prev:
+            raise ValueError(f"space-weather levels: {date} is not after the previous level's date")
+        if not (math.isfinite(f107) and 50.0 <= f107 <= 400.0):
+            raise ValueError(f"space-weather level at {date}: F10.7 {f107!r} sfu must be in [50, 400]")
+        if ap not in AP_TO_KP10:
+            raise ValueError(f"space-weather level at {date}: ap {ap!r} must be one of {sorted(AP_TO_KP10)}")
+        steps.append((year, month, day, f107, ap))
+        prev = jd
+    jd_first = _jd_of_date(*steps[0][:3])
+    source = BUNDLED_FILE if source in (None, "") else os.fspath(source)
+    with open(source, encoding="ascii") as f:
+        lines = f.read().splitlines()
+    head, observed, section = [], [], None
+    for line in lines:
+        if line.startswith("BEGIN "):
+            section = line.split()[1]
+        elif line.startswith("END "):
+            section = None
+        elif section == "OBSERVED":
+            if _jd_of_date(int(line[0:4]), int(line[4:7]), int(line[7:10])) < jd_first:
+                observed.append(line)
+        elif section is None and not line.startswith("NUM_") and not observed:
+            head.append(line)
+    if not observed:
+        raise ValueError(f"space-weather file {source!r} has no observed entry before {levels[0][0]}")
+    last = observed[-1]
+    rows = []
+    for year, month, day, f107, ap in steps:
+        kp10 = AP_TO_KP10[ap]
+        rows.append(f"{year:4d} {month:02d} {day:02d}" + last[10:18] + f"{kp10:3d}" * 8 + f"{8 * kp10:4d}"
+                    + f"{ap:4d}" * 9 + last[82:92] + f"{f107:6.1f}" + last[98:100] + f"{f107:6.1f}" * 5)
+    out = head + [f"NUM_OBSERVED_POINTS {len(observed) + len(rows)}", "BEGIN OBSERVED", *observed, *rows,
+                  "END OBSERVED", "NUM_DAILY_PREDICTED_POINTS 0", "BEGIN DAILY_PREDICTED", "END DAILY_PREDICTED",
+                  "NUM_MONTHLY_PREDICTED_POINTS 0", "BEGIN MONTHLY_PREDICTED", "END MONTHLY_PREDICTED"]
+    with open(dest, "w", encoding="ascii") as f:
+        f.write("\n".join(out) + "\n")
+    return dest

@@ -21,7 +21,9 @@ import json
 import math
 from pathlib import Path
 import sys
+import tempfile
 
+from components.environment import space_weather
 from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
@@ -42,6 +44,12 @@ THESIS = {"420km": dict(h0=420.0, target=350.0, delta_v=19.84, propellant=0.564,
                         life_no_burn=25.04, life_burn=3.44, figure=12),
           "525km": dict(h0=525.0, target=300.0, delta_v=63.21, propellant=1.707, burn_min=117.20,
                         life_no_burn=97.41, life_burn=3.19, figure=13)}
+# `--space-weather thesis`: a stand-in for the thesis' space-weather file (docs/models/orbit.md,
+# "Lifetimes"): the bundled history to the scenarios' start, then the solar-cycle-25 maximum at the
+# level the predictions of the time gave (130 sfu, ap 9) and, from 2030, the solar-minimum entry a
+# file of that time ended with and FreeFlyer held for ever after (75 sfu, ap 7).
+THESIS_SPACE_WEATHER = (("2023-01-01", 130.0, 9), ("2030-01-01", 75.0, 7))
+THESIS_SPACE_WEATHER_FILE = "space_weather_thesis.txt"
 RECORD = ["orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",
           "orbit.reentered", "orbit.density", "propulsion.mass", "propulsion.propellant_used",
           "propulsion.burn_time", "propulsion.burning"]
@@ -61,8 +69,12 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
     ssp = Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
-    overrides = {"orbit.density_model": density, "orbit.space_weather_file": space_weather_file}
-    with staged_results(out, lambda err: f"{err.run}.partial.csv") as staged:
+    with staged_results(out, lambda err: f"{err.run}.partial.csv") as staged, \
+            tempfile.TemporaryDirectory(prefix="neighbor_sw_") as tmp:
+        if space_weather_file == "thesis":  # written beside the results, so the run can be repeated
+            space_weather_file = str((staged.path if staged else Path(tmp)) / THESIS_SPACE_WEATHER_FILE)
+            space_weather.held_copy(space_weather_file, THESIS_SPACE_WEATHER)
+        overrides = {"orbit.density_model": density, "orbit.space_weather_file": space_weather_file}
         summary = _run_all(ssp, scenarios, model, density, overrides, max_years, progress,
                            staged.path if staged else None)
         if staged is not None:
@@ -91,6 +103,7 @@ def _run_all(ssp, scenarios, model, density, overrides, max_years, progress, out
                 reentered = bool(r.final["orbit.reentered"])
                 ref = THESIS[name]
                 s = {"scenario": name, "burn": burn, "model": model, "density_model": density,
+                     "space_weather": Path(overrides["orbit.space_weather_file"]).name or "bundled",
                      "reentered": reentered, "lifetime_years": r.stop_time / YEAR,
                      "thesis_lifetime_years": ref["life_burn" if burn else "life_no_burn"],
                      "steps": r.steps, "wall_time_s": r.wall_time,
@@ -123,12 +136,13 @@ def table(summary):
 
         def life(s):
             mark = "" if s["reentered"] else "> "
-            return f"{mark}{s['lifetime_years']:.2f} ({s['thesis_lifetime_years']:.2f})"
+            diff = 100.0 * (s["lifetime_years"] - s["thesis_lifetime_years"]) / s["thesis_lifetime_years"]
+            return f"{mark}{s['lifetime_years']:.2f} ({s['thesis_lifetime_years']:.2f}; {diff:+.0f} %)"
 
         lines.append(f"| {name} | {b['delta_v_m_s']:.2f} ({b['thesis_delta_v_m_s']:.2f}) | "
                      f"{b['propellant_used_kg']:.3f} ({b['thesis_propellant_kg']:.3f}) | "
                      f"{b['burn_time_min']:.2f} ({b['thesis_burn_min']:.2f}) | {life(n)} | {life(b)} | "
-                     f"{b['model']}, {b['density_model']} |")
+                     f"{b['model']}, {b['density_model']}, {b.get('space_weather', 'bundled')} space weather |")
     return "\n".join(lines) + "\n"
 
 
@@ -173,8 +187,9 @@ def main(argv=None):
     ap.add_argument("--model", choices=list(SYSTEMS), default="averaged")
     ap.add_argument("--density", default="jacchia_roberts",
                     help="exponential | harris_priester | msis | jacchia_roberts (default)")
-    ap.add_argument("--space-weather", default="", metavar="FILE",
-                    help="CSSI space-weather file (default: the bundled copy)")
+    ap.add_argument("--space-weather", default="", metavar="FILE|thesis",
+                    help="CSSI space-weather file (default: the bundled copy), or `thesis`: the stand-in for the "
+                    "thesis' file (history to 2023, 130 sfu to 2030, then 75 sfu held; docs/models/orbit.md)")
     ap.add_argument("--scenarios", default=",".join(THESIS), help="comma-separated, e.g. 420km,475km")
     ap.add_argument("--max-years", type=float, default=150.0)
     ap.add_argument("--out", default="results/deorbit_study")

@@ -23,24 +23,30 @@ import sys
 
 import numpy as np
 
-from components.core.constants import DAY, R_EQ, YEAR
+from components.core.constants import DAY, MU_EARTH, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
 
 from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
+from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, propulsion_report, staged_results
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
 WH = 3600.0
-# Thesis figures for the 420 km scenario (sections 3.2, 3.3.9, 3.5, 3.6)
-THESIS = {"soc_after_burn_percent": 79.65, "energy_used_Wh": 2.2, "energy_left_Wh": 8.6,
-          "battery_empty_days_after_burn": 14.0, "max_storage_MB": 0.1, "contacts_to_downlink": 2,
-          "tracking_propellant_g": 4.75, "detumble_propellant_g": 2.36, "slew_propellant_g": 4.51,
-          "total_propellant_kg": 0.587, "burn_time_min": 38.74, "lifetime_with_burn_years": 2.20,
-          "detumble_time_s": 9.97, "slew_time_s": 24.84}
+# Thesis figures per scenario. Every scenario: the attitude validation cases the mission's
+# detumble and slew are (section 3.3.5-3.3.6) and the section 3.2 burn and lifetime; 420 km also the
+# tracking, propellant sizing, power and data budgets (sections 3.3.9, 3.5, 3.6).
+_ATTITUDE = {"detumble_time_s": 9.97, "slew_time_s": 24.84, "detumble_propellant_g": 2.36, "slew_propellant_g": 4.51}
+THESIS = {
+    "420km": {**_ATTITUDE, "burn_time_min": 38.74, "burn_propellant_kg": 0.564, "lifetime_with_burn_years": 2.20,
+              "tracking_propellant_g": 4.75, "total_propellant_kg": 0.587, "soc_after_burn_percent": 79.65,
+              "energy_used_Wh": 2.2, "energy_left_Wh": 8.6, "battery_empty_days_after_burn": 14.0,
+              "max_storage_MB": 0.1, "contacts_to_downlink": 2},
+    "475km": {**_ATTITUDE, "burn_time_min": 67.42, "burn_propellant_kg": 0.982, "lifetime_with_burn_years": 3.44},
+    "525km": {**_ATTITUDE, "burn_time_min": 117.20, "burn_propellant_kg": 1.707, "lifetime_with_burn_years": 3.19},
+}
 RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
            "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
            "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
@@ -48,6 +54,7 @@ RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "missio
            "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
            "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked"]
           + [f"dynamics.omega_BN_B[{i}]" for i in (1, 2, 3)] + [f"dynamics.euler123[{i}]" for i in (1, 2, 3)]
+          + [f"dynamics.euler_integrated[{i}]" for i in (1, 2, 3)]
           + [f"dynamics.q_BN[{i}]" for i in (1, 2, 3, 4)])
 
 
@@ -87,6 +94,21 @@ def _first(mask):
     return int(idx[0]) if idx.size else None
 
 
+def _altitude_at(d, i, orbit):
+    """a - R_eq at row i (km) and what kind of a it is. The averaged orbit's a is a mean element;
+    Cowell's is osculating (a 15-20 km band at 420 km), so there the mean over the orbit before
+    row i is taken when the record holds it (at least 20 rows in the last period)."""
+    a = d["orbit.sma"]
+    if orbit == "averaged":
+        return float(a[i] - R_EQ) / 1e3, "mean"
+    t = d["time"]
+    period = 2.0 * np.pi * np.sqrt(float(a[i]) ** 3 / MU_EARTH)
+    window = (t > t[i] - period) & (t <= t[i])
+    if np.count_nonzero(window) >= 20:
+        return float(np.mean(a[window]) - R_EQ) / 1e3, "mean over the last orbit"
+    return float(a[i] - R_EQ) / 1e3, "osculating"
+
+
 def summarize(r, scenario, orbit):
     d = r.data
     t = d["time"]
@@ -119,7 +141,7 @@ def summarize(r, scenario, orbit):
     starts = {p: phase_start(p) for p in DeorbitPhase if p != DeorbitPhase.NONE}
     t_mon = float(t[i_mon])
     s["deorbit_start_days"] = t0 / DAY
-    s["altitude_at_deorbit_km"] = float(d["orbit.sma"][i_deorbit] - R_EQ) / 1e3
+    s["altitude_at_deorbit_km"], s["altitude_at_deorbit_kind"] = _altitude_at(d, i_deorbit, orbit)
     s["attitude_determination_s"] = starts[DeorbitPhase.DETUMBLE][1] - starts[DeorbitPhase.ATTITUDE_DETERMINATION][1]
     s["detumble_time_s"] = starts[DeorbitPhase.SLEW][1] - starts[DeorbitPhase.DETUMBLE][1]
     s["slew_time_s"] = starts[DeorbitPhase.BURN][1] - starts[DeorbitPhase.SLEW][1]
@@ -146,43 +168,91 @@ def summarize(r, scenario, orbit):
     i_clear = _first(after & (store <= 0.5))
     s["contacts_to_downlink"] = None if i_clear is None else int(np.sum(rises <= i_clear))
     s["lifetime_with_burn_years"] = (r.stop_time - starts[DeorbitPhase.BURN][1]) / YEAR if s["reentered"] else None
-    s["thesis"] = THESIS if scenario == "420km" else {}
+    s["thesis"] = THESIS[scenario]
+    s["propulsion"] = propulsion_report.of_mission(s)
     return s
 
 
 def table(s):
-    rows = [("de-orbit starts (days after deployment)", s.get("deorbit_start_days"), None, "{:.2f}"),
-            ("altitude at de-orbit start (km)", s.get("altitude_at_deorbit_km"), None, "{:.1f}"),
-            ("attitude determination (s)", s.get("attitude_determination_s"), 600.0, "{:.1f}"),
-            ("detumble time (s)", s.get("detumble_time_s"), "detumble_time_s", "{:.2f}"),
-            ("slew time (s)", s.get("slew_time_s"), "slew_time_s", "{:.2f}"),
-            ("burn time (min)", s.get("burn_time_min"), "burn_time_min", "{:.2f}"),
-            ("detumble propellant (g)", s.get("detumble_propellant_g"), "detumble_propellant_g", "{:.3f}"),
-            ("slew propellant (g)", s.get("slew_propellant_g"), "slew_propellant_g", "{:.3f}"),
-            ("tracking propellant during the burn (g)", s.get("tracking_propellant_g"), "tracking_propellant_g",
-             "{:.3f}"),
-            ("total propellant (kg)", s.get("total_propellant_kg"), "total_propellant_kg", "{:.4f}"),
-            ("battery after the de-orbit maneuver (%)", s.get("soc_after_burn_percent"), "soc_after_burn_percent",
-             "{:.2f}"),
-            ("energy used to the end of the burn (Wh)", s.get("energy_used_Wh"), "energy_used_Wh", "{:.3f}"),
-            ("energy left after the burn (Wh)", s.get("energy_left_Wh"), "energy_left_Wh", "{:.3f}"),
-            ("battery empty after the burn (days)", s.get("battery_empty_days_after_burn"),
-             "battery_empty_days_after_burn", "{:.2f}"),
-            ("largest data storage (MB)", s.get("max_storage_MB"), "max_storage_MB", "{:.4f}"),
-            ("contacts after the burn to downlink", s.get("contacts_to_downlink"), "contacts_to_downlink", "{}"),
-            ("re-entry after the burn (years)", s.get("lifetime_with_burn_years"), "lifetime_with_burn_years",
-             "{:.2f}")]
-    thesis = s.get("thesis", {})
-    lines = ["| quantity | this run | thesis |", "|---|---|---|"]
-    for label, value, ref, fmt in rows:
+    """The summary beside the thesis' values (every scenario: what the thesis publishes for it),
+    with the relative difference, then the propulsion budget of the run's propellant."""
+    kind = s.get("altitude_at_deorbit_kind", "mean")
+    rows = [("de-orbit starts (days after deployment)", "deorbit_start_days", "{:.2f}"),
+            (f"altitude at de-orbit start (km, a - R_eq, {kind})", "altitude_at_deorbit_km", "{:.1f}"),
+            ("attitude determination (s)", "attitude_determination_s", "{:.1f}"),
+            ("detumble time (s)", "detumble_time_s", "{:.2f}"),
+            ("slew time (s)", "slew_time_s", "{:.2f}"),
+            ("burn time (min)", "burn_time_min", "{:.2f}"),
+            ("burn propellant (kg)", "burn_propellant_kg", "{:.4f}"),
+            ("detumble propellant (g)", "detumble_propellant_g", "{:.3f}"),
+            ("slew propellant (g)", "slew_propellant_g", "{:.3f}"),
+            ("tracking propellant during the burn (g)", "tracking_propellant_g", "{:.3f}"),
+            ("total propellant (kg; thesis: sized for the worst-case slew)", "total_propellant_kg", "{:.4f}"),
+            ("battery after the de-orbit maneuver (%)", "soc_after_burn_percent", "{:.2f}"),
+            ("energy used to the end of the burn (Wh)", "energy_used_Wh", "{:.3f}"),
+            ("energy left after the burn (Wh)", "energy_left_Wh", "{:.3f}"),
+            ("battery empty after the burn (days)", "battery_empty_days_after_burn", "{:.2f}"),
+            ("largest data storage (MB; thesis: below)", "max_storage_MB", "{:.4f}"),
+            ("contacts after the burn to downlink", "contacts_to_downlink", "{}"),
+            ("re-entry after the burn (years)", "lifetime_with_burn_years", "{:.2f}")]
+    thesis = dict(s.get("thesis", {}))
+    thesis.setdefault("attitude_determination_s", 600.0)  # section 3.4: ten minutes
+    lines = [f"NEIGHBOR mission, {s.get('scenario')} scenario ({s.get('orbit')} orbit)",
+             "| quantity | this run | thesis | difference |", "|---|---|---|---|"]
+    for label, key, fmt in rows:
+        value, ref = s.get(key), thesis.get(key)
         ours = "-" if value is None else fmt.format(value)
-        theirs = ref if isinstance(ref, float) else thesis.get(ref) if ref else None
-        lines.append(f"| {label} | {ours} | {'-' if theirs is None else theirs} |")
+        diff = "-" if value is None or not ref else f"{100.0 * (value - ref) / ref:+.1f} %"
+        lines.append(f"| {label} | {ours} | {'-' if ref is None else ref} | {diff} |")
     lines.append(f"\nfault management: {s.get('fault_management', '-')}")
+    if "propulsion" in s:
+        lines.append("\npropulsion budget for this run's propellant "
+                     "(`neighbor-cosim propulsion` sizes the worst case):")
+        p = s["propulsion"]
+        shown = ("delta_v_m_s", "total_propellant_kg", "volume_cm3", "inner_radius_cm", "shell_mass_g", "assembly_g")
+        lines += [f"  {label}: {fmt.format(p[key])}" for key, label, fmt in propulsion_report.ROWS if key in shown]
     return "\n".join(lines) + "\n"
 
 
+def _envelope(ax, x, y, color, label, max_points=600, **kw):
+    """Plot y(x); a series longer than max_points is drawn as its min/max envelope per bin
+    with the bin mean, so a 15 ms limit cycle over 40 min reads as a band, not a solid block."""
+    if x.size <= max_points:
+        ax.plot(x, y, color=color, label=label, **kw)
+        return
+    edges = np.linspace(0, x.size, max_points + 1).astype(int)
+    xs = x[edges[:-1]]
+    lo = np.minimum.reduceat(y, edges[:-1])
+    hi = np.maximum.reduceat(y, edges[:-1])
+    mean = np.add.reduceat(y, edges[:-1]) / np.diff(edges)
+    ax.fill_between(xs, lo, hi, color=color, alpha=0.25, linewidth=0)
+    ax.plot(xs, mean, color=color, label=f"{label} (bin mean; band: min-max)", **kw)
+
+
+def _phase_spans(ax, t_hours, mode, phase):
+    """Shade the de-orbit phases and mark the mode changes on a time axis in hours."""
+    colors = {DeorbitPhase.ATTITUDE_DETERMINATION: "tab:purple", DeorbitPhase.DETUMBLE: "tab:orange",
+              DeorbitPhase.SLEW: "tab:olive", DeorbitPhase.BURN: "tab:red"}
+    for p, color in colors.items():
+        sel = np.flatnonzero((mode == MissionMode.DEORBIT) & (phase == p))
+        if sel.size:
+            ax.axvspan(t_hours[sel[0]], t_hours[min(sel[-1] + 1, t_hours.size - 1)], color=color, alpha=0.3,
+                       linewidth=0, label=p.name.lower().replace("_", " "))
+    changes = np.flatnonzero(np.diff(mode) != 0) + 1
+    for i in changes:
+        ax.axvline(t_hours[i], color="0.4", linewidth=0.6, linestyle="--")
+        ax.annotate(MissionMode(int(mode[i])).name.lower(), (t_hours[i], 1.0), xycoords=("data", "axes fraction"),
+                    rotation=90, va="top", ha="right", fontsize=7, color="0.3")
+
+
+def _contacts(ax, t_hours, visible, label=True):
+    ax.fill_between(t_hours, 0, 1, where=visible.astype(bool), step="post", transform=ax.get_xaxis_transform(),
+                    color="tab:green", alpha=0.15, linewidth=0, label="ground contact" if label else None)
+
+
 def plot(d, s, out):
+    """The mission's figures (see the module docstring); long series are enveloped, angles are
+    the continuous Eq. 31 angles, phases and contacts are marked, short events get a zoom."""
     import matplotlib
 
     matplotlib.use("Agg")
@@ -197,8 +267,12 @@ def plot(d, s, out):
             fig.savefig(f, dpi=110, format="png")
         plt.close(fig)
 
+    def legend(ax, **kw):
+        ax.legend(fontsize=7, framealpha=0.85, **({"loc": "best"} | kw))
+
     fig, ax = plt.subplots(figsize=(8, 4.5))
-    ax.plot(t / YEAR, (d["orbit.sma"] - R_EQ) / 1e3, label="a - R_eq")
+    kind = "mean elements" if s["orbit"] == "averaged" else "osculating"
+    ax.plot(t / YEAR, (d["orbit.sma"] - R_EQ) / 1e3, label=f"a - R_eq ({kind})")
     ax.plot(t / YEAR, d["orbit.perigee_altitude"] / 1e3, linewidth=0.8, label="perigee altitude")
     if "deorbit_start_days" in s:
         ax.axvline(s["deorbit_start_days"] * DAY / YEAR, color="k", linestyle="--", linewidth=1, label="de-orbit")
@@ -206,7 +280,7 @@ def plot(d, s, out):
     ax.set_xlabel("years since deployment")
     ax.set_ylabel("altitude (km)")
     ax.set_title(f"NEIGHBOR mission, {s['scenario']} scenario ({s['orbit']} orbit), cf. thesis Fig. 11")
-    ax.legend(fontsize=8)
+    legend(ax, loc="lower left")
     ax.grid(alpha=0.3)
     save(fig, "altitude.png")
 
@@ -219,24 +293,26 @@ def plot(d, s, out):
         tt = t[sel] - t[sel][0]
         burn = p == DeorbitPhase.BURN
         fig, axes = plt.subplots(3 if burn else 2, 1, figsize=(8, 8 if burn else 6), sharex=True)
-        for i in (1, 2, 3):
-            axes[0].plot(tt, np.degrees(d[f"dynamics.omega_BN_B[{i}]"][sel]), label=f"omega_{'xyz'[i - 1]}")
-        axes[0].set_ylabel("rate (deg/s)")
+        for i, color in zip((1, 2, 3), ("tab:blue", "tab:orange", "tab:green")):
+            _envelope(axes[0], tt, np.degrees(d[f"dynamics.omega_BN_B[{i}]"][sel]), color, f"omega_{'xyz'[i - 1]}")
+        axes[0].set_ylabel("body rate (deg/s)")
         if p == DeorbitPhase.SLEW:
             for i in (1, 2, 3, 4):
                 axes[1].plot(tt, d[f"dynamics.q_BN[{i}]"][sel], label=f"q{i}")
-            axes[1].set_ylabel("quaternion")
+            axes[1].set_ylabel("quaternion q_BN (-)")
         else:
-            for i in (1, 2, 3):
-                axes[1].plot(tt, np.degrees(d[f"dynamics.euler123[{i}]"][sel]), label=f"1-2-3 angle {i}")
-            axes[1].set_ylabel("angle (deg)")
-        if p == DeorbitPhase.BURN:
-            axes[2].plot(tt, np.degrees(d["tracking.attitude_error"][sel]), color="k", linewidth=0.3,
-                         label="angle from the desired attitude")
+            # Eq. 31's angles (rates integrated) from the phase start: continuous, as the thesis plots
+            for i, color in zip((1, 2, 3), ("tab:blue", "tab:orange", "tab:green")):
+                e = d[f"dynamics.euler_integrated[{i}]"][sel]
+                _envelope(axes[1], tt, np.degrees(e - e[0]), color, ("phi", "theta", "psi")[i - 1])
+            axes[1].set_ylabel("angle turned, Eq. 31 (deg)")
+        if burn:
+            _envelope(axes[2], tt, np.degrees(d["tracking.attitude_error"][sel]), "k",
+                      "angle from the desired attitude", linewidth=0.8)
             axes[2].set_ylabel("tracking error (deg)")
         axes[-1].set_xlabel("time in phase (s)")
         for a in axes:
-            a.legend(fontsize=7, loc="upper right")
+            legend(a, loc="upper left", bbox_to_anchor=(1.01, 1.0))
             a.grid(alpha=0.3)
         axes[0].set_title(title)
         save(fig, name)
@@ -247,23 +323,37 @@ def plot(d, s, out):
         t_end = (s.get("deorbit_start_days", 0) * DAY) + 3 * DAY
         sel = (t >= t[i3] - 3600.0) & (t <= t_end)
         th = (t[sel] - t[i3]) / 3600.0
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        ax.plot(th, 100.0 * d["power.state_of_charge"][sel])
-        ax.set_xlabel("hours since the end of the grace period")
-        ax.set_ylabel("battery state of charge (%)")
-        ax.set_title("Battery through the final contact, de-orbit and first contacts (cf. Fig. 46)")
-        ax.grid(alpha=0.3)
-        save(fig, "battery.png")
-        fig, ax = plt.subplots(figsize=(8, 4.5))
-        ax.plot(th, d["data.storage_used"][sel] / 1e6, label="storage used")
-        ax.fill_between(th, 0, d["ground.visible"][sel].astype(float) * max(d["data.storage_used"].max() / 1e6, 1e-3),
-                        step="post", alpha=0.2, color="tab:green", label="ground contact")
-        ax.set_xlabel("hours since the end of the grace period")
-        ax.set_ylabel("data stored (MB)")
-        ax.set_title("Data storage and downlink (cf. Fig. 47)")
-        ax.legend(fontsize=8)
-        ax.grid(alpha=0.3)
-        save(fig, "data.png")
+        m, ph, vis = mode[sel], phase[sel], d["ground.visible"][sel]
+        store = d["data.storage_used"][sel] / 1e6
+        # the zoom: from just before the de-orbit until the stored data is downlinked
+        i_deorbit = np.flatnonzero(m == MissionMode.DEORBIT)
+        i_mon = np.flatnonzero(m == MissionMode.MONITORING)
+        window = None
+        if i_deorbit.size:
+            after = np.flatnonzero((np.arange(m.size) > (i_mon[0] if i_mon.size else i_deorbit[-1]))
+                                   & (store <= 0.5e-6))
+            t_end_zoom = th[after[0]] if after.size else th[i_deorbit[-1]]
+            window = (th[i_deorbit[0]] - 0.5, t_end_zoom + 0.5)
+        for name, y, ylabel, title in (
+                ("battery.png", 100.0 * d["power.state_of_charge"][sel], "battery state of charge (%)",
+                 "Battery through the final contact, de-orbit and first contacts (cf. Fig. 46)"),
+                ("data.png", store, "data stored (MB)", "Data storage and downlink (cf. Fig. 47)")):
+            fig, (ax, zoom) = plt.subplots(2, 1, figsize=(10, 7))
+            for a, first in ((ax, True), (zoom, False)):
+                a.plot(th, y, color="k" if name == "battery.png" else "tab:blue",
+                       label=("state of charge" if name == "battery.png" else "storage used") if first else None)
+                _contacts(a, th, vis, first)
+                a.set_ylabel(ylabel)
+                a.set_xlabel("hours since the end of the grace period")
+                a.grid(alpha=0.3)
+            ax.set_title(title, fontsize=10)
+            legend(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            if window is not None:
+                _phase_spans(zoom, th, m, ph)
+                zoom.set_xlim(*window)
+                zoom.set_title("zoom: final contact, de-orbit phases (shaded) and the downlink", fontsize=9)
+                legend(zoom, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            save(fig, name)
 
 
 def main(argv=None):
@@ -295,6 +385,39 @@ def main(argv=None):
     if "error" in s:
         print(f"mission incomplete: {s['error']} within --max-years {args.max_years:g}", file=sys.stderr)
         return 1
+    return 0
+
+
+def main_propulsion(argv=None):
+    """`neighbor-cosim propulsion` (system_ssp.apps.propulsion_report): the budget of the worst
+    case and of a mission run, read from --mission or run here."""
+    ap = argparse.ArgumentParser(prog="neighbor-cosim propulsion",
+                                 description=propulsion_report.__doc__.split("\n\n")[0])
+    ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
+    ap.add_argument("--mission", metavar="SUMMARY_JSON",
+                    help="summary.json of a mission run of the scenario (default: run the mission now)")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--json", metavar="FILE", help="also write both budgets as JSON")
+    add_console_arguments(ap)
+    args = ap.parse_args(argv)
+    progress = console_settings(args)
+    if args.mission:
+        path = Path(args.mission)
+        try:
+            summary = json.loads(path.read_text())
+        except (OSError, ValueError) as err:
+            raise SSPError(f"{path}: cannot read a mission summary ({err})") from None
+        if summary.get("scenario") != args.scenario:
+            raise SSPError(f"{path} is a {summary.get('scenario')!r} mission run, not --scenario {args.scenario}")
+    else:
+        summary, _ = run_mission(args.scenario, ssp_dir=args.ssp_dir, progress=progress)
+    budget = propulsion_report.of_mission(summary)
+    worst, _ = propulsion_report.worst_case(summary, args.ssp_dir)
+    print(propulsion_report.report(worst, budget, args.scenario), end="")
+    if args.json:
+        write_text_atomic(Path(args.json), json.dumps({"scenario": args.scenario, "worst_case": worst,
+                                                       "mission": budget, "thesis": propulsion_report.THESIS},
+                                                      indent=1))
     return 0
 
 

@@ -11,11 +11,12 @@ import pytest
 from paths import REPO
 import system_ssp
 from system_ssp.apps import thesis
+from system_ssp.apps.validation import assert_reproduces
 
 
 @pytest.fixture(scope="module")
-def euler_cases(ssp_paths):
-    return thesis.run_cases(ssp_paths["detumble"].parent, "euler")
+def euler_cases(thesis_cases):
+    return thesis_cases
 
 
 # Tolerances: half a unit of the last printed decimal for q and omega; the thesis prints slew
@@ -28,6 +29,13 @@ def euler_cases(ssp_paths):
 def test_euler_cosimulation_reproduces_thesis(euler_cases, name, q_decimals):
     r, t = euler_cases[name], thesis.THESIS[name]
     assert r.converged
+    # the validation table's tolerances (neighbor-cosim validation)
+    assert_reproduces(f"{name}.q", r.q)
+    assert_reproduces(f"{name}.omega", r.omega_deg)
+    assert_reproduces(f"{name}.euler", r.euler_deg)
+    assert_reproduces(f"{name}.duration", r.duration)
+    if t["propellant"] is not None:
+        assert_reproduces(f"{name}.propellant", r.propellant)
     q_tol = 1e-4 if name == "slew_case3_z" else 0.5 * 10 ** -q_decimals + 1e-12
     np.testing.assert_allclose(r.q, t["q"], rtol=0, atol=q_tol)
     np.testing.assert_allclose(r.omega_deg, t["omega"], rtol=0, atol=0.5e-4 + 1e-12)
@@ -45,7 +53,8 @@ def test_euler_durations_and_slew_case3_totals(euler_cases):
     total = euler_cases["slew_case3"]
     assert total.converged and len(total.parts) == 3
     assert total.duration == pytest.approx(166.26, abs=1e-9)  # 32.805 + 82.5 + 50.955
-    assert total.propellant == pytest.approx(16.03, abs=0.005)
+    assert_reproduces("slew_case3.duration", total.duration)
+    assert_reproduces("slew_case3.propellant", total.propellant)
 
 
 def test_slew_case_files_start_from_the_cosimulated_detumble_end(euler_cases, ssp_paths):

@@ -334,8 +334,12 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
             names = [v.name for v in md.modelVariables]
             vr = {v.name: v.valueReference for v in md.modelVariables}
             new = [f"wheel_torque_B[{i}]" for i in (1, 2, 3)] + [f"wheel_momentum_B[{i}]" for i in (1, 2, 3)]
-            assert names[-6:] == new and names[-7] == "H_B[3]"
-            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-6])
+            # then the thesis' Eq. 31 angles, appended after the wheel inputs
+            later = ([f"euler_integrated[{i}]" for i in (1, 2, 3)] + ["euler0_from_q0"]
+                     + [f"euler0[{i}]" for i in (1, 2, 3)])
+            assert names[-13:-7] == new and names[-14] == "H_B[3]" and names[-7:] == later
+            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-13])
+            assert min(vr[n] for n in later) > max(vr[n] for n in new)
             assert names.index("torque_B[1]") < names.index("q_BN[1]")
 
 

@@ -8,6 +8,7 @@ import pytest
 from components.core import constants
 from components.orbit import propulsion as p
 from fmu_helpers import check_declarations, instantiate
+from system_ssp.apps.validation import assert_reproduces
 
 REL = 0.005  # the brief's 0.5 %
 
@@ -24,6 +25,8 @@ def test_deorbit_scenarios_match_thesis(h1, h2, dv, mp, minutes):
     assert s["delta_v"] == pytest.approx(dv, rel=REL)
     assert s["propellant"] == pytest.approx(mp, rel=REL)
     assert s["burn_time"] / 60.0 == pytest.approx(minutes, rel=REL)
+    assert_reproduces(f"deorbit_{h1:.0f}km.delta_v_m_s", s["delta_v"])
+    assert_reproduces(f"deorbit_{h1:.0f}km.propellant_kg", s["propellant"])
     # Eq. 2 is the signed form; the rocket equation inverts
     r1, r2 = constants.R_EQ + h1 * 1e3, constants.R_EQ + h2 * 1e3
     assert p.delta_v_eq2(r1, r2) == pytest.approx(-s["delta_v"], rel=1e-12)
