@@ -30,7 +30,8 @@ from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, propulsion_report, staged_results
+from . import (DEFAULT_SSP_DIR, add_console_arguments, console_settings, deorbit_study, parse_sets, propulsion_report,
+               staged_results, thesis)
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 SCENARIOS = ("420km", "475km", "525km")
@@ -38,15 +39,19 @@ WH = 3600.0
 # Thesis figures per scenario. Every scenario: the attitude validation cases the mission's
 # detumble and slew are (section 3.3.5-3.3.6) and the section 3.2 burn and lifetime; 420 km also the
 # tracking, propellant sizing, power and data budgets (sections 3.3.9, 3.5, 3.6).
-_ATTITUDE = {"detumble_time_s": 9.97, "slew_time_s": 24.84, "detumble_propellant_g": 2.36, "slew_propellant_g": 4.51}
-THESIS = {
-    "420km": {**_ATTITUDE, "burn_time_min": 38.74, "burn_propellant_kg": 0.564, "lifetime_with_burn_years": 2.20,
-              "tracking_propellant_g": 4.75, "total_propellant_kg": 0.587, "soc_after_burn_percent": 79.65,
-              "energy_used_Wh": 2.2, "energy_left_Wh": 8.6, "battery_empty_days_after_burn": 14.0,
-              "max_storage_MB": 0.1, "contacts_to_downlink": 2},
-    "475km": {**_ATTITUDE, "burn_time_min": 67.42, "burn_propellant_kg": 0.982, "lifetime_with_burn_years": 3.44},
-    "525km": {**_ATTITUDE, "burn_time_min": 117.20, "burn_propellant_kg": 1.707, "lifetime_with_burn_years": 3.19},
-}
+# Each published value is taken from where its case is defined: the attitude cases (thesis
+# runner), the burn and lifetime (de-orbit study), the sizing (propulsion report).
+_ATTITUDE = {"detumble_time_s": thesis.THESIS["detumble_case1"]["duration"],
+             "slew_time_s": thesis.THESIS["slew_case1"]["duration"],
+             "detumble_propellant_g": thesis.THESIS["detumble_case1"]["propellant"],
+             "slew_propellant_g": thesis.THESIS["slew_case1"]["propellant"]}
+THESIS = {name: {**_ATTITUDE, "burn_time_min": ref["burn_min"], "burn_propellant_kg": ref["propellant"],
+                 "lifetime_with_burn_years": ref["life_burn"]} for name, ref in deorbit_study.THESIS.items()}
+# section 3.3.9 (sized for 420 km), 3.5 and 3.6
+THESIS["420km"].update(tracking_propellant_g=propulsion_report.THESIS["tracking_propellant_g"],
+                       total_propellant_kg=propulsion_report.THESIS["total_propellant_kg"],
+                       soc_after_burn_percent=79.65, energy_used_Wh=2.2, energy_left_Wh=8.6,
+                       battery_empty_days_after_burn=14.0, max_storage_MB=0.1, contacts_to_downlink=2)
 RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
            "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
            "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
