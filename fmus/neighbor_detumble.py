@@ -1,7 +1,8 @@
 """FMU `DetumbleController` (instance `detumble`): PD rate damping with thruster thresholds.
 
 Wraps components.attitude.detumble.DetumbleController (thesis Eq. 9-16, Appendix C `Detumble`,
-stop test of Appendix D). Stateless: every output is a function of the current inputs.
+stop test of Appendix D). State: the time the stop test has held (settle_time, a flight option
+appended after the thesis' variables); the command is a function of the current inputs.
 """
 import math
 
@@ -32,12 +33,16 @@ class DetumbleController(NeighborSlave):
                        bool)
         self.thruster_controller_interface(
             self._command, self._done, RATE_INPUTS + ACCEL_INPUTS, RATE_INPUTS,
-            "Detumble complete: rates within tolerance (Appendix D stop test)")
+            "Detumble complete: rates within tolerance (Appendix D stop test), for settle_time when it is > 0")
+        self.parameter("settle_time", 0.0, "s",
+                       "Settle criterion: done once the rates have stayed within omega_tol for this long (>= 0); "
+                       "0: the thesis' single-sample test")
+        self.target_inputs("not used by the detumble law (rates to omega_d only)")
 
     def build_model(self):
         return detumble.DetumbleController(self.vector("Kp", 3), self.vector("Kd", 3), self.vector("omega_d", 3),
                                            self.vector("omega_tol", 3), self.vector("torque_level", 3),
-                                           self.values["signed_stop_test"])
+                                           self.values["signed_stop_test"], self.values["settle_time"])
 
     def _command(self):
         return self.model.command(self.vector("omega_BN_B", 3), self.vector("omega_dot_BN_B", 3))
@@ -46,4 +51,6 @@ class DetumbleController(NeighborSlave):
         return self.model.done(self.vector("omega_BN_B", 3))
 
     def do_step(self, current_time, step_size):
+        self.model.advance(self.vector("omega_BN_B", 3), step_size, self.values["enabled"])
+        self._input_version += 1  # the settle count changed: `done` computed before the step is stale
         return True

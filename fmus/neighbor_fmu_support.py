@@ -150,6 +150,16 @@ class NeighborSlave(Fmi2Slave):
                           depends_on=deps)
         self.output("done", lambda: self.feedthrough(done), None, done_description, bool, depends_on=done_inputs)
 
+    def target_inputs(self, used_when):
+        """The moving-target inputs of the RCS controller family, `q_target_BN[4]` and
+        `omega_target_B[3]` (the burn guidance's attitude and rate), declared after a controller's
+        other variables so that their value references stay as they were. `used_when` says when
+        this law reads them."""
+        self.input_array("q_target_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         f"Target attitude quaternion q_BN, scalar last, from the guidance; {used_when}")
+        self.input_array("omega_target_B", [0.0] * 3, "rad/s",
+                         f"Target angular velocity in B, from the guidance; {used_when}")
+
     def inertia_parameters(self, mass_description):
         """The spacecraft inertia parameters shared by RigidBody and the controllers that use
         the inertia: mass and box edges (Eq. 4) or a full tensor inertia_B[i,j]."""

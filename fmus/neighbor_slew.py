@@ -1,17 +1,23 @@
 """FMU `SlewController` (instance `slew`): quaternion-error PD with thruster thresholds.
 
 Wraps components.attitude.slew.SlewController (thesis Eq. 41-46, Appendix C `Slew`, stop test of
-Appendix E, or of Appendix G with accept_antipodal). Stateless.
+Appendix E, or of Appendix G with accept_antipodal).
+
+Flight options (appended after the thesis' variables, so their value references are unchanged):
+`target_from_input` takes the target from the inputs q_target_BN and omega_target_B (the burn
+guidance) instead of the parameters q_d and omega_d; `rate_deadband` raises the firing threshold
+to an impulse bit; `settle_time` > 0 ends the slew once the error angle is within settle_angle
+and the rates within omega_tol for that long. State: the time the stop test has held.
 """
 import math
 
 from neighbor_fmu_support import NeighborSlave
 
-from components.core import rotations
 from components.attitude import slew, thruster_control
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+TARGET_INPUTS = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
 
 
 class SlewController(NeighborSlave):
@@ -31,26 +37,51 @@ class SlewController(NeighborSlave):
         self.parameter("accept_antipodal", False, None,
                        "True: done also when each element matches -q_d (Appendix G); false: q_d only (Appendix E)",
                        bool)
+        deps = Q_INPUTS + RATE_INPUTS + TARGET_INPUTS
         self.thruster_controller_interface(
-            self._command, self._done, Q_INPUTS + RATE_INPUTS, Q_INPUTS + RATE_INPUTS,
-            "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test)")
+            self._command, self._done, deps, deps,
+            "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test; with settle_time, "
+            "error angle and rates held within tolerance for settle_time)")
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
-                    "Rotation angle from the current to the target attitude, 2 acos|dq4|", depends_on=Q_INPUTS)
+                    "Rotation angle from the current to the target attitude, 2 acos|dq4|",
+                    depends_on=Q_INPUTS + TARGET_INPUTS)
+        self.parameter("target_from_input", False, None,
+                       "True: target from the inputs q_target_BN and omega_target_B (burn guidance); false: the "
+                       "fixed parameters q_d and omega_d (the thesis cases)", bool)
+        self.target_inputs("used when target_from_input")
+        self.parameter_array("rate_deadband", [0.0] * 3, "rad/s",
+                             "Flight option: a pair fires only when |command| / Kd exceeds this (>= 0; one impulse "
+                             "bit lets a pulse end inside it); 0: the thesis threshold, the pair torque")
+        self.parameter("settle_time", 0.0, "s",
+                       "Settle criterion: done once the error angle is within settle_angle and the rates within "
+                       "omega_tol for this long (>= 0); 0: the thesis' single-sample element test")
+        self.parameter("settle_angle", math.radians(1.0), "rad",
+                       "Attitude error angle for the settle criterion, in (0, pi] (used when settle_time > 0)")
 
     def build_model(self):
         return slew.SlewController(self.vector("Kp", 3), self.vector("Kd", 3), self.vector("q_d", 4),
                                    self.vector("omega_d", 3), self.values["q_tol"], self.vector("omega_tol", 3),
-                                   self.vector("torque_level", 3), self.values["accept_antipodal"])
+                                   self.vector("torque_level", 3), self.values["accept_antipodal"],
+                                   self.vector("rate_deadband", 3), self.values["settle_time"],
+                                   self.values["settle_angle"])
+
+    def _targeted(self):
+        """The model, its target taken from the inputs when target_from_input."""
+        if self.values["target_from_input"]:
+            self.model.set_target(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
+        return self.model
 
     def _command(self):
-        return self.model.command(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
+        return self._targeted().command(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _done(self):
-        return self.model.done(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
+        return self._targeted().done(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _angle(self):
-        dq = rotations.normalized(self.model.error_quaternion(self.vector("q_BN", 4)), "q_BN")
-        return 2.0 * math.acos(min(1.0, abs(dq[3])))
+        return self._targeted().attitude_error(self.vector("q_BN", 4))
 
     def do_step(self, current_time, step_size):
+        self._targeted().advance(self.vector("q_BN", 4), self.vector("omega_BN_B", 3), step_size,
+                                 self.values["enabled"])
+        self._input_version += 1  # the settle count changed: `done` computed before the step is stale
         return True

@@ -9,6 +9,10 @@ State: the desired quaternion q_d. With q_d_from_measured (default, Appendix F `
 latched from the q_BN input at the first step while enabled (before that the outputs use
 q_d = q_BN) and released while disabled; otherwise it starts at q_d0 and is propagated every
 step. Each do_step propagates it at omega_d over the communication step (Eq. 19-21).
+With target_from_input (appended after the thesis' variables) q_d and omega_d follow the inputs
+q_target_BN and omega_target_B instead: the burn attitude the guidance computes from the actual
+orbit, in place of the Eq. 67 rate at Re + 400 km; each new target re-anchors q_d, which is
+propagated in between (DeorbitTrackingController.follow).
 """
 from neighbor_fmu_support import NeighborSlave
 
@@ -16,6 +20,7 @@ from components.attitude import deorbit_tracking, rigid_body, thruster_control
 
 Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
+TARGET_INPUTS = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
 
 
 class TrackingController(NeighborSlave):
@@ -39,21 +44,27 @@ class TrackingController(NeighborSlave):
         self.inertia_parameters("Spacecraft mass for the box inertia the law uses (Eq. 4)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
+        deps = Q_INPUTS + RATE_INPUTS + TARGET_INPUTS
         self.thruster_controller_interface(
-            self._command, self._done, Q_INPUTS + RATE_INPUTS, Q_INPUTS + RATE_INPUTS,
+            self._command, self._done, deps, deps,
             "Tracking converged: every sliding-vector component within its threshold e (the burn itself "
             "ends on the propellant budget, not on this signal)")
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
-                    "Rotation angle from the desired to the current attitude, 2 acos|dq4|", depends_on=Q_INPUTS)
+                    "Rotation angle from the desired to the current attitude, 2 acos|dq4|",
+                    depends_on=Q_INPUTS + TARGET_INPUTS)
         self.output("pointing_error", lambda: self.feedthrough(self._pointing), "rad",
                     "Angle between the body x axis (de-orbit thrust axis) and the desired x axis",
-                    depends_on=Q_INPUTS)
+                    depends_on=Q_INPUTS + TARGET_INPUTS)
         self.output_array("q_d", 4, lambda: self.feedthrough(self._target), "1",
                           "Desired quaternion q_BN, scalar last (equals q_BN while the latch is pending)",
-                          depends_on=Q_INPUTS)
+                          depends_on=Q_INPUTS + TARGET_INPUTS)
         self.output_array("sliding_vector", 3, lambda: self.feedthrough(self._evaluate)[2], "rad/s",
                           "Sliding vector s = omega - omega_d + k sign(dq4) dq_1:3 (Eq. 70)",
-                          depends_on=Q_INPUTS + RATE_INPUTS)
+                          depends_on=deps)
+        self.parameter("target_from_input", False, None,
+                       "True: q_d and omega_d are the inputs q_target_BN and omega_target_B (burn guidance from the "
+                       "actual orbit); false: the thesis' q_d propagated at the parameter omega_d", bool)
+        self.target_inputs("used when target_from_input")
 
     def build_model(self):
         J = self.inertia(rigid_body.box_inertia)
@@ -62,8 +73,14 @@ class TrackingController(NeighborSlave):
             J, self.values["k"], self.vector("G", 3), self.vector("e", 3), self.vector("omega_d", 3),
             self.vector("omega_dot_d", 3), self.vector("torque_level", 3), q_d0)
 
+    def _targeted(self):
+        """The model, its reference taken from the inputs when target_from_input."""
+        if self.values["target_from_input"]:
+            self.model.follow(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
+        return self.model
+
     def _evaluate(self):
-        return self.model.evaluate(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
+        return self._targeted().evaluate(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _command(self):
         torque, flags, _, _ = self.feedthrough(self._evaluate)
@@ -74,15 +91,17 @@ class TrackingController(NeighborSlave):
         return all(abs(s[i]) <= e[i] for i in range(3))
 
     def _angle(self):
-        return self.model.attitude_error(self.vector("q_BN", 4))
+        return self._targeted().attitude_error(self.vector("q_BN", 4))
 
     def _pointing(self):
-        return self.model.pointing_error(self.vector("q_BN", 4))
+        return self._targeted().pointing_error(self.vector("q_BN", 4))
 
     def _target(self):
-        return self.model.target(self.vector("q_BN", 4))
+        return self._targeted().target(self.vector("q_BN", 4))
 
     def do_step(self, current_time, step_size):
+        if self.values["target_from_input"] and self.values["enabled"]:
+            self._targeted()  # a new target from the guidance re-anchors q_d before it is propagated
         self.model.advance(step_size, self.vector("q_BN", 4), self.values["enabled"])
         self._input_version += 1  # q_d changed: outputs computed before the step are stale
         return True

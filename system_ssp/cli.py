@@ -1,5 +1,5 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `replace`, `compare`, `campaign`, `thesis`, `deorbit-study`, `mission`, `propulsion` and
+`info`, `replace`, `compare`, `flatten`, `campaign`, `thesis`, `deorbit-study`, `mission`, `propulsion` and
 `validation`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
@@ -16,15 +16,16 @@ import sys
 import traceback
 
 from . import __version__
-from .apps import (add_console_arguments, campaign, console_settings, deorbit_study, mission, parse_sets, replace,
-                   thesis, validation)
+from .apps import (add_console_arguments, campaign, console_settings, deorbit_study, flatten, mission, parse_sets,
+                   replace, thesis, validation)
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
-        "replace": replace.main_replace, "compare": replace.main_compare, "campaign": campaign.main,
+        "replace": replace.main_replace, "compare": replace.main_compare, "flatten": flatten.main,
+        "campaign": campaign.main,
         "propulsion": mission.main_propulsion, "validation": validation.main}
 
 
@@ -65,6 +66,8 @@ def _parser():
     sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
                    "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
     sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")
+    sub.add_parser("flatten", add_help=False, help="the system with its system parameters folded into component "
+                   "bindings, for hosts that do not read them (flatten SYSTEM --out X.ssp)")
     sub.add_parser("campaign", add_help=False, help="a sweep or Monte Carlo campaign on Dask (campaign SPEC.toml "
                    "--out DIR [--workers N] [--scheduler ADDRESS])")
     sub.add_parser("thesis", add_help=False,

@@ -73,7 +73,8 @@ def mission_420km(ssp_paths, tmp_path_factory):
     from system_ssp.apps import mission
 
     out = tmp_path_factory.mktemp("mission")
-    summary, result = mission.run_mission("420km", "averaged", ssp_dir=ssp_paths["neighbor_mission"].parent, out=out)
+    summary, result = mission.run_mission("420km", "averaged", ssp_dir=ssp_paths["neighbor_mission"].parent, out=out,
+                                          gnc="thesis")
     return summary, result, out
 
 

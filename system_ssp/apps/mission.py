@@ -1,12 +1,16 @@
 """The NEIGHBOR mission from deployment to re-entry, run through the master, with the thesis'
 figures and a summary beside the published numbers.
 
-    neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell] [--out results/mission]
-                           [--ssv FILE] [--set COMP.VAR=VALUE]
+    neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell] [--gnc closed-loop|thesis]
+                           [--out results/mission] [--ssv FILE] [--set COMP.VAR=VALUE]
 
 Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
 minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
-set (system_ssp/systems/parameters/neighbor_mission_<scenario>.ssv), and writes into --out:
+set (system_ssp/systems/parameters/neighbor_mission_<scenario>.ssv). `--gnc closed-loop` (the
+default) flies the coupled loop: the burn attitude from the orbit, thrust along the body axis,
+flight settle criteria; `--gnc thesis` applies parameters/mission_gnc_thesis.ssv, the thesis'
+guidance and control, which gives its published numbers (system_ssp/systems/generators/mission.py).
+It writes into --out:
 - timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode), their units
                    in timeseries.units.json;
 - summary.json     every computed figure beside the thesis' (also printed as a table);
@@ -34,6 +38,7 @@ from . import (DEFAULT_SSP_DIR, add_console_arguments, console_settings, deorbit
                staged_results, thesis)
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
+GNC = {"closed-loop": None, "thesis": "mission_gnc_thesis.ssv"}  # the parameter set each applies
 SCENARIOS = ("420km", "475km", "525km")
 WH = 3600.0
 # Thesis figures per scenario. Every scenario: the attitude validation cases the mission's
@@ -64,10 +69,11 @@ RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "missio
 
 
 def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
-                parameters=None, profile=False, progress=False, parameter_sets=()):
+                parameters=None, profile=False, progress=False, parameter_sets=(), gnc="closed-loop"):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
-    `parameter_sets` (files, names component.variable) apply after the scenario's set and
-    `parameters` ({component.variable: value}) after them."""
+    `gnc` (GNC) picks the guidance and control parameter set, applied after the scenario's;
+    `parameter_sets` (files, names component.variable) apply after it and `parameters`
+    ({component.variable: value}) after them."""
     if orbit not in SYSTEMS:
         raise SSPError(f"unknown orbit model {orbit!r} (expected one of: {', '.join(SYSTEMS)})")
     if scenario not in SCENARIOS:
@@ -78,13 +84,16 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
     if not (max_years > 0 and np.isfinite(max_years)):
         raise SSPError(f"--max-years {max_years:g}: must be a positive number of years (the longest the mission "
                        "may run before re-entry)")
-    ssv = PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"
+    if gnc not in GNC:
+        raise SSPError(f"unknown guidance and control set {gnc!r} (expected one of: {', '.join(GNC)})")
+    ssv = [PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"] + ([PARAMETERS_DIR / GNC[gnc]] if GNC[gnc] else [])
     with staged_results(out, lambda err: "timeseries.csv") as staged:
         with System(ssp) as system:
-            r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv), *parameter_sets],
+            r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
                            parameters=parameters or {},
                            outputs=RECORD, profile=profile, progress=progress)
         s = summarize(r, scenario, orbit)
+        s["gnc"] = gnc
         if staged is not None:
             write_result(r.data, staged.path / "timeseries.csv", r.units)
             write_text_atomic(staged.path / "summary.json", json.dumps(s, indent=1))
@@ -202,7 +211,8 @@ def table(s):
             ("re-entry after the burn (years)", "lifetime_with_burn_years", "{:.2f}")]
     thesis = dict(s.get("thesis", {}))
     thesis.setdefault("attitude_determination_s", 600.0)  # section 3.4: ten minutes
-    lines = [f"NEIGHBOR mission, {s.get('scenario')} scenario ({s.get('orbit')} orbit)",
+    lines = [f"NEIGHBOR mission, {s.get('scenario')} scenario ({s.get('orbit')} orbit, "
+             f"{s.get('gnc', 'closed-loop')} guidance and control)",
              "| quantity | this run | thesis | difference |", "|---|---|---|---|"]
     for label, key, fmt in rows:
         value, ref = s.get(key), thesis.get(key)
@@ -365,6 +375,9 @@ def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
     ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
+    ap.add_argument("--gnc", choices=list(GNC), default="closed-loop",
+                    help="guidance and control: closed-loop (burn attitude from the orbit, thrust along the body "
+                         "axis, flight settle criteria; default) or thesis (the thesis' laws and its numbers)")
     ap.add_argument("--out", default="results/mission")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)
@@ -378,7 +391,7 @@ def main(argv=None):
     progress = console_settings(args)
     s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years,
                        parameters=parse_sets(args.set), profile=args.profile, progress=progress,
-                       parameter_sets=args.ssv)
+                       parameter_sets=args.ssv, gnc=args.gnc)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:
@@ -401,6 +414,9 @@ def main_propulsion(argv=None):
     ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
     ap.add_argument("--mission", metavar="SUMMARY_JSON",
                     help="summary.json of a mission run of the scenario (default: run the mission now)")
+    ap.add_argument("--gnc", choices=list(GNC), default="thesis",
+                    help="guidance and control of the mission run here (default: thesis, whose numbers the "
+                         "thesis' sizing used)")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--json", metavar="FILE", help="also write both budgets as JSON")
     add_console_arguments(ap)
@@ -415,7 +431,7 @@ def main_propulsion(argv=None):
         if summary.get("scenario") != args.scenario:
             raise SSPError(f"{path} is a {summary.get('scenario')!r} mission run, not --scenario {args.scenario}")
     else:
-        summary, _ = run_mission(args.scenario, ssp_dir=args.ssp_dir, progress=progress)
+        summary, _ = run_mission(args.scenario, ssp_dir=args.ssp_dir, progress=progress, gnc=args.gnc)
     budget = propulsion_report.of_mission(summary)
     worst, _ = propulsion_report.worst_case(summary, args.ssp_dir)
     print(propulsion_report.report(worst, budget, args.scenario), end="")

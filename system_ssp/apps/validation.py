@@ -220,7 +220,7 @@ def compute(ssp_dir=DEFAULT_SSP_DIR, progress=False):
     for name, r in cases.items():
         ours[f"{name}.q"], ours[f"{name}.omega"], ours[f"{name}.euler"] = r.q, r.omega_deg, r.euler_deg
         ours[f"{name}.duration"], ours[f"{name}.propellant"] = r.duration, r.propellant
-    s, _ = mission.run_mission("420km", ssp_dir=ssp_dir, progress=progress)
+    s, _ = mission.run_mission("420km", ssp_dir=ssp_dir, progress=progress, gnc="thesis")
     for key in ("detumble_time_s", "slew_time_s", "burn_time_min", "tracking_propellant_g", "soc_after_burn_percent",
                 "energy_used_Wh", "energy_left_Wh", "battery_empty_days_after_burn", "max_storage_MB",
                 "contacts_to_downlink"):

@@ -92,6 +92,44 @@ def check_connector_units(comps, units):
             units.convert(conn.unit, fmu_unit, comp, comp, f"{conn.origin}: connector {comp.name}.{name}")
 
 
+def is_parameter_connection(desc, c):
+    """A connection from a system connector of kind parameter (SSP 1.0: a parameter of the
+    system that the connection hands to a component's parameter)."""
+    for element, connector in ((c.start_element, c.start_connector), (c.end_element, c.end_connector)):
+        sc = desc.system_connectors.get(connector) if element is None else None
+        if sc is not None and sc.kind == "parameter":
+            return True
+    return False
+
+
+def parameter_connections(desc, by_name):
+    """{system parameter connector: [(component info, variable, origin)]}: where each system
+    parameter's value goes. Every target must be a parameter of its component."""
+    out = {name: [] for name, sc in desc.system_connectors.items() if sc.kind == "parameter"}
+    for c in desc.connections:
+        if not is_parameter_connection(desc, c):
+            continue
+        where = f"{c.origin}: connection {c.label()}"
+        if c.start_element is None and c.end_element is None:
+            raise SSPError(f"{where}: joins two system connectors; a system parameter must go to a component's "
+                           "parameter")
+        name, element, var = ((c.start_connector, c.end_element, c.end_connector) if c.start_element is None
+                              else (c.end_connector, c.start_element, c.start_connector))
+        comp = by_name.get(element)
+        if comp is None:
+            raise SSPError(f"{where}: no component named {element!r}{near(element, by_name)}")
+        v = comp.vars.get(var)
+        if v is None:
+            raise SSPError(f"{where}: component {element!r} has no variable {var!r}{near(var, comp.vars)}")
+        if v.causality != "parameter":
+            raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system parameter can only set "
+                           "parameters")
+        if c.transform is not None:
+            raise SSPError(f"{where}: transformations on parameter connections are not supported")
+        out[name].append((comp, var, c.origin))
+    return out
+
+
 def resolve_connections(desc, comps, by_name, units):
     """[Link] for the SSD's connections: each joins an output to an input (system connectors
     resolved as pass-throughs), every input fed at most once."""
@@ -129,7 +167,8 @@ def resolve_connections(desc, comps, by_name, units):
         return r if r not in ("src", "dst") else ("output" if r == "src" else "input")
 
     half = []  # (src_end, dst_end, transform, suppress, connection)
-    for c in desc.connections:
+    # a system parameter's connections fan its value out before the run (parameter_connections)
+    for c in [c for c in desc.connections if not is_parameter_connection(desc, c)]:
         a = end(c.start_element, c.start_connector, c)
         b = end(c.end_element, c.end_connector, c)
         ra, rb = role(a), role(b)

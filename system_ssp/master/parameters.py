@@ -145,10 +145,29 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
     """All start values for a run: {(comp index, var): value}, later sources overriding earlier:
     the SSD's component bindings, the root system's bindings, `parameter_sets`, `parameters`."""
     out = {}
+    fan_out = getattr(system, "parameter_links", {})
 
     def put(comp, var, pv):
         out[(comp.index, var)] = resolve_parameter(system, comp, var, pv.value, pv.type, pv.unit, pv.units,
                                                    pv.origin, f"{comp.name}.{var}")
+
+    def put_system(name, value, vtype=None, unit=None, units=None, origin=""):
+        """A system parameter (an SSD system connector of kind parameter): its value goes to every
+        component parameter it is connected to, converted to each one's unit."""
+        connector = system.desc.system_connectors[name]
+        for comp, var, _ in fan_out[name]:
+            out[(comp.index, var)] = resolve_parameter(
+                system, comp, var, value, vtype, unit if unit is not None else connector.unit, units, origin,
+                f"{name} (system parameter) -> {comp.name}.{var}")
+
+    def named(name, where):
+        """(component, variable) of a 'component.variable' name, or None for a system parameter."""
+        if name in fan_out:
+            return None
+        if isinstance(name, str) and "." not in name and fan_out:
+            raise SSPError(f"{where} {name!r}: not a system parameter{near(name, fan_out)} (system parameters: "
+                           f"{', '.join(fan_out)}) and not 'component.variable'")
+        return split_name(system.comps, name, where)
 
     for comp in system.comps:
         for pv in comp.decl.parameters:
@@ -157,16 +176,26 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
                                f"variable{near(pv.name, comp.vars)}")
             put(comp, pv.name, pv)
     for pv in system.desc.parameters:
-        comp, var = split_name(system.comps, pv.name, f"{pv.origin}: parameter")
-        put(comp, var, pv)
+        target = named(pv.name, f"{pv.origin}: parameter")
+        if target is None:
+            put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
+        else:
+            put(*target, pv)
     for ps in parameter_sets or []:
         for pv in read_parameter_set(system, ps):
             try:
-                comp, var = split_name(system.comps, pv.name, "parameter")
+                target = named(pv.name, "parameter")
             except SSPError as exc:
                 raise SSPError(f"{pv.origin}: {exc}") from None
-            put(comp, var, pv)
+            if target is None:
+                put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
+            else:
+                put(*target, pv)
     for name, value in (parameters or {}).items():
-        comp, var = split_name(system.comps, name, "parameter")
-        out[(comp.index, var)] = resolve_parameter(system, comp, var, value, None, None, None, "", name)
+        target = named(name, "parameter")
+        if target is None:
+            put_system(name, value)
+        else:
+            comp, var = target
+            out[(comp.index, var)] = resolve_parameter(system, comp, var, value, None, None, None, "", name)
     return out

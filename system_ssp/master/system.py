@@ -11,7 +11,8 @@ import zipfile
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
-from .connections import FeedthroughGraph, UnitTable, check_connector_units, resolve_connections
+from .connections import (FeedthroughGraph, UnitTable, check_connector_units, parameter_connections,
+                          resolve_connections)
 from .execution import execute
 from .info import describe_system
 from .names import split_name
@@ -77,6 +78,7 @@ class System:
         self.units = UnitTable(self.desc, self.comps)
         check_connector_units(self.comps, self.units)
         self.links = resolve_connections(self.desc, self.comps, self.by_name, self.units)
+        self.parameter_links = parameter_connections(self.desc, self.by_name)
         self.graph = FeedthroughGraph(self.comps, self.links)
 
     # ---- queries ------------------------------------------------------------------------

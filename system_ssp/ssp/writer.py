@@ -36,7 +36,7 @@ def typed_value(value):
     if isinstance(value, int):
         return f'<ssv:Integer value="{int(value)}"/>'
     if isinstance(value, float):
-        return f'<ssv:Real value="{value!r}"/>'
+        return f'<ssv:Real value="{float(value)!r}"/>'  # float(): numpy scalars repr as np.float64(..)
     return f"<ssv:String value={quoteattr(value)}/>"
 
 
@@ -97,7 +97,8 @@ class SystemWriter:
     def ssd(self, name, spec):
         """Write <name>.ssd from a spec: components as (instance, FMU model identifier, [parameter
         files in parameters/, without .ssv]), connections as (source, output, destination, input,
-        n) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar, optional "stop"
+        n) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar, optional
+        "parameters" (system parameters, see _system_parameters_xml) and "parameter_bindings", "stop"
         Boolean outputs, "order", "stop_time", "step_size", and "schedule": {"modes": [(name,
         step, active components or None, recordEvery, [(component, connector, [values])][,
         {component: k}])], "events": [(component, connector)]} for an nc:Schedule (the optional
@@ -112,12 +113,15 @@ class SystemWriter:
                # Namespace on the root: libcosim's parser takes xmlns attributes on inner
                # elements for child elements.
                f'<ssd:SystemStructureDescription {NS} xmlns:osp="{NS_OSP}" version="1.0" name="{name}">',
-               f'  <ssd:System name="{name}" description={quoteattr(spec["description"])}>',
-               "    <ssd:Elements>"]
-        for inst, fmu, concerns in spec["components"]:
+               f'  <ssd:System name="{name}" description={quoteattr(spec["description"])}>']
+        for inst, fmu, _ in spec["components"]:
             variables, units = self.fmu_variables(fmu)
             all_units.update(units)
             comp_vars[inst] = {v.name: v for v in variables}
+        out += _system_parameters_xml(name, spec, comp_vars)
+        out.append("    <ssd:Elements>")
+        for inst, fmu, concerns in spec["components"]:
+            variables, _ = self.fmu_variables(fmu)
             out.append(f'      <ssd:Component name="{inst}" type="application/x-fmu-sharedlibrary" '
                        f'source="resources/{fmu}.fmu">')
             out.append("        <ssd:Connectors>")
@@ -139,6 +143,10 @@ class SystemWriter:
                     raise GeneratorError(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
                 out.append(f'      <ssd:Connection startElement="{src}" startConnector="{a}" '
                            f'endElement="{dst}" endConnector="{b}"/>')
+        for pname, (_, targets) in spec.get("parameters", {}).items():
+            for comp, var in targets:
+                out.append(f'      <ssd:Connection startConnector={quoteattr(pname)} endElement="{comp}" '
+                           f'endConnector={quoteattr(var)}/>')
         out.append("    </ssd:Connections>")
         dt = spec["step_size"]
         for comp, var in spec.get("stop", []):
@@ -170,6 +178,37 @@ class SystemWriter:
                 "  </ssd:DefaultExperiment>"]
         out += ["</ssd:SystemStructureDescription>", ""]
         return "\n".join(out)
+
+
+def _system_parameters_xml(name, spec, comp_vars):
+    """The system's parameter connectors and their ParameterBindings: spec "parameters" =
+    {name: (description, [(component, parameter), ...])}, each given once (in the system's
+    "parameter_bindings" files, names without a component) and handed by parameter connections to
+    every component parameter listed; all targets share one type and unit."""
+    params = spec.get("parameters", {})
+    if not params:
+        return []
+    out = ["    <ssd:Connectors>"]
+    for pname, (description, targets) in params.items():
+        kinds = set()
+        for comp, var in targets:
+            v = comp_vars.get(comp, {}).get(var)
+            if v is None or v.causality != "parameter":
+                raise GeneratorError(f"{name}: system parameter {pname}: {comp}.{var} is not a parameter")
+            kinds.add((v.type, v.unit if v.type == "Real" else None))
+        if len(kinds) != 1:
+            raise GeneratorError(f"{name}: system parameter {pname}: its targets differ in type or unit: {kinds}")
+        vtype, unit = kinds.pop()
+        t = f'<ssc:Real unit="{unit}"/>' if vtype == "Real" and unit else f"<ssc:{vtype}/>"
+        out.append(f"      <!-- {description} -->")
+        out.append(f'      <ssd:Connector name={quoteattr(pname)} kind="parameter">{t}</ssd:Connector>')
+    out.append("    </ssd:Connectors>")
+    files = spec.get("parameter_bindings", [])
+    if files:
+        out.append("    <ssd:ParameterBindings>")
+        out += [f'      <ssd:ParameterBinding source="parameters/{f}.ssv"/>' for f in files]
+        out.append("    </ssd:ParameterBindings>")
+    return out
 
 
 def _schedule_xml(name, schedule, comp_vars):

@@ -110,3 +110,36 @@ def test_study_arguments():
     with pytest.raises(SSPError, match="unknown model"):
         deorbit_study.run_study(model="sgp4")
     assert math.isclose(deorbit_study.THESIS["525km"]["life_no_burn"], 97.41)
+
+
+def test_a_mispointed_burn_costs_delta_v_through_the_fmus(fmu_paths, tmp_path):
+    """Guidance -> orbit coupling through the master: the orbit thrusts along the body's thrust
+    axis at the attitude the BurnGuidance FMU computes from the orbit. A thrust axis 20 deg off
+    the body x axis (propulsion.axis_B) lowers the orbit by cos 20 deg of the aligned burn; the
+    aligned burn equals the retrograde (-v) one."""
+    from system_ssp.ssp.writer import SystemWriter
+
+    (tmp_path / "resources").mkdir()
+    for name in ("BurnGuidance", "OrbitAveraged", "Propulsion"):
+        (tmp_path / "resources" / f"{name}.fmu").symlink_to(fmu_paths[name])
+    writer = SystemWriter(tmp_path, fmu_paths["Propulsion"].parent)
+    writer.ssd("guided_burn", {
+        "description": "burn attitude from the orbit, thrust along the body axis",
+        "components": [("guidance", "BurnGuidance", []), ("orbit", "OrbitAveraged", []),
+                       ("propulsion", "Propulsion", [])],
+        "connections": [("orbit", "r_BN_N", "guidance", "r_BN_N", 3), ("orbit", "v_BN_N", "guidance", "v_BN_N", 3),
+                        ("guidance", "q_target_BN", "orbit", "q_BN", 4),
+                        ("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
+                        ("propulsion", "mass", "orbit", "mass", 0)],
+        "order": ["propulsion", "orbit", "guidance"], "stop_time": 600.0, "step_size": 0.5})
+    drops = {}
+    with system_ssp.System(tmp_path / "guided_burn.ssd") as s:
+        for label, extra in (("aligned", {}), ("retrograde", {"orbit.retrograde": True}),
+                             ("20 deg", {"propulsion.axis_B[1]": math.cos(math.radians(20.0)),
+                                         "propulsion.axis_B[2]": math.sin(math.radians(20.0))})):
+            r = s.run(stop_time=600.0, parameters={"orbit.density_model": "exponential", "orbit.Cd": 1e-9,
+                                                   "propulsion.burn_enable": True, **extra},
+                      outputs=["orbit.sma"])
+            drops[label] = r.data["orbit.sma"][0] - r.final["orbit.sma"]
+    assert drops["aligned"] == pytest.approx(drops["retrograde"], rel=1e-4)
+    assert drops["20 deg"] / drops["aligned"] == pytest.approx(math.cos(math.radians(20.0)), rel=2e-3)

@@ -59,6 +59,7 @@ class Metric:
     name: str
     kind: str
     variable: Optional[str] = None
+    equals: Optional[float] = None  # time_when:comp.var==value: the first time the signal equals it
 
 
 @dataclass
@@ -246,10 +247,19 @@ def _metric(path, name, m):
     if not isinstance(m, str):
         raise SSPError(f"{path}: metrics.{name} = {m!r}: expected a string")
     kind, _, var = m.partition(":")
+    equals = None
+    if kind == "time_when" and "==" in var:
+        var, _, value = var.partition("==")
+        var = var.strip()
+        try:
+            equals = float(value)
+        except ValueError:
+            var = ""  # reported below
     if kind not in METRIC_KINDS or (kind in ("final", "min", "max", "time_when")) != bool(var):
         raise SSPError(f"{path}: metrics.{name} = {m!r}: expected \"stop_time\", \"stop_reason\", \"steps\" or "
-                       "\"final:comp.var\", \"min:comp.var\", \"max:comp.var\", \"time_when:comp.var\"")
-    return Metric(name, kind, var or None)
+                       "\"final:comp.var\", \"min:comp.var\", \"max:comp.var\", \"time_when:comp.var\" (first time "
+                       "true) or \"time_when:comp.var==number\" (first time equal)")
+    return Metric(name, kind, var or None, equals)
 
 
 def resolve_system(name, spec_path):

@@ -52,8 +52,9 @@ def metric_values(spec, result):
         elif m.kind in ("min", "max"):
             col = data[m.variable].astype(float)
             out[m.name] = float(col.min() if m.kind == "min" else col.max())
-        else:  # time_when: the first recorded time the signal is true (non-zero); NaN if never
-            hit = np.flatnonzero(data[m.variable] != 0)
+        else:  # time_when: the first recorded time the signal is true (non-zero) or equals m.equals; NaN if never
+            col = data[m.variable]
+            hit = np.flatnonzero(col != 0 if m.equals is None else col == m.equals)
             out[m.name] = float(data["time"][hit[0]]) if len(hit) else math.nan
     return out
 

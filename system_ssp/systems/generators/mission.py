@@ -8,6 +8,7 @@ re-entry. Components (instance: FMU):
   orbit: Orbit (Cowell, Jacchia-Roberts)    ground: GroundStation (UIUC visibility, confirmation)
   propulsion: Propulsion (de-orbit burn)    dynamics: RigidBody (thesis Euler StateChange)
   detumble / slew / tracking: the three RCS attitude controllers (only the enabled one commands)
+  guidance: BurnGuidance (burn attitude and rate from the orbit) -> slew and tracking targets
   selector: TorqueSelector -> thrusters: RcsThrusters -> dynamics
   power: Power (LG HG2 cell, Table 5 loads)   data: DataStorage (256 kB flash, 9600 baud)
 `neighbor_mission_lifetime` is the same system with orbit = OrbitAveraged (the fidelity swap).
@@ -33,14 +34,23 @@ the run begins 1855 days earlier (5 years idle + 30 days grace, Appendix I) with
 deployed at the altitude from which it decays to the scenario altitude by then (found here with
 the orbit-averaged model and the same Jacchia-Roberts atmosphere and space weather), and the
 heartbeat lost 5 years after deployment. The burn spends the scenario's Eq. 2-3 propellant.
-The orbit FMU applies the thrust along -v (retrograde): the attitude loop holds the thesis'
-burn attitude in its own reference (identity target, tracked at the orbital rate), which is not
-tied to the orbit's velocity direction here (documented in the README).
+
+Guidance, navigation and control come in two parameter sets (GNC_SETS), one of which the
+mission command applies after the scenario's:
+  closed_loop  the orbit thrusts along the body's thrust axis (q_BN from the rigid body), the
+               guidance FMU computes the burn attitude and its rate from the orbit's r and v, the
+               slew and the tracking take it as their target; flight settle criteria and an
+               impulse-bit rate deadband end the maneuvers off the nominal point; RK4 attitude.
+  thesis       the thesis' numbers: thrust along -v whatever the attitude (orbit.retrograde, the
+               lower-fidelity option), identity slew target, tracking at the Eq. 67 rate of
+               Re + 400 km latched from the attitude at the burn start, single-sample stop tests,
+               Euler attitude integration.
 """
 import datetime as dt
 import math
 
 
+from components.attitude import rigid_body, thruster_control
 from components.environment import atmosphere
 from components.orbit import averaged, propulsion
 from components.core import time_utils
@@ -82,8 +92,9 @@ COMPONENTS = {
     "ground": ("GroundStation", ["mission_ground"], {"bus", "monitor", "slow"}),
     "propulsion": ("Propulsion", ["mission_propulsion"], {"bus", "slow_burn"}),
     "dynamics": ("RigidBody", ["mission_takeover", "spacecraft"], set()),
-    "detumble": ("DetumbleController", ["detumble_gains"], {"detumble"}),
-    "slew": ("SlewController", ["slew_gains"], {"slew"}),
+    "guidance": ("BurnGuidance", [], {"slow"}),
+    "detumble": ("DetumbleController", ["detumble_gains", "mission_detumble"], {"detumble"}),
+    "slew": ("SlewController", ["slew_gains", "mission_slew"], {"slew"}),
     "tracking": ("TrackingController", ["mission_tracking"], {"burn"}),
     "selector": ("TorqueSelector", [], set()),
     "thrusters": ("RcsThrusters", ["thrusters"], set()),
@@ -97,8 +108,46 @@ MANEUVERS = ("detumble", "slew", "burn")
 # states held at the step's start; a timed event the manager reaches at the step's end (a
 # wake-up) applies from then on, not to the step before. The rest follow the feedthrough edges
 # (propulsion -> orbit, orbit -> ground, controllers -> selector -> thrusters -> dynamics).
-ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "ground", "detumble", "slew", "tracking",
-         "selector", "thrusters", "dynamics"]
+ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", "ground", "detumble", "slew",
+         "tracking", "selector", "thrusters", "dynamics"]
+
+
+# Flight tolerances sized from the impulse bit: the rate change of one 15 ms firing (the attitude
+# loop's step, the shortest pulse) at the nominal 12 kg, 0.017-0.043 deg/s per axis. They hold for
+# any mass down to 8 kg (the bit grows as the mass falls: 1.5x at 8 kg).
+MIN_ON_TIME = 0.015
+BITS = thruster_control.impulse_bit_rates(
+    thruster_control.pair_torques(), [rigid_body.box_inertia(propulsion.MASS0, 0.1, 0.2, 0.3)[i, i] for i in range(3)],
+    MIN_ON_TIME)
+DETUMBLE_FLIGHT = {**vec("omega_tol", [0.75 * b for b in BITS]), "settle_time": 1.0}
+SLEW_FLIGHT = {"target_from_input": True, **vec("omega_tol", [2.0 * b for b in BITS]),
+               **vec("rate_deadband", [1.5 * b for b in BITS]), "settle_time": 3.0, "settle_angle": math.radians(1.0)}
+# What the thesis parameter set restores (names component.variable); every value the closed loop
+# changes appears here.
+GNC_THESIS = {"orbit.retrograde": True, "dynamics.integrator": "euler", "tracking.target_from_input": False,
+              "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
+              "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
+              **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
+GNC_SETS = {"closed_loop": None, "thesis": "mission_gnc_thesis"}  # None: the system's own bindings
+
+
+# The spacecraft's physical values, each given once (system parameters of the SSD, in
+# parameters/mission_spacecraft.ssv) and handed by parameter connections to every component that
+# uses it: `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
+# propulsion's initial mass together.
+SPACECRAFT_PARAMETERS = {
+    "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", propulsion.MASS0,
+                        [("dynamics", "mass"), ("tracking", "mass"), ("propulsion", "mass0")]),
+    "spacecraft_edge_a": ("Box edge a along body y, m (Appendix A: 0.1 m); also the x thruster pairs' spacing",
+                          0.1, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("thrusters", "edge_a")]),
+    "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", 0.2,
+                          [("dynamics", "edge_b"), ("tracking", "edge_b")]),
+    "spacecraft_edge_c": ("Box edge c along body x, m (Appendix A: 0.3 m); also the y and z thruster pairs' arms",
+                          0.3, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("thrusters", "edge_c")]),
+    "spacecraft_Cd": ("Drag coefficient (Table 2: 2.2)", 2.2, [("orbit", "Cd")]),
+    "spacecraft_drag_area": ("Drag area facing the flow, m2 (Table 2: 0.02 m2)", 0.02, [("orbit", "area")]),
+    "rcs_thrust": ("Force of one RCS thruster, N (Appendix A: 25 mN)", 0.025, [("thrusters", "thrust")]),
+}
 
 
 def having(role):
@@ -154,6 +203,13 @@ def system(orbit_fmu):
              ("mission", "burn_enable", "propulsion", "burn_enable", 0),
              ("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
              ("propulsion", "mass", "orbit", "mass", 0),
+             ("dynamics", "q_BN", "orbit", "q_BN", 4),
+             ("orbit", "r_BN_N", "guidance", "r_BN_N", 3),
+             ("orbit", "v_BN_N", "guidance", "v_BN_N", 3),
+             ("guidance", "q_target_BN", "slew", "q_target_BN", 4),
+             ("guidance", "omega_target_B", "slew", "omega_target_B", 3),
+             ("guidance", "q_target_BN", "tracking", "q_target_BN", 4),
+             ("guidance", "omega_target_B", "tracking", "omega_target_B", 3),
              ("dynamics", "omega_BN_B", "detumble", "omega_BN_B", 3),
              ("dynamics", "omega_dot_BN_B", "detumble", "omega_dot_BN_B", 3),
              ("dynamics", "q_BN", "slew", "q_BN", 4),
@@ -182,6 +238,8 @@ def system(orbit_fmu):
                        "org.neighbor-cosim.master annotation (nc:Schedule)",
         "components": comps,
         "connections": conns,
+        "parameters": {name: (about, targets) for name, (about, _, targets) in SPACECRAFT_PARAMETERS.items()},
+        "parameter_bindings": ["mission_spacecraft"],
         "stop": [("orbit", "reentered")],
         "order": ORDER,
         "stop_time": 40.0 * YEAR,
@@ -222,11 +280,12 @@ def generate(writer):
     h420 = takeover_altitudes["420km"]
     writer.ssv("mission_orbit",
                f"Host orbit at deployment ({MISSION_EPOCH}, 51.6 deg; {h420:.2f} km decays to 420 km by "
-               f"{DEORBIT_EPOCH}), Cd 2.2, 0.02 m^2, Jacchia-Roberts with the bundled space weather, retrograde burn",
+               f"{DEORBIT_EPOCH}), Cd 2.2, 0.02 m^2, Jacchia-Roberts with the bundled space weather, thrust along "
+               "the body's thrust axis (q_BN from the rigid body)",
                {"epoch": MISSION_EPOCH, "sma0": R_EQ + h420 * KM, "ecc0": 0.0, "inc0": math.radians(51.6),
                "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": 2.2, "area": 0.02, "reentry_altitude": 250.0 * KM,
                "density_model": "jacchia_roberts", "space_weather_file": "", "use_constant_space_weather": False,
-               "retrograde": True})
+               "retrograde": False})
     writer.ssv("mission_ground",
                "UIUC ground station (40.1020 N, 88.2272 W), horizon mask (Appendix I sets none)",
                {"epoch": MISSION_EPOCH})
@@ -236,12 +295,25 @@ def generate(writer):
                "Main de-orbit thrusters, 12 kg, the 420 km -> 350 km budget (Eq. 2-3: 0.564 kg)",
                {"mass0": propulsion.MASS0, "propellant_budget": budget["420km"]})
     writer.ssv("mission_takeover",
-               "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), thesis Euler integration",
-               {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "euler"})
+               "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), RK4 attitude integration",
+               {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "rk4"})
     writer.ssv("mission_tracking",
-               "De-orbit tracking (Appendix F): k 1, G 0.1 I, e 0.001, desired attitude from the measured one at "
-               "the start of the burn", {"k": 1.0, **vec("G", [0.1] * 3), **vec("e", [0.001] * 3),
-                                        "q_d_from_measured": True})
+               "De-orbit tracking (Appendix F): k 1, G 0.1 I, e 0.001, desired attitude and rate from the burn "
+               "guidance", {"k": 1.0, **vec("G", [0.1] * 3), **vec("e", [0.001] * 3),
+                            "q_d_from_measured": True, "target_from_input": True})
+    writer.ssv("mission_detumble",
+               "Detumble flight settle criterion: rate window 0.75 impulse bit per axis held for 1 s", DETUMBLE_FLIGHT)
+    writer.ssv("mission_slew",
+               "Slew to the burn attitude from the guidance; flight rate deadband 1.5 impulse bits, settle within "
+               "1 deg and 2 impulse bits for 3 s", SLEW_FLIGHT)
+    writer.ssv("mission_spacecraft",
+               "The spacecraft's physical values, each once: system parameters handed to every component that uses "
+               "them (the system's parameter connections)",
+               {name: value for name, (_, value, _) in SPACECRAFT_PARAMETERS.items()})
+    writer.ssv("mission_gnc_thesis",
+               "The thesis' guidance and control (its published numbers): thrust along -v whatever the attitude, "
+               "identity slew target, tracking at the Eq. 67 rate latched at the burn start, single-sample stop "
+               "tests, Euler attitude integration", GNC_THESIS)
     writer.ssv("mission_power", "LG HG2 cell: 3.0 Ah x 3.6 V = 10.8 Wh, full",
                {"capacity": 10.8 * 3600.0, "initial_state_of_charge": 1.0})
     writer.ssv("mission_data", "256 kB flash, Table 7 rate, 9600 baud downlink",

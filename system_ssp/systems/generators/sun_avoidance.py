@@ -85,6 +85,12 @@ SYSTEM = {
                     ("dynamics", "omega_BN_B", "tracker", "omega_BN_B", 3),
                     ("tracker", "torque_cmd_B", "dynamics", "torque_B", 3),
                     ("dynamics", "q_BN", "guidance", "q_BN", 4)],  # checked against guidance.q0 at the start
+    # The initial attitude, given once: the guidance plans from it and the rigid body starts there
+    # (two separate values once let the flown boresight pass 0.85 deg from the Sun).
+    "parameters": {f"initial_attitude[{i}]": (f"Initial attitude q_BN, scalar last (component {i})",
+                                              [("guidance", f"q0[{i}]"), ("dynamics", f"q0[{i}]")])
+                   for i in (1, 2, 3, 4)},
+    "parameter_bindings": [f"{NAME}_initial_attitude"],
     "stop": [("tracker", "done")],
     "order": ["tracker", "dynamics", "guidance"],
     "stop_time": 600.0,
@@ -94,8 +100,9 @@ SYSTEM = {
 
 def scenario(sun):
     g = {f"guidance.{k}": v for k, v in vec("sun_N", sun).items()}
-    g.update({f"guidance.{k}": v for k, v in {**vec("q0", list(Q0)), **vec("q_f", list(Q_F))}.items()})
-    g.update({f"dynamics.{k}": v for k, v in INITIAL.items()})
+    g.update({f"guidance.{k}": v for k, v in vec("q_f", list(Q_F)).items()})
+    g.update(vec("initial_attitude", list(Q0)))
+    g.update({f"dynamics.{k}": v for k, v in INITIAL.items() if not k.startswith("q0")})
     return g
 
 
@@ -112,4 +119,6 @@ def generate(writer):
                "Sun 10 deg off the direct eigenaxis path (keep-out 30 deg): three-segment detour", scenario(sun_near()))
     writer.ssv(f"{NAME}_far_sun",
                "Sun opposite the direct path's midpoint: single eigenaxis slew", scenario(sun_far()))
+    writer.ssv(f"{NAME}_initial_attitude", "Initial attitude q_BN of the guidance and the rigid body, given once",
+               vec("initial_attitude", list(Q0)))
     writer.ssd(NAME, SYSTEM)

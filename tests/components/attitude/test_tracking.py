@@ -153,11 +153,12 @@ def test_fmu_declarations(build_one):
     deps = check_declarations(build_one("neighbor_tracking.py"))
     q_in = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
     w_in = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-    assert deps["torque_cmd_B[2]"] == sorted(q_in + w_in + ["enabled"])
-    assert deps["thrust_flag[1]"] == sorted(q_in + w_in + ["enabled"])
-    assert deps["done"] == sorted(q_in + w_in)
-    assert deps["attitude_error"] == sorted(q_in) and deps["q_d[4]"] == sorted(q_in)
-    assert deps["sliding_vector[3]"] == sorted(q_in + w_in)
+    target = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
+    assert deps["torque_cmd_B[2]"] == sorted(q_in + w_in + target + ["enabled"])
+    assert deps["thrust_flag[1]"] == sorted(q_in + w_in + target + ["enabled"])
+    assert deps["done"] == sorted(q_in + w_in + target)
+    assert deps["attitude_error"] == sorted(q_in + target) and deps["q_d[4]"] == sorted(q_in + target)
+    assert deps["sliding_vector[3]"] == sorted(q_in + w_in + target)
 
 
 def test_fmu_closed_loop_with_rigid_body_matches_component(build_one, tmp_path):
