@@ -43,13 +43,17 @@ class Propulsion(NeighborSlave):
                     "Propellant mass flow (>= 0; zero when not burning)", depends_on=deps)
         self.output("burning", lambda: self.model.burning(self.values["burn_enable"]), None,
                     "True while burn_enable is true and the budget is not spent", bool, depends_on=deps)
-        self.output("mass", lambda: self.model.mass, "kg", "Current total spacecraft mass mass0 - propellant_used")
+        self.output("mass", lambda: self.model.mass_with(self.values["rcs_propellant"]), "kg",
+                    "Current total spacecraft mass: mass0 - propellant_used - rcs_propellant (one tank)",
+                    depends_on=["rcs_propellant"])
         self.output("propellant_used", lambda: self.model.used, "kg", "Propellant used so far")
         self.output("propellant_remaining", lambda: self.model.remaining, "kg",
                     "Propellant budget not yet used")
         self.output("burn_time", lambda: self.model.burn_time, "s", "Accumulated burn time")
         self.output("budget_spent", lambda: self.model.spent, None,
                     "True once the propellant budget is used up (thrust stays off)", bool)
+        self.input("rcs_propellant", 0.0, "kg", "Propellant the RCS thrusters have drawn from the same tank (>= 0), "
+                   "from the thruster FMU; lowers the mass")
 
     def build_model(self):
         v = self.values

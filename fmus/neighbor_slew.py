@@ -66,8 +66,9 @@ class SlewController(NeighborSlave):
                                    self.values["settle_angle"])
 
     def _targeted(self):
-        """The model, its target taken from the inputs when target_from_input."""
-        if self.values["target_from_input"]:
+        """The model, its target taken from the inputs when target_from_input and enabled (a
+        disabled controller's inputs are not refreshed by a master that suspends it)."""
+        if self.values["target_from_input"] and self.values["enabled"]:
             self.model.set_target(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
         return self.model
 

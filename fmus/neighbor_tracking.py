@@ -74,8 +74,9 @@ class TrackingController(NeighborSlave):
             self.vector("omega_dot_d", 3), self.vector("torque_level", 3), q_d0)
 
     def _targeted(self):
-        """The model, its reference taken from the inputs when target_from_input."""
-        if self.values["target_from_input"]:
+        """The model, its reference taken from the inputs when target_from_input and enabled (a
+        disabled controller's inputs are not refreshed by a master that suspends it)."""
+        if self.values["target_from_input"] and self.values["enabled"]:
             self.model.follow(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
         return self.model
 
@@ -100,7 +101,7 @@ class TrackingController(NeighborSlave):
         return self._targeted().target(self.vector("q_BN", 4))
 
     def do_step(self, current_time, step_size):
-        if self.values["target_from_input"] and self.values["enabled"]:
+        if self.values["target_from_input"]:
             self._targeted()  # a new target from the guidance re-anchors q_d before it is propagated
         self.model.advance(step_size, self.vector("q_BN", 4), self.values["enabled"])
         self._input_version += 1  # q_d changed: outputs computed before the step are stale

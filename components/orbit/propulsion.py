@@ -243,6 +243,13 @@ class MainThrusters:
     def mass(self):
         return self.mass0 - self.used
 
+    def mass_with(self, rcs_propellant):
+        """Total mass (kg) when the RCS has also drawn `rcs_propellant` (kg) from the shared tank."""
+        rcs = float(rcs_propellant)
+        if not (math.isfinite(rcs) and 0.0 <= rcs < self.mass):
+            raise ValueError(f"rcs_propellant = {rcs_propellant!r} kg must be in [0, {self.mass!r}) (the mass left)")
+        return self.mass - rcs
+
     @property
     def remaining(self):
         return self.budget - self.used

@@ -164,6 +164,11 @@ def summarize(r, scenario, orbit):
     s["detumble_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.SLEW][0]] - rcs[starts[DeorbitPhase.DETUMBLE][0]])
     s["slew_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.BURN][0]] - rcs[starts[DeorbitPhase.SLEW][0]])
     s["tracking_propellant_g"] = 1e3 * float(rcs[i_mon] - rcs[starts[DeorbitPhase.BURN][0]])
+    # the thrust axis against the tracked burn attitude, after the first 10 s of the burn (the
+    # tracking's own transient from the slew's end state)
+    burning = (t >= starts[DeorbitPhase.BURN][1] + 10.0) & (t < t_mon)
+    pointing = np.degrees(d["tracking.pointing_error"][burning])
+    s["burn_pointing_error_deg"] = float(pointing.max()) if pointing.size else None
     s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
     s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
     soc, energy = d["power.state_of_charge"], d["power.energy"]
@@ -201,6 +206,7 @@ def table(s):
             ("detumble propellant (g)", "detumble_propellant_g", "{:.3f}"),
             ("slew propellant (g)", "slew_propellant_g", "{:.3f}"),
             ("tracking propellant during the burn (g)", "tracking_propellant_g", "{:.3f}"),
+            ("largest thrust-axis pointing error in the burn (deg, after 10 s)", "burn_pointing_error_deg", "{:.3f}"),
             ("total propellant (kg; thesis: sized for the worst-case slew)", "total_propellant_kg", "{:.4f}"),
             ("battery after the de-orbit maneuver (%)", "soc_after_burn_percent", "{:.2f}"),
             ("energy used to the end of the burn (Wh)", "energy_used_Wh", "{:.3f}"),
@@ -322,9 +328,15 @@ def plot(d, s, out):
                 _envelope(axes[1], tt, np.degrees(e - e[0]), color, ("phi", "theta", "psi")[i - 1])
             axes[1].set_ylabel("angle turned, Eq. 31 (deg)")
         if burn:
-            _envelope(axes[2], tt, np.degrees(d["tracking.attitude_error"][sel]), "k",
-                      "angle from the desired attitude", linewidth=0.8)
+            err = np.degrees(d["tracking.attitude_error"][sel])
+            _envelope(axes[2], tt, err, "k", "angle from the desired attitude", linewidth=0.8)
             axes[2].set_ylabel("tracking error (deg)")
+            settled = err[tt >= 10.0]
+            if settled.size and err.max() > 3.0 * settled.max() > 0.0:
+                # the first seconds (the slew's end state, the first target) would flatten the rest
+                axes[2].set_ylim(0.0, 1.5 * settled.max())
+                axes[2].annotate(f"first 10 s: up to {err.max():.1f} deg (off the scale)", (0.02, 0.9),
+                                 xycoords="axes fraction", fontsize=8)
         axes[-1].set_xlabel("time in phase (s)")
         for a in axes:
             legend(a, loc="upper left", bbox_to_anchor=(1.01, 1.0))

@@ -22,10 +22,12 @@ FAMILIES = [
     ("orbit", ["Orbit", "OrbitAveraged"], [("deorbit", "orbit"), ("deorbit_lifetime", "orbit")]),
     ("RCS attitude controller", ["DetumbleController", "SlewController", "TrackingController"],
      [("detumble", "detumble"), ("slew", "slew")]),
+    ("RCS thrusters", ["RcsThrusters", "RcsThrusterSet"], [("detumble", "thrusters"), ("slew", "thrusters")]),
 ]
 # Connectors a family member may have beyond the family's (its own outputs; the tracking law's
 # desired-attitude signals)
-EXTRAS = {"attitude_error", "pointing_error", "sliding_vector[1]", "sliding_vector[2]", "sliding_vector[3]"}
+EXTRAS = {"attitude_error", "pointing_error", "sliding_vector[1]", "sliding_vector[2]", "sliding_vector[3]",
+          "axial_firing", "force_B[1]", "force_B[2]", "force_B[3]"}  # the thruster set's burn torque and net force
 
 
 def _cli(*args):

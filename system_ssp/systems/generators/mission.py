@@ -9,7 +9,8 @@ re-entry. Components (instance: FMU):
   propulsion: Propulsion (de-orbit burn)    dynamics: RigidBody (thesis Euler StateChange)
   detumble / slew / tracking: the three RCS attitude controllers (only the enabled one commands)
   guidance: BurnGuidance (burn attitude and rate from the orbit) -> slew and tracking targets
-  selector: TorqueSelector -> thrusters: RcsThrusters -> dynamics
+  selector: TorqueSelector -> thrusters: RcsThrusterSet (the 16 thrusters one by one) -> dynamics;
+  the RCS propellant comes out of the propulsion's tank (propulsion.rcs_propellant lowers the mass)
   power: Power (LG HG2 cell, Table 5 loads)   data: DataStorage (256 kB flash, 9600 baud)
 `neighbor_mission_lifetime` is the same system with orbit = OrbitAveraged (the fidelity swap).
 
@@ -97,7 +98,7 @@ COMPONENTS = {
     "slew": ("SlewController", ["slew_gains", "mission_slew"], {"slew"}),
     "tracking": ("TrackingController", ["mission_tracking"], {"burn"}),
     "selector": ("TorqueSelector", [], set()),
-    "thrusters": ("RcsThrusters", ["thrusters"], set()),
+    "thrusters": ("RcsThrusterSet", ["thrusters"], set()),
     "power": ("Power", ["mission_power"], {"idle", "bus", "monitor", "slow"}),
     "data": ("DataStorage", ["mission_data"], {"bus", "monitor", "slow"}),
 }
@@ -226,6 +227,8 @@ def system(orbit_fmu):
              ("slew", "torque_cmd_B", "selector", "torque_cmd_slew_B", 3),
              ("tracking", "torque_cmd_B", "selector", "torque_cmd_tracking_B", 3),
              ("selector", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
+             ("thrusters", "propellant_mass", "propulsion", "rcs_propellant", 0),
+             ("propulsion", "burning", "thrusters", "axial_firing", 0),
              ("thrusters", "torque_B", "dynamics", "torque_B", 3),
              ("mission", "data_recording", "data", "data_recording", 0),
              ("mission", "downlink_enable", "data", "downlink_enable", 0),

@@ -1,0 +1,78 @@
+"""FMU `RcsThrusterSet` (instance `thrusters`): the NEIGHBOR thrusters one by one.
+
+Wraps components.attitude.thruster_set.ThrusterSet: the thesis' 12 RCS thrusters on the module's
+edge centres and 4 axial thrusters on its -x face corners (Figures 16-19), each with its own
+position, direction, optional force error and misalignment; torque per Eq. 13 (l x F) summed over
+the firing thrusters, the minimum on-time, the propellant thruster by thruster (Eq. 74). Same
+connectors as the pair model `RcsThrusters` (torque_cmd_B in; torque_B, thrust_flag,
+torque_level, fire_time, fire_time_total, propellant_mass out), so a system swaps one for the
+other by replacing the component; in addition the net RCS force, and `axial_firing` (the burn)
+adds the axial thrusters' torque, a disturbance when they are misaligned.
+"""
+from neighbor_fmu_support import NeighborSlave
+
+from components.attitude import thruster_set
+
+CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
+N = 16
+
+
+class RcsThrusterSet(NeighborSlave):
+    description = ("NEIGHBOR thrusters one by one (thesis Figures 16-19, Eq. 13, 74): 12 RCS thrusters on the "
+                   "module's edge centres and 4 axial thrusters, per-thruster force error and misalignment, "
+                   "minimum on-time; applied torque, net force, firing time and propellant")
+
+    def __init__(self, **kwargs):
+        super().__init__(**kwargs)
+        self.parameter("thrust", 0.025, "N", "Nominal force of one RCS thruster (25 mN)")
+        self.parameter("edge_a", 0.1, "m", "Edge a of the host: the module's side, x-pair spacing (Eq. 16)")
+        self.parameter("edge_c", 0.3, "m", "Edge c of the host along x: the y/z pairs' arms c/2, c/2 - c/3 (Eq. 16)")
+        self.parameter("Isp", 42.0, "s", "Specific impulse of the thrusters")
+        self.parameter("g0", 9.81, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
+        self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
+        self.output_array("torque_B", 3, lambda: self.feedthrough(self._force_torque)[1], "N.m",
+                          "Torque of the firing thrusters, sum of l x F (Eq. 13)",
+                          depends_on=CMD_INPUTS + ["axial_firing"])
+        self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._flags), None,
+                          "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=CMD_INPUTS)
+        self.output_array("torque_level", 3, lambda: self.model.levels, "N.m",
+                          "Nominal torque of one thruster pair per axis (Eq. 16)")
+        self.output_array("fire_time", 3, lambda: self.model.axis_fire_time(), "s",
+                          "Accumulated firing time of the x, y, z thruster pairs")
+        self.output("fire_time_total", lambda: sum(self.model.axis_fire_time()), "s",
+                    "Firing time summed over the axes (the thesis' ThrustTime)")
+        self.output("propellant_mass", lambda: self.model.propellant_mass(), "kg",
+                    "RCS propellant used, sum of |F_i| t_i / (Isp g0) over the thrusters (Eq. 74)")
+        self.parameter("min_on_time", 0.0, "s",
+                       "Minimum on-time of a firing (>= 0): a thruster fired stays on at least this long")
+        self.parameter_array("force_error", [0.0] * N, "1",
+                             "Force error of each thruster as a fraction of thrust, in (-1, 1] (12 RCS, then 4 axial)")
+        self.parameter_array("misalignment_1", [0.0] * N, "rad",
+                             "Misalignment of each thruster's direction: rotation about its first perpendicular axis "
+                             "(|angle| <= 0.2)")
+        self.parameter_array("misalignment_2", [0.0] * N, "rad",
+                             "Misalignment of each thruster's direction: rotation about its second perpendicular axis "
+                             "(|angle| <= 0.2)")
+        self.input("axial_firing", False, None, "The axial de-orbit thrusters are firing (the burn): their torque "
+                   "is added (their force is the propulsion's)", bool)
+        self.output_array("force_B", 3, lambda: self.feedthrough(self._force_torque)[0], "N",
+                          "Net force of the firing RCS thrusters in B (zero for aligned pairs; the axial thrusters' "
+                          "force is the propulsion's)",
+                          depends_on=CMD_INPUTS + ["axial_firing"])
+
+    def build_model(self):
+        v = self.values
+        return thruster_set.ThrusterSet(
+            v["thrust"], v["edge_a"], v["edge_c"], v["Isp"], v["g0"], v["min_on_time"], self.vector("force_error", N),
+            list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))))
+
+    def _flags(self):
+        return self.model.flags(self.vector("torque_cmd_B", 3))
+
+    def _force_torque(self):
+        return self.model.force_and_torque(self.feedthrough(self._flags), self.values["axial_firing"])
+
+    def do_step(self, current_time, step_size):
+        self.model.step(self.feedthrough(self._flags), step_size)
+        self._input_version += 1  # the minimum on-time changed: outputs computed before the step are stale
+        return True

@@ -1,0 +1,76 @@
+"""The thrusters one by one (thesis Figures 16-19, Eq. 13, 16, 74): the geometry gives the pair
+torques with no net force, misalignment and force errors give real hardware's torques and
+forces, the minimum on-time holds a firing, and the propellant is counted per thruster."""
+import math
+
+import numpy as np
+import pytest
+
+from components.attitude import thruster_control as tc
+from components.attitude.thruster_set import ThrusterSet, thesis_layout
+from components.attitude.thrusters import ThrusterPairs
+
+
+def test_thesis_geometry_gives_the_pair_torques_and_no_net_force():
+    layout = thesis_layout()
+    assert len(layout) == 16 and sum(role == "axial" for *_, role in layout) == 4
+    # every RCS thruster on the centre of an edge of the module (x in [-0.15, -0.05], |y|, |z| <= 0.05)
+    for _, (x, y, z), d, role in layout:
+        assert -0.15 <= x <= -0.05 and abs(y) <= 0.05 and abs(z) <= 0.05
+        assert math.isclose(np.linalg.norm(d), 1.0)
+        if role != "axial":
+            assert sum(abs(v) in (0.05,) for v in (y, z)) + (x in (-0.15, -0.05)) == 2  # on an edge
+    s = ThrusterSet()
+    levels = tc.pair_torques()
+    for axis in range(3):
+        for sign in (1, -1):
+            flags = [0, 0, 0]
+            flags[axis] = sign
+            force, torque = s.force_and_torque(flags)
+            expected = [0.0, 0.0, 0.0]
+            expected[axis] = sign * levels[axis]
+            assert torque == tuple(expected)  # bit for bit: the thesis cases do not move
+            assert force == (0.0, 0.0, 0.0)
+    assert s.force_and_torque([0, 0, 0], axial=True) == ((0.0, 0.0, 0.0), (0.0, 0.0, 0.0))
+
+
+def test_same_firing_and_propellant_as_the_pair_model():
+    pairs, single = ThrusterPairs(), ThrusterSet()
+    rng = np.random.default_rng(3)
+    for _ in range(400):
+        cmd = rng.uniform(-0.004, 0.004, 3)
+        assert single.flags(cmd) == pairs.flags(cmd)
+        assert single.force_and_torque(single.flags(cmd))[1] == pytest.approx(pairs.applied_torque(cmd), abs=1e-18)
+        pairs.step(cmd, 0.015)
+        single.step(single.flags(cmd), 0.015)
+    assert single.axis_fire_time() == pytest.approx(pairs.fire_time, rel=1e-12)
+    assert single.propellant_mass() == pytest.approx(pairs.propellant_mass(), rel=1e-12)
+
+
+def test_misalignment_and_force_error_leave_a_net_force_and_cross_torques():
+    angle = math.radians(1.0)
+    # the same tilt of a pair's two opposite thrusters cancels in the force: tilt them apart
+    s = ThrusterSet(misalignment=[(angle * (-1) ** i, 0.0) for i in range(16)], force_error=[0.02] * 16)
+    force, torque = s.force_and_torque([0, 1, 0])
+    assert 0.0 < np.linalg.norm(force) <= 2 * 0.025 * 1.02 * math.sin(angle) + 1e-12
+    assert abs(torque[1]) == pytest.approx(tc.pair_torques()[1] * 1.02, rel=1e-3)
+    assert max(abs(torque[0]), abs(torque[2])) > 0.0  # cross-axis torque from the tilt
+    # the four axial thrusters tilted alike: the burn's disturbance torque, (sum of l) x F
+    _, burn = ThrusterSet(misalignment=[(angle, 0.0)] * 16).force_and_torque([0, 0, 0], axial=True)
+    assert np.linalg.norm(burn) == pytest.approx(4 * 0.025 * 0.15 * math.sin(angle), rel=1e-6)
+    with pytest.raises(ValueError, match="misalignment must be 16 pairs"):
+        ThrusterSet(misalignment=[(0.3, 0.0)] * 16)
+    with pytest.raises(ValueError, match="force_error must be 16"):
+        ThrusterSet(force_error=[0.0] * 3)
+
+
+def test_minimum_on_time_holds_a_firing():
+    s = ThrusterSet(min_on_time=0.05)
+    s.step([1, 0, 0], 0.015)
+    for _ in range(3):  # the command is gone, the thrusters finish their 50 ms
+        assert s.force_and_torque([0, 0, 0])[1][0] > 0.0
+        s.step([0, 0, 0], 0.015)
+    assert s.force_and_torque([0, 0, 0])[1] == (0.0, 0.0, 0.0)
+    assert s.axis_fire_time()[0] == pytest.approx(0.06)
+    s.set_state(ThrusterSet().get_state())
+    assert s.propellant_mass() == 0.0
