@@ -171,7 +171,8 @@ def test_fmu_declarations(fmu_path):
     feed = ["burn_enable"]
     for name in ("F_thrust_B[1]", "F_thrust_B[2]", "F_thrust_B[3]", "mdot", "burning"):
         assert deps[name] == feed
-    for name in ("mass", "propellant_used", "propellant_remaining", "burn_time", "budget_spent"):
+    assert deps["mass"] == ["rcs_propellant"]  # the RCS draws from the same tank
+    for name in ("propellant_used", "propellant_remaining", "burn_time", "budget_spent"):
         assert deps[name] == []
     md = fmpy.read_model_description(str(fmu_path))
     units = {v.name: v.unit for v in md.modelVariables}
@@ -211,3 +212,12 @@ def test_fmu_burn_through_fmpy(fmu_path, tmp_path):
 def test_fmu_rejects_budget_above_mass(fmu_path):
     with pytest.raises(Exception):
         fmpy.simulate_fmu(str(fmu_path), stop_time=1.0, start_values={"propellant_budget": 13.0})
+
+
+def test_the_rcs_draws_from_the_same_tank():
+    m = p.MainThrusters(mass0=12.0, propellant_budget=0.5)
+    m.step(True, 60.0)
+    assert m.mass_with(0.01) == pytest.approx(12.0 - m.used - 0.01, rel=1e-15)
+    for bad in (-0.001, math.nan, 12.0):
+        with pytest.raises(ValueError, match="rcs_propellant"):
+            m.mass_with(bad)
