@@ -45,6 +45,18 @@ def quantize(command, levels, thresholds=None):
     return torque, flags
 
 
+def nearest_pair_flags(command, levels):
+    """-1/0/+1 per axis: the pair torque in {-L, 0, +L} nearest the commanded torque (the thruster
+    models' rounding: a controller's already-quantized command passes through unchanged)."""
+    out = []
+    for i in range(3):
+        c, half = command[i], 0.5 * levels[i]
+        if not math.isfinite(c):
+            raise ValueError(f"torque_cmd_B[{i + 1}] = {c!r} must be finite")
+        out.append(1 if c >= half else (-1 if c <= -half else 0))
+    return out
+
+
 def impulse_bit_rates(levels, inertia_diagonal, min_on_time):
     """Rate change (rad/s) one firing of the minimum on-time gives about each axis, L t_min / I_ii:
     the smallest correction the RCS can make, which a stop window or a rate deadband narrower

@@ -113,14 +113,8 @@ class ThrusterSet:
         self.on_left = [0.0] * n  # minimum on-time still owed after a firing started
 
     def flags(self, command):
-        """-1/0/+1 per axis: the pair whose nominal torque is nearest the commanded torque."""
-        out = []
-        for i in range(3):
-            c, half = command[i], 0.5 * self.levels[i]
-            if not math.isfinite(c):
-                raise ValueError(f"torque_cmd_B[{i + 1}] = {c!r} must be finite")
-            out.append(1 if c >= half else (-1 if c <= -half else 0))
-        return out
+        """-1/0/+1 per axis: nearest available level to the commanded torque."""
+        return tc.nearest_pair_flags(command, self.levels)
 
     def axis_fire_time(self):
         """Firing time of the x, y and z pairs (s): each pair's two thrusters' time, halved."""

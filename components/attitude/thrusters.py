@@ -25,13 +25,7 @@ class ThrusterPairs:
 
     def flags(self, command):
         """-1/0/+1 per axis: nearest available level to the commanded torque."""
-        out = []
-        for i in range(3):
-            c, half = command[i], 0.5 * self.levels[i]
-            if not math.isfinite(c):
-                raise ValueError(f"torque_cmd_B[{i + 1}] = {c!r} must be finite")
-            out.append(1 if c >= half else (-1 if c <= -half else 0))
-        return out
+        return tc.nearest_pair_flags(command, self.levels)
 
     def applied_torque(self, command):
         return [f * lvl for f, lvl in zip(self.flags(command), self.levels)]
