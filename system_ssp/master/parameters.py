@@ -145,7 +145,7 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
     """All start values for a run: {(comp index, var): value}, later sources overriding earlier:
     the SSD's component bindings, the root system's bindings, `parameter_sets`, `parameters`."""
     out = {}
-    fan_out = getattr(system, "parameter_links", {})
+    fan_out = system.parameter_links
 
     def put(comp, var, pv):
         out[(comp.index, var)] = resolve_parameter(system, comp, var, pv.value, pv.type, pv.unit, pv.units,
@@ -169,6 +169,17 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
                            f"{', '.join(fan_out)}) and not 'component.variable'")
         return split_name(system.comps, name, where)
 
+    def put_named(pv, where):
+        """A bound or file value: to a component's parameter or fanned out as a system parameter."""
+        try:
+            target = named(pv.name, where)
+        except SSPError as exc:
+            raise SSPError(f"{pv.origin}: {exc}") from None
+        if target is None:
+            put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
+        else:
+            put(*target, pv)
+
     for comp in system.comps:
         for pv in comp.decl.parameters:
             if pv.name not in comp.vars:
@@ -176,21 +187,10 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
                                f"variable{near(pv.name, comp.vars)}")
             put(comp, pv.name, pv)
     for pv in system.desc.parameters:
-        target = named(pv.name, f"{pv.origin}: parameter")
-        if target is None:
-            put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
-        else:
-            put(*target, pv)
+        put_named(pv, "parameter")
     for ps in parameter_sets or []:
         for pv in read_parameter_set(system, ps):
-            try:
-                target = named(pv.name, "parameter")
-            except SSPError as exc:
-                raise SSPError(f"{pv.origin}: {exc}") from None
-            if target is None:
-                put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
-            else:
-                put(*target, pv)
+            put_named(pv, "parameter")
     for name, value in (parameters or {}).items():
         target = named(name, "parameter")
         if target is None:
