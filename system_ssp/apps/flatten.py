@@ -7,7 +7,8 @@ connections without startElement to every component parameter that uses it). lib
 such a connection ("No such node (<xmlattr>.startElement)"). The flattened copy writes each
 system parameter's value, as our master resolves it, into the first ParameterBinding of every
 component it reaches (the one libcosim applies; added if the component has none) and removes the
-system's parameter connectors, their connections and the system-level bindings. The result runs
+system's parameter connectors, their connections and the system-level bindings (a value those set
+for a component's variable directly goes into that component's binding too). The result runs
 the same in any host; what it loses is the single place to change a value.
 """
 import argparse
@@ -18,6 +19,7 @@ from lxml import etree
 
 from ..errors import SSPError
 from ..master import System
+from ..master.names import split_name
 from ..master.parameters import collect_parameters
 from ..ssp.reader import NS, NS_SSV
 from .replace import _pack, _unpack
@@ -27,17 +29,20 @@ def flatten_system_parameters(source, out):
     """Write `out` (.ssp): `source` with its system parameters folded into component bindings.
     Returns {system parameter: [component.variable, ...]} of what was folded."""
     with System(source) as system:
+        names = set(system.parameter_links)
         links = {name: targets for name, targets in system.parameter_links.items() if targets}
         values = collect_parameters(system)
+        # what the system-level bindings set directly (component.variable) goes to the components too
+        direct = [split_name(system.comps, pv.name, pv.origin) for pv in system.desc.parameters
+                  if pv.name not in names]
     with tempfile.TemporaryDirectory() as tmp:
         root = Path(tmp)
         ssd = _unpack(source, root)
         tree = etree.parse(str(ssd))
         sys_el = tree.getroot().find("ssd:System", NS)
         per_component = {}
-        for targets in links.values():
-            for comp, var, _ in targets:
-                per_component.setdefault(comp.name, {})[var] = values[(comp.index, var)]
+        for comp, var in [(c, v) for targets in links.values() for c, v, _ in targets] + direct:
+            per_component.setdefault(comp.name, {})[var] = values[(comp.index, var)]
         for comp_el in sys_el.find("ssd:Elements", NS).findall("ssd:Component", NS):
             if comp_el.get("name") in per_component:
                 _fold(root, tree.getroot().get("name"), comp_el, per_component[comp_el.get("name")])
@@ -49,7 +54,8 @@ def flatten_system_parameters(source, out):
             sys_el.remove(connectors)
         conns = sys_el.find("ssd:Connections", NS)
         for c in list(conns.findall("ssd:Connection", NS)):
-            if c.get("startElement") is None and c.get("startConnector") in links:
+            if ((c.get("startElement") is None and c.get("startConnector") in names)
+                    or (c.get("endElement") is None and c.get("endConnector") in names)):
                 conns.remove(c)
         bindings = sys_el.find("ssd:ParameterBindings", NS)
         if bindings is not None:
