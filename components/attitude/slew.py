@@ -17,7 +17,7 @@ Flight options (defaults give the thesis law):
   Kd_i rate_deadband_i), i.e. when the switching function L_i / Kd_i is beyond the deadband.
   The thesis threshold (pair torque / Kd = 0.008 deg/s) is narrower than the rate change of
   one 15 ms pulse (0.017-0.043 deg/s), so near the target every pulse overshoots and the next
-  fires back: the law limit-cycles at every step and never meets a 0.01 deg/s window. A
+  fires back: the law limit-cycles and meets a 0.01 deg/s window only by chance. A
   deadband of one impulse bit (thruster_control.impulse_bit_rates) lets a pulse end inside it.
 - `settle_time` (s) > 0: done once the attitude error angle is within `settle_angle` and every
   rate error within omega_tol, held for settle_time (the single-sample element test otherwise).
