@@ -32,13 +32,7 @@ class AttitudeDetermination(NeighborSlave):
                        "Smallest angle between nadir and Sun for a TRIAD fix, [0, pi/2)")
         self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
                              "Initial estimate q_BN (used until the first fix; normalized, non-zero)")
-        self.input_array("nadir_B", [0.0, 0.0, 0.0], "1", "Measured nadir unit vector in B")
-        self.input("nadir_valid", False, None, "Nadir measurement valid", bool)
-        self.input_array("sun_B", [0.0, 0.0, 0.0], "1", "Measured Sun unit vector in B")
-        self.input("sun_valid", False, None, "Sun measurement valid", bool)
-        self.input_array("omega_meas_B", [0.0, 0.0, 0.0], "rad/s", "Measured angular velocity in B (gyro)")
-        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N (e.g. GPS)")
-        self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N (ephemeris)")
+        self.attitude_measurement_inputs()
         self.output_array("q_est_BN", 4, lambda: self.feedthrough(self._estimate)[0], "1",
                           "Estimated attitude quaternion q_BN, scalar last", depends_on=VECTORS)
         self.output_array("omega_est_B", 3, lambda: self.feedthrough(self._rate), "rad/s",

@@ -160,6 +160,18 @@ class NeighborSlave(Fmi2Slave):
         self.input_array("omega_target_B", [0.0] * 3, "rad/s",
                          f"Target angular velocity in B, from the guidance; {used_when}")
 
+    def attitude_measurement_inputs(self):
+        """The inputs of the attitude-knowledge family (AttitudeDetermination, AttitudeEstimator):
+        the nadir and Sun vectors with their validity, the gyro rate, and the positions that give
+        the vectors' reference directions, in this order."""
+        self.input_array("nadir_B", [0.0, 0.0, 0.0], "1", "Measured nadir unit vector in B")
+        self.input("nadir_valid", False, None, "Nadir measurement valid", bool)
+        self.input_array("sun_B", [0.0, 0.0, 0.0], "1", "Measured Sun unit vector in B")
+        self.input("sun_valid", False, None, "Sun measurement valid", bool)
+        self.input_array("omega_meas_B", [0.0, 0.0, 0.0], "rad/s", "Measured angular velocity in B (gyro)")
+        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N (e.g. GPS)")
+        self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N (ephemeris)")
+
     def inertia_parameters(self, mass_description):
         """The spacecraft inertia parameters shared by RigidBody and the controllers that use
         the inertia: mass and box edges (Eq. 4) or a full tensor inertia_B[i,j]."""
