@@ -36,16 +36,16 @@ deployed at the altitude from which it decays to the scenario altitude by then (
 the orbit-averaged model and the same Jacchia-Roberts atmosphere and space weather), and the
 heartbeat lost 5 years after deployment. The burn spends the scenario's Eq. 2-3 propellant.
 
-Guidance, navigation and control come in two parameter sets (GNC_SETS), one of which the
-mission command applies after the scenario's:
-  closed_loop  the orbit thrusts along the body's thrust axis (q_BN from the rigid body), the
+Guidance, navigation and control come in two sets (system_ssp.apps.mission.GNC picks one after
+the scenario's parameter set):
+  closed-loop  (the system's own bindings) the orbit thrusts along the body's thrust axis, the
                guidance FMU computes the burn attitude and its rate from the orbit's r and v, the
                slew and the tracking take it as their target; flight settle criteria and an
                impulse-bit rate deadband end the maneuvers off the nominal point; RK4 attitude.
-  thesis       the thesis' numbers: thrust along -v whatever the attitude (orbit.retrograde, the
-               lower-fidelity option), identity slew target, tracking at the Eq. 67 rate of
-               Re + 400 km latched from the attitude at the burn start, single-sample stop tests,
-               Euler attitude integration.
+  thesis       (parameters/mission_gnc_thesis.ssv) the thesis' numbers: thrust along -v
+               whatever the attitude (orbit.retrograde, the lower-fidelity option), identity slew
+               target, tracking at the Eq. 67 rate of Re + 400 km latched from the attitude at the
+               burn start, single-sample stop tests, Euler attitude integration.
 """
 import datetime as dt
 import math
@@ -129,7 +129,6 @@ GNC_THESIS = {"orbit.retrograde": True, "dynamics.integrator": "euler", "trackin
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
               **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
-GNC_SETS = {"closed_loop": None, "thesis": "mission_gnc_thesis"}  # None: the system's own bindings
 
 
 # The spacecraft's physical values, each given once (system parameters of the SSD, in
