@@ -1,20 +1,25 @@
 """FMU `AttitudeEstimator` (instance `estimator`): TRIAD to start, then a multiplicative
 extended Kalman filter on the gyro with nadir and Sun vector updates (thesis 3.3.1).
 
-Wraps components.sensing.mekf.AttitudeEstimator. The same inputs as `AttitudeDetermination`
+Wraps components.sensing.mekf.AttitudeEstimator. The same first inputs as `AttitudeDetermination`
 (the TRIAD-only estimator), so a system swaps one for the other by replacing the component.
-do_step: before the first TRIAD fix it waits (`initialized` false, q_est_BN = q0); the fix
-starts the filter; afterwards each valid vector at the step's start updates it and the gyro
-propagates it to the step's end, where the outputs are (state outputs; `omega_est_B`, the
-bias-corrected gyro rate, is direct feedthrough).
+do_step(t, h) takes the inputs as the measurements of the step's end (mekf.AttitudeEstimator.step):
+it propagates the attitude with the gyro sample held from the last step and the rate with the
+commanded torque, then fuses the new vectors and gyro sample. Before the first TRIAD fix it
+waits (`initialized` false, q_est_BN = q0). Every output is computed in do_step (no direct
+feedthrough): in a Gauss-Seidel master that steps the estimator after the rigid body and the
+sensors, the outputs after the step are the estimate at t + h; in a Jacobi master, at t.
+
+`truth_feedback` (a fidelity choice, e.g. the thesis' parameter set): the controller-facing
+outputs q_est_BN, omega_est_B and omega_dot_est_B are the truth inputs of the step (the filter
+does not run), so controllers wired to the estimator fly on the true state.
 """
 import math
 
 from neighbor_fmu_support import NeighborSlave
 
-from components.sensing import mekf
-
-RATE = [f"omega_meas_B[{i}]" for i in (1, 2, 3)]
+from components.attitude import rigid_body
+from components.sensing import mekf, triad
 
 
 class AttitudeEstimator(NeighborSlave):
@@ -23,6 +28,7 @@ class AttitudeEstimator(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
+        self._out = None  # the outputs, computed at the end of initialization and of each step
         self.parameter("nadir_sigma", math.radians(0.25), "rad", "Horizon sensor error angle RMS, >= 0")
         self.parameter("sun_sigma", math.radians(0.5) / 3.0, "rad", "Sun sensor error angle RMS, >= 0")
         self.parameter("gyro_sigma", 5.5e-4, "rad/s", "Gyro rate noise RMS per sample, >= 0")
@@ -37,37 +43,110 @@ class AttitudeEstimator(NeighborSlave):
                              "Output q_est_BN before the first fix (unit, scalar last)")
         self.attitude_measurement_inputs()
         self.output_array("q_est_BN", 4, self._q, "1", "Estimated attitude quaternion q_BN, scalar last")
-        self.output_array("omega_est_B", 3, lambda: self.feedthrough(self._rate), "rad/s",
-                          "Estimated angular velocity in B: the gyro rate less the estimated bias", depends_on=RATE)
+        self.output_array("omega_est_B", 3, lambda: self._outputs()["omega"], "rad/s",
+                          "Estimated angular velocity in B (the rate filter on the bias-corrected gyro; the raw "
+                          "gyro before the first sample)")
         self.output_array("bias_est_B", 3, lambda: list(self.model.filter.bias), "rad/s", "Estimated gyro bias")
         self.output_array("sigma_attitude", 3, self._sigma, "rad",
                           "1-sigma attitude error about the body axes from the covariance (0 before the first fix)")
-        self.output("initialized", lambda: self.model.filter.initialized, None,
-                    "The filter has started (a TRIAD fix was possible)", bool)
+        self.output("initialized", lambda: self.values["truth_feedback"] or self.model.filter.initialized, None,
+                    "The filter has started (a TRIAD fix was possible); always true with truth_feedback", bool)
+        # appended after the first release's variables (their value references stay)
+        self.parameter("truth_feedback", False, None,
+                       "True: q_est_BN, omega_est_B and omega_dot_est_B are the truth inputs (perfect knowledge, the "
+                       "filter does not run); false: the estimate", bool)
+        self.parameter("update_interval", 0.0, "s",
+                       "Shortest time between two updates with the same sensor, >= 0 (a vector equal to the last one "
+                       "used is a held sample and never used again)")
+        self.parameter("accel_sigma", 5e-4, "rad/s2",
+                       "Rate filter: 1-sigma angular acceleration the torque model misses (thruster errors, "
+                       "disturbances), >= 0")
+        self.inertia_parameters("Spacecraft mass for the rate filter's inertia, kg (Table 2: 12 kg)")
+        self.input_array("torque_cmd_B", [0.0, 0.0, 0.0], "N.m", "Torque commanded over the step just ended")
+        self.input_array("q_true_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                         "True attitude (truth feedback, and the error outputs), scalar last")
+        self.input_array("omega_true_B", [0.0, 0.0, 0.0], "rad/s", "True angular velocity in B (truth feedback)")
+        self.input_array("omega_dot_true_B", [0.0, 0.0, 0.0], "rad/s2",
+                         "True angular acceleration in B (truth feedback)")
+        self.output_array("omega_dot_est_B", 3, lambda: self._outputs()["omega_dot"], "rad/s2",
+                          "Estimated angular acceleration in B over the last step, from the commanded torque")
+        self.output("attitude_error", lambda: self._outputs()["attitude_error"], "rad",
+                    "Angle between q_est_BN and q_true_BN after the last step (0 before the first fix)")
+        self.output("rate_error", lambda: self._outputs()["rate_error"], "rad/s",
+                    "Norm of omega_est_B - omega_true_B after the last step")
+        self.parameter("use_coarse_sun", False, None,
+                       "Use the coarse Sun vector (coarse_sun_B) whenever the fine Sun sensor's is not valid", bool)
+        self.parameter("coarse_sun_sigma", math.radians(2.0), "rad", "Coarse Sun vector error angle RMS, >= 0")
+        self.input_array("coarse_sun_B", [0.0, 0.0, 0.0], "1",
+                         "Measured unit vector toward the Sun in B from coarse sun sensors (e.g. one on every face)")
+        self.input("coarse_sun_valid", False, None, "Coarse Sun measurement valid", bool)
+        self.parameter("valid_sigma", math.pi, "rad",
+                       "attitude_valid once the filter's largest 1-sigma attitude error is at most this, > 0")
+        self.output("attitude_valid", self._valid, None,
+                    "The attitude is known well enough to fly on: initialized and the largest sigma_attitude at most "
+                    "valid_sigma (always true with truth_feedback)", bool)
 
     def build_model(self):
         v = self.values
         if not (v["gyro_sample_time"] > 0.0):
             raise ValueError(f"gyro_sample_time = {v['gyro_sample_time']!r} s must be > 0")
+        if not (v["valid_sigma"] > 0.0):
+            raise ValueError(f"valid_sigma = {v['valid_sigma']!r} rad must be > 0")
         sigma_v = v["gyro_sigma"] * math.sqrt(v["gyro_sample_time"])  # rad/s^0.5
         return mekf.AttitudeEstimator(v["nadir_sigma"], v["sun_sigma"], sigma_v, v["bias_walk"], v["sigma_bias0"],
-                                      v["min_separation"])
+                                      v["min_separation"], inertia=self.inertia(rigid_body.box_inertia),
+                                      accel_sigma=v["accel_sigma"], update_interval=v["update_interval"],
+                                      coarse_sun_sigma=v["coarse_sun_sigma"] if v["use_coarse_sun"] else None)
 
     def _q(self):
-        f = self.model.filter
-        return list(f.q) if f.initialized else self.vector("q0", 4)
+        return self._outputs()["q"]
+
+    def _outputs(self):
+        # before the end of initialization: from the values as they stand (not kept)
+        return self._compute() if self._out is None else self._out
+
+    def _valid(self):
+        v = self.values
+        return v["truth_feedback"] or (self.model.filter.initialized and max(self._sigma()) <= v["valid_sigma"])
 
     def _sigma(self):
         f = self.model.filter
         return list(f.attitude_sigma()) if f.initialized else [0.0, 0.0, 0.0]
 
-    def _rate(self):
-        return list(self.model.filter.rate(self.vector("omega_meas_B", 3)))
+    def _refresh(self):
+        self._out = self._compute()
+
+    def _compute(self):
+        """The outputs after a step (or at the end of initialization), from the model or the truth."""
+        model, truth = self.model, self.values["truth_feedback"]
+        q_true, w_true = self.vector("q_true_BN", 4), self.vector("omega_true_B", 3)
+        if truth:
+            q, w, w_dot = q_true, w_true, self.vector("omega_dot_true_B", 3)
+        else:
+            f = model.filter
+            q = list(f.q) if f.initialized else self.vector("q0", 4)
+            w = list(model.rate) if model.rate is not None else self.vector("omega_meas_B", 3)
+            w_dot = list(model.acceleration)
+        error = 0.0
+        if not truth and model.filter.initialized:
+            error = triad.error_angle(q, q_true)
+        return {"q": q, "omega": w, "omega_dot": w_dot, "attitude_error": error,
+                "rate_error": math.sqrt(sum((a - b) ** 2 for a, b in zip(w, w_true)))}
+
+    def exit_initialization_mode(self):
+        super().exit_initialization_mode()
+        self._refresh()
 
     def do_step(self, current_time, step_size):
         v = self.values
-        measurements = (self.vector("nadir_B", 3), v["nadir_valid"], self.vector("sun_B", 3), v["sun_valid"],
-                        self.vector("r_BN_N", 3), self.vector("r_SN_N", 3))
-        self.model.step(measurements, self.vector("omega_meas_B", 3), step_size)
-        self._input_version += 1  # the bias changed: omega_est_B computed before the step is stale
+        if not v["truth_feedback"]:
+            measurements = (self.vector("nadir_B", 3), v["nadir_valid"], self.vector("sun_B", 3), v["sun_valid"],
+                            self.vector("r_BN_N", 3), self.vector("r_SN_N", 3))
+            self.model.step(measurements, self.vector("omega_meas_B", 3), step_size, self.vector("torque_cmd_B", 3),
+                            (self.vector("coarse_sun_B", 3), v["coarse_sun_valid"]))
+        self._refresh()
         return True
+
+    def _set_fmu_state(self, state):
+        super()._set_fmu_state(state)
+        self._refresh()

@@ -24,9 +24,14 @@ class Gyro(NeighborSlave):
         self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "True angular velocity of B relative to N, in B")
         self.output_array("omega_meas_B", 3, lambda: self.feedthrough(self._measure), "rad/s",
                           "Measured angular velocity in B", depends_on=RATE)
+        # appended after the first release's variables (their value references stay)
+        self.parameter("sigma_sample_time", 0.0, "s",
+                       "Sampling step at which sigma holds, >= 0; 0: every sample has sigma. Otherwise a sample at the "
+                       "communication step h has sigma sqrt(sigma_sample_time / h) (white noise of fixed density)")
 
     def build_model(self):
-        return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"])
+        return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"],
+                            self.values["sigma_sample_time"])
 
     def _measure(self):
         return self.model.measure(self.vector("omega_BN_B", 3))

@@ -38,6 +38,11 @@ PARAMETERS = (
                                  "tracking controller holding the attitude (>= 0; 0: no timeout)"),
     ("phase_retries", None, int, "Retries of a timed-out detumble or slew before the mission moves on (>= 0)"),
 )
+APPENDED_PARAMETERS = (
+    ("attitude_determination_timeout", "s", float,
+     "After this long in attitude determination without attitude_valid the detumble starts anyway (it needs rates "
+     "only; >= 0; 0: wait for a valid attitude)"),
+)
 INPUTS = (
     ("heartbeat", None, bool, "Host spacecraft heartbeat present (HostSpacecraft.heartbeat)"),
     ("ground_contact", None, bool, "Ground station in contact (GroundStation.visible)"),
@@ -47,6 +52,10 @@ INPUTS = (
     ("budget_spent", None, bool, "Propellant budget spent: burn over (de-orbit -> monitoring)"),
     ("state_of_charge", "1", float, "Battery state of charge, 0..1 (Power)"),
     ("reentered", None, bool, "Spacecraft has re-entered (orbit FMU)"),
+)
+APPENDED_INPUTS = (
+    ("attitude_valid", None, bool, "The attitude is known (AttitudeEstimator.initialized): attitude determination "
+                                   "lasts at least attitude_determination_duration and until this holds"),
 )
 # When the manager switches a load beyond the plain mode table (components.mission.manager).
 LOAD_NOTES = {"microprocessor_quiescent": "; false when nominal or in end state",
@@ -93,6 +102,14 @@ class MissionManager(NeighborSlave):
         self.output("time_in_mode", lambda: self.model.time_in_mode, "s", "Time since the current mode was entered")
         self.output("time_in_phase", lambda: self.model.time_in_phase, "s",
                     "Time since the current de-orbit phase was entered (0 outside the de-orbit mode)")
+        # appended after the first release's variables (their value references stay)
+        for name, unit, kind, text in APPENDED_PARAMETERS:
+            self.parameter(name, D[name], unit, text, kind)
+        for name, unit, kind, text in APPENDED_INPUTS:
+            self.input(name, mm.INPUT_DEFAULTS[name], unit, text, kind)
+        self.output("determination_timeouts", lambda: self.model.determination_timeouts, None,
+                    "Attitude determinations that ended at attitude_determination_timeout without a valid attitude",
+                    int)
 
     def _powered(self):
         model = self.model
@@ -103,10 +120,10 @@ class MissionManager(NeighborSlave):
         return cache[1]
 
     def build_model(self):
-        params = {name: self.values[name] for name, _, _, _ in PARAMETERS}
+        params = {name: self.values[name] for name, _, _, _ in PARAMETERS + APPENDED_PARAMETERS}
         return mm.MissionManager(params, self.start_time)
 
     def do_step(self, current_time, step_size):
-        inputs = {name: self.values[name] for name, _, _, _ in INPUTS}
+        inputs = {name: self.values[name] for name, _, _, _ in INPUTS + APPENDED_INPUTS}
         self.model.step(current_time, step_size, inputs)
         return True

@@ -15,7 +15,10 @@ Modes (`mode`):
                     the contact -> DEORBIT if it was latched, else back to AWAITING (Appendix I
                     leaves the confirmation loop when the contact ends)
   5 DEORBIT         sub-phases (`phase`): 1 attitude determination (a fixed
-                    attitude_determination_duration, 600 s), 2 detumble (until detumble_done),
+                    attitude_determination_duration, 600 s, longer until the input
+                    attitude_valid holds, e.g. the estimator's first fix after an eclipse; after
+                    attitude_determination_timeout, if > 0, the detumble starts anyway: it needs
+                    rates only), 2 detumble (until detumble_done),
                     3 slew to the burn attitude (until slew_done), 4 burn with the attitude held
                     by the tracking controller (until budget_spent) -> MONITORING.
                     Fault management: a detumble or slew that has not finished after
@@ -93,10 +96,12 @@ PARAMETER_DEFAULTS = {
     "detumble_timeout": 600.0,
     "slew_timeout": 600.0,
     "phase_retries": 1,
+    "attitude_determination_timeout": 0.0,
 }
 INPUT_DEFAULTS = {
     "heartbeat": True, "ground_contact": False, "ground_command": False, "detumble_done": False,
     "slew_done": False, "budget_spent": False, "state_of_charge": 1.0, "reentered": False,
+    "attitude_valid": True,
 }
 
 
@@ -114,7 +119,8 @@ def check_parameters(params):
                          f"{sorted(PARAMETER_DEFAULTS)}")
     p = dict(PARAMETER_DEFAULTS, **params)
     for name in ("grace_period", "wake_period", "wake_duration", "wake_offset", "attitude_determination_duration",
-                 "battery_empty_soc", "beacon_interval", "detumble_timeout", "slew_timeout"):
+                 "battery_empty_soc", "beacon_interval", "detumble_timeout", "slew_timeout",
+                 "attitude_determination_timeout"):
         try:
             p[name] = float(p[name])
         except (TypeError, ValueError):
@@ -134,7 +140,7 @@ def check_parameters(params):
         raise ValueError(f"attitude_determination_duration = {p['attitude_determination_duration']!r} s must be >= 0")
     if p["beacon_interval"] < 0:
         raise ValueError(f"beacon_interval = {p['beacon_interval']!r} s must be >= 0 (0: beacon in every contact)")
-    for name in ("detumble_timeout", "slew_timeout"):
+    for name in ("detumble_timeout", "slew_timeout", "attitude_determination_timeout"):
         if p[name] < 0:
             raise ValueError(f"{name} = {p[name]!r} s must be >= 0 (0: no timeout)")
     if isinstance(p["phase_retries"], bool) or not float(p["phase_retries"]).is_integer() or p["phase_retries"] < 0:
@@ -178,12 +184,14 @@ class MissionManager:
         self.mode_entry = self.phase_entry = t0
         self.awake, self.wake_end, self.next_wake_k = False, NO_EVENT, 0
         self.grace_end = self.att_det_end = NO_EVENT
+        self.att_det_waiting = False  # determination time over, waiting for a valid attitude
         self.confirmed = False  # ground_command latched during the current final contact
         self.in_contact = False  # monitoring: beaconing in the contact sampled at the last step start
         self.contact_seen = False  # monitoring: ground_contact at the last step start
         self.last_beacon = None  # monitoring: start of the last contact used for a beacon
         self.heartbeat_lost_at = NO_EVENT  # time of the check that found the heartbeat missing
         self.detumble_timeouts = self.slew_timeouts = 0  # phase timeouts so far (retries included)
+        self.determination_timeouts = 0
         self.attempt = 0  # retries of the current phase
         self.phase_published = t0  # end of the step that first output the current phase
         mode = self.p["initial_mode"]
@@ -233,6 +241,7 @@ class MissionManager:
         self.phase_published = None  # set at the end of this step
         self.att_det_end = t + self.p["attitude_determination_duration"] if phase == ATTITUDE_DETERMINATION \
             else NO_EVENT
+        self.att_det_waiting = False
 
     def _check_heartbeat(self, t, heartbeat):
         if self.mode == IDLE and not heartbeat:
@@ -272,7 +281,9 @@ class MissionManager:
         elif mode == DEORBIT:
             # the controller has had a whole step with its enable on
             started = self.phase_published is not None and self.phase_published < t - time_tol(t)
-            if started and self.phase == DETUMBLE and x["detumble_done"]:
+            if self.phase == ATTITUDE_DETERMINATION and self.att_det_waiting and x["attitude_valid"]:
+                self._enter_phase(DETUMBLE, t)
+            elif started and self.phase == DETUMBLE and x["detumble_done"]:
                 self._enter_phase(SLEW, t)
             elif started and self.phase == SLEW and x["slew_done"]:
                 self._enter_phase(BURN, t)
@@ -305,7 +316,10 @@ class MissionManager:
             if self.mode == GRACE:
                 events.append((self.grace_end, 2, "grace_end"))
         elif self.mode == DEORBIT and self.phase == ATTITUDE_DETERMINATION:
-            events.append((self.att_det_end, 3, "att_det_end"))
+            if not self.att_det_waiting:
+                events.append((self.att_det_end, 3, "att_det_end"))
+            elif self.p["attitude_determination_timeout"] > 0:
+                events.append((self.phase_entry + self.p["attitude_determination_timeout"], 3, "att_det_timeout"))
         elif self.mode == DEORBIT and self.phase in (DETUMBLE, SLEW):
             limit = self.p["detumble_timeout" if self.phase == DETUMBLE else "slew_timeout"]
             if limit > 0:
@@ -352,6 +366,12 @@ class MissionManager:
             elif kind == "grace_end":
                 self._enter(AWAITING, te)
             elif kind == "att_det_end":
+                if x["attitude_valid"]:
+                    self._enter_phase(DETUMBLE, te)
+                else:  # no attitude yet (e.g. no Sun in eclipse): wait for it, or for the timeout
+                    self.att_det_waiting = True
+            elif kind == "att_det_timeout":  # the documented fallback: the detumble needs rates only
+                self.determination_timeouts += 1
                 self._enter_phase(DETUMBLE, te)
             elif kind == "phase_timeout":
                 if self.phase == DETUMBLE:
@@ -402,7 +422,8 @@ class MissionManager:
 
     # ---- state -----------------------------------------------------------------------------
     _STATE = ("t", "mode", "phase", "end_reason", "mode_entry", "phase_entry", "awake", "wake_end", "next_wake_k",
-              "attempt", "detumble_timeouts", "slew_timeouts", "grace_end", "att_det_end", "confirmed", "in_contact",
+              "attempt", "detumble_timeouts", "slew_timeouts", "determination_timeouts", "grace_end",
+              "att_det_end", "att_det_waiting", "confirmed", "in_contact",
               "contact_seen", "last_beacon", "heartbeat_lost_at", "phase_published")
 
     def get_state(self):

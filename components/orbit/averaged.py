@@ -445,7 +445,9 @@ class OrbitAveraged:
         thrust = self.thrust_acceleration(F_thrust_B, q_BN, retrograde, mass)
         self._out_cache = None
         t, y = self.t, self.y
-        while not self.reentered and t_end - t > 1e-9 * max(1.0, abs(t_end)):
+        # a step shorter than the rounding of the time is no step; anything longer is integrated
+        # (a relative tolerance would drop the 0.1 s steps of a run years after its epoch)
+        while not self.reentered and t_end - t > 64.0 * math.ulp(max(1.0, abs(t_end))):
             h = min(t_end - t, self.max_step)
             to_midnight = DAY - (self._day_offset + t) % DAY
             if to_midnight > 1e-3:

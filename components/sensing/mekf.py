@@ -71,12 +71,19 @@ class AttitudeMEKF:
         """The rate estimate omega_meas - b (rad/s)."""
         return tuple(float(w) - float(b) for w, b in zip(omega_meas, self.bias))
 
-    def propagate(self, omega_meas, h):
+    def propagate(self, omega_meas, h, covariance=True):
+        """Attitude over h with the bias-corrected rate held; the covariance too unless the
+        caller gathers several steps into one propagate_covariance (first order either way)."""
         self._need()
         w = self.rate(omega_meas)
         if not all(math.isfinite(x) for x in w):
             raise ValueError(f"omega_meas_B {list(omega_meas)} must be finite")
         self.q = triad.propagate(self.q, w, h)
+        if covariance:
+            self.propagate_covariance(w, h)
+
+    def propagate_covariance(self, w, h):
+        """P over h with the (bias-corrected) rate w: Phi = I + F h."""
         F = np.zeros((6, 6))
         F[:3, :3] = -_skew(w)
         F[:3, 3:] = -np.eye(3)
@@ -122,46 +129,206 @@ class AttitudeMEKF:
         self.P = None if state["P"] is None else np.array(state["P"], dtype=float)
 
 
-class AttitudeEstimator:
-    """TRIAD to start, then the MEKF (thesis section 3.3.1): the estimator the controllers fly on.
+def _cross(a, b):
+    return (a[1] * b[2] - a[2] * b[1], a[2] * b[0] - a[0] * b[2], a[0] * b[1] - a[1] * b[0])
 
-    step(measurements, omega_meas, h) at each communication point: before the first TRIAD fix
-    (both vectors valid and apart, triad.AttitudeDetermination.fix) it only waits; the fix
-    initializes the filter with the first-order TRIAD error; afterwards every valid vector
-    updates it (none in eclipse: no Sun vector) and the gyro propagates it over the step."""
+
+def _times(M, v):
+    return tuple(M[i][0] * v[0] + M[i][1] * v[1] + M[i][2] * v[2] for i in range(3))
+
+
+class RateFilter:
+    """Body-rate estimate for the controllers: per axis a Kalman filter whose prediction is Euler's
+    equation with the commanded torque, J omega_dot = L - omega x J omega, and whose measurement
+    is the bias-corrected gyro rate (variance sigma_v^2 / h per sample at step h). The torque
+    model carries the estimate through a firing without the lag of a plain low-pass filter;
+    `accel_sigma` (rad/s^2, the 1-sigma unmodelled angular acceleration: thruster force and
+    direction errors, disturbances) sets how much the gyro is trusted over the model.
+    Plain floats: it runs at every 15 ms step of the mission."""
+
+    def __init__(self, inertia, sigma_v, accel_sigma):
+        J = np.array(inertia, dtype=float).reshape(3, 3)
+        if not np.all(np.isfinite(J)) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
+            raise ValueError(f"inertia {J.tolist()} must be finite and positive definite (kg.m2)")
+        self.J, self.J_inv = J.tolist(), np.linalg.inv(J).tolist()
+        self.sigma_v = _sigma("sigma_v", sigma_v, "rad/s^0.5")
+        self.accel_sigma = _sigma("rate accel_sigma", accel_sigma, "rad/s^2")
+        self.omega = None  # no estimate before the first sample
+        self.P = [0.0, 0.0, 0.0]
+        self.omega_dot = (0.0, 0.0, 0.0)
+
+    def acceleration(self, torque):
+        w = self.omega
+        gyroscopic = _cross(w, _times(self.J, w))
+        return _times(self.J_inv, [float(torque[i]) - gyroscopic[i] for i in range(3)])
+
+    def predict(self, torque, h):
+        """Carry the estimate over a step of h seconds with the torque commanded over it."""
+        if self.omega is None:
+            return
+        a = self.omega_dot = self.acceleration(torque)
+        self.omega = [self.omega[i] + a[i] * h for i in range(3)]
+        q = (self.accel_sigma * h) ** 2
+        self.P = [p + q for p in self.P]
+
+    def update(self, omega_corrected, h):
+        """Fuse one bias-corrected gyro sample taken at the end of a step of h seconds."""
+        z = [float(x) for x in omega_corrected]
+        R = self.sigma_v ** 2 / max(h, 1e-9)
+        if self.omega is None:
+            self.omega, self.P = z, [R, R, R]
+            return
+        for i in range(3):
+            k = self.P[i] / (self.P[i] + R)
+            self.omega[i] += k * (z[i] - self.omega[i])
+            self.P[i] *= 1.0 - k
+
+    def get_state(self):
+        return {"omega": None if self.omega is None else list(self.omega), "P": list(self.P),
+                "omega_dot": list(self.omega_dot)}
+
+    def set_state(self, state):
+        self.omega = None if state["omega"] is None else [float(x) for x in state["omega"]]
+        self.P = [float(x) for x in state["P"]]
+        self.omega_dot = tuple(float(x) for x in state["omega_dot"])
+
+
+# The estimator propagates the covariance in steps of at least this long (and before each
+# update): at the 15 ms attitude loop, the 6 x 6 products are most of the filter's cost.
+COVARIANCE_STEP = 0.1
+
+
+class AttitudeEstimator:
+    """TRIAD to start, then the MEKF (thesis section 3.3.1), and the rate filter: the estimator
+    the controllers fly on.
+
+    step(measurements, omega_meas, h, torque) once per communication point, with the
+    measurements taken now, at the end of the step of h seconds just ended, and the torque
+    commanded over that step:
+    1. the attitude is propagated over the step with the mean of the gyro samples at its start
+       (held) and end (second order: a tumbling body's rate changes within a step), the rate
+       estimate with the torque (RateFilter.predict);
+    2. before the first fix, TRIAD is tried (triad.AttitudeDetermination.fix) and, when possible,
+       starts the filter with its first-order error; afterwards each vector that is a new sample
+       (it differs from the one used last, and `update_interval` has passed since) updates the
+       filter (no Sun vector in eclipse or outside the sensor's field of view);
+       with `coarse_sun_sigma` set, a coarse Sun vector (e.g. coarse sun sensors on every face)
+       stands in for the fine one whenever the fine sensor does not see the Sun, in the fix and
+       in the updates: on a tumbling host one narrow-field sensor may never see it;
+    3. the gyro sample of now corrects the rate estimate and is held for the next step.
+    So the estimate refers to the time of the measurements: the end of the step when the
+    sensors were read after the truth advanced (a Gauss-Seidel master with the estimator after
+    the rigid body and the sensors), its start otherwise (one step of latency)."""
 
     def __init__(self, nadir_sigma=math.radians(0.25), sun_sigma=math.radians(0.5) / 3.0,
-                 sigma_v=5.5e-4 * math.sqrt(0.1), sigma_u=1e-6, sigma_bias0=1e-3, min_separation=math.radians(5.0)):
+                 sigma_v=5.5e-4 * math.sqrt(0.1), sigma_u=1e-6, sigma_bias0=1e-3, min_separation=math.radians(5.0),
+                 inertia=None, accel_sigma=5e-4, update_interval=0.0, coarse_sun_sigma=None):
         self.triad = triad.AttitudeDetermination(nadir_sigma, sun_sigma, min_separation=min_separation)
+        self.coarse_triad = None if coarse_sun_sigma is None else \
+            triad.AttitudeDetermination(nadir_sigma, coarse_sun_sigma, min_separation=min_separation)
         self.filter = AttitudeMEKF(sigma_v, sigma_u)
+        self.rates = RateFilter(np.diag([0.05, 0.1, 0.1]) if inertia is None else inertia, sigma_v, accel_sigma)
         self.sigma_bias0 = _sigma("sigma_bias0", sigma_bias0, "rad/s", positive=True)
+        self.update_interval = _sigma("update_interval", update_interval, "s")
         # per-axis sigmas of the vector measurements (the sensors' error angle RMS over two axes)
         self.nadir_sigma = max(self.triad.nadir_sigma, 1e-6) / math.sqrt(2.0)
         self.sun_sigma = max(self.triad.sun_sigma, 1e-6) / math.sqrt(2.0)
+        self.coarse_sigma = None if coarse_sun_sigma is None else \
+            max(self.coarse_triad.sun_sigma, 1e-6) / math.sqrt(2.0)
+        self.time = 0.0
+        self.cov_pending, self.cov_rate = 0.0, (0.0, 0.0, 0.0)  # covariance propagation gathered
+        self.held_rate = None  # the gyro sample of the step's start
+        self.last = {"nadir": (None, -math.inf), "sun": (None, -math.inf), "coarse": (None, -math.inf)}  # (used, when)
 
-    def step(self, measurements, omega_meas, h):
+    @property
+    def rate(self):
+        """The rate estimate (rad/s, body axes); None before the first gyro sample."""
+        w = self.rates.omega
+        return None if w is None else tuple(float(x) for x in w)
+
+    @property
+    def acceleration(self):
+        """The angular acceleration over the last step (rad/s^2) from the commanded torque."""
+        return tuple(self.rates.omega_dot)
+
+    def _new(self, name, vector):
+        used, when = self.last[name]
+        return tuple(vector) != used and self.time - when >= self.update_interval - 1e-9
+
+    def _fresh(self, name, vector):
+        """A new sample of this sensor (then marked used)?"""
+        if not self._new(name, vector):
+            return False
+        self.last[name] = (tuple(vector), self.time)
+        return True
+
+    def step(self, measurements, omega_meas, h, torque=(0.0, 0.0, 0.0), coarse_sun=None):
+        """measurements = (nadir_B, nadir_valid, sun_B, sun_valid, r_BN_N, r_SN_N);
+        coarse_sun = (sun_B, valid) of the coarse sensors, used only with coarse_sun_sigma."""
         nadir_B, nadir_valid, sun_B, sun_valid, r_BN_N, r_SN_N = measurements
+        coarse = coarse_sun if self.coarse_triad is not None and coarse_sun is not None and coarse_sun[1] else None
         f = self.filter
+        self.time += h
+        if f.initialized and self.held_rate is not None:
+            mean = [0.5 * (a + float(b)) for a, b in zip(self.held_rate, omega_meas)]
+            f.propagate(mean, h, covariance=False)
+            self.cov_pending += h
+            self.cov_rate = f.rate(mean)
+        self.rates.predict(torque, h)
         if not f.initialized:
-            q = self.triad.fix(*measurements)
-            if q is None:
-                return
-            nadir_N = [-x for x in r_BN_N]
-            sun_N = [s - r for s, r in zip(r_SN_N, r_BN_N)]
-            angle = math.acos(max(-1.0, min(1.0, rotations.dot(triad._unit(nadir_N, "nadir"),
-                                                                triad._unit(sun_N, "Sun")))))
-            first, second = sorted((self.nadir_sigma, self.sun_sigma))
-            sigma = triad.triad_error_rms(first * math.sqrt(2.0), second * math.sqrt(2.0), angle) / math.sqrt(3.0)
-            f.initialize(q, max(sigma, 1e-6), sigma_bias=self.sigma_bias0)
+            self._initialize(measurements, coarse)
         else:
-            if nadir_valid:
+            if self.cov_pending >= COVARIANCE_STEP - 1e-9 or self._due(nadir_valid, nadir_B, sun_valid, sun_B, coarse):
+                self._propagate_covariance()
+            if nadir_valid and self._fresh("nadir", nadir_B):
                 f.update(nadir_B, [-x for x in r_BN_N], self.nadir_sigma)
+            sun_N = [s - r for s, r in zip(r_SN_N, r_BN_N)]
             if sun_valid:
-                f.update(sun_B, [s - r for s, r in zip(r_SN_N, r_BN_N)], self.sun_sigma)
-        f.propagate(omega_meas, h)
+                if self._fresh("sun", sun_B):
+                    f.update(sun_B, sun_N, self.sun_sigma)
+            elif coarse is not None and self._fresh("coarse", coarse[0]):
+                f.update(coarse[0], sun_N, self.coarse_sigma)
+        self.held_rate = tuple(float(x) for x in omega_meas)
+        self.rates.update(f.rate(self.held_rate), h)
+
+    def _due(self, nadir_valid, nadir_B, sun_valid, sun_B, coarse):
+        """Would a vector update this step (then the covariance must be current first)?"""
+        return ((nadir_valid and self._new("nadir", nadir_B)) or (sun_valid and self._new("sun", sun_B))
+                or (not sun_valid and coarse is not None and self._new("coarse", coarse[0])))
+
+    def _propagate_covariance(self):
+        if self.cov_pending > 0.0:
+            self.filter.propagate_covariance(self.cov_rate, self.cov_pending)
+            self.cov_pending = 0.0
+
+    def _initialize(self, measurements, coarse):
+        """Start the filter from a TRIAD fix (the fine Sun vector, else the coarse one), if possible."""
+        nadir_B, nadir_valid, sun_B, sun_valid, r_BN_N, r_SN_N = measurements
+        q, sun_sigma, sun_used = self.triad.fix(*measurements), self.sun_sigma, ("sun", sun_B)
+        if q is None and coarse is not None:
+            q = self.coarse_triad.fix(nadir_B, nadir_valid, coarse[0], True, r_BN_N, r_SN_N)
+            sun_sigma, sun_used = self.coarse_sigma, ("coarse", coarse[0])
+        if q is None:
+            return
+        nadir_N = [-x for x in r_BN_N]
+        sun_N = [s - r for s, r in zip(r_SN_N, r_BN_N)]
+        angle = math.acos(max(-1.0, min(1.0, rotations.dot(triad._unit(nadir_N, "nadir"), triad._unit(sun_N, "Sun")))))
+        first, second = sorted((self.nadir_sigma, sun_sigma))
+        sigma = triad.triad_error_rms(first * math.sqrt(2.0), second * math.sqrt(2.0), angle) / math.sqrt(3.0)
+        self.filter.initialize(q, max(sigma, 1e-6), sigma_bias=self.sigma_bias0)
+        self._fresh("nadir", nadir_B)
+        self._fresh(*sun_used)
 
     def get_state(self):
-        return {"filter": self.filter.get_state()}
+        return {"filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
+                "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
+                "held_rate": self.held_rate, "last": {k: [None if v is None else list(v), t]
+                                                      for k, (v, t) in self.last.items()}}
 
     def set_state(self, state):
         self.filter.set_state(state["filter"])
+        self.rates.set_state(state["rates"])
+        self.time = float(state["time"])
+        self.cov_pending, self.cov_rate = float(state["cov_pending"]), tuple(state["cov_rate"])
+        self.held_rate = None if state["held_rate"] is None else tuple(state["held_rate"])
+        self.last = {k: (None if v is None else tuple(v), float(t)) for k, (v, t) in state["last"].items()}

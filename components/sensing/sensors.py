@@ -175,20 +175,40 @@ class SunSensor(_VectorSensor):
 
 
 class Gyro(_Seeded):
-    """3-axis rate gyro (thesis 3.3.1, Bosch BMG160 [44]): omega + bias + white noise."""
+    """3-axis rate gyro (thesis 3.3.1, Bosch BMG160 [44]): omega + bias + white noise.
 
-    def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0):
+    `sigma` is the noise of one sample. With `sigma_sample_time` > 0 it is the noise at that
+    sampling step, and a sample at the communication step h has sigma sqrt(sigma_sample_time / h)
+    (white rate noise of a fixed density over the Nyquist band): the same gyro sampled at 15 ms
+    or 0.1 s has the same angle random walk, sigma sqrt(sigma_sample_time) in rad/s^0.5. Until
+    the first step (h unknown) the sample has sigma."""
+
+    def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0, sigma_sample_time=0.0):
         self.bias = finite_vector(bias, 3, "bias")
         self.sigma = check_sigma("sigma", sigma, "rad/s")
+        self.sigma_sample_time = check_sigma("sigma_sample_time", sigma_sample_time, "s")
+        self.scale = self.sigma
         super().__init__(seed)
 
     def _draw(self):
         return tuple(float(x) for x in self.rng.standard_normal(3))
 
+    def step(self, h=None):
+        if self.sigma_sample_time > 0.0 and h is not None and h > 0.0:
+            self.scale = self.sigma * math.sqrt(self.sigma_sample_time / h)
+        super().step(h)
+
     def measure(self, omega_BN_B):
         w = finite_vector(omega_BN_B, 3, "omega_BN_B")
-        b, n, s = self.bias, self.sample, self.sigma
+        b, n, s = self.bias, self.sample, self.scale
         return (w[0] + b[0] + s * n[0], w[1] + b[1] + s * n[1], w[2] + b[2] + s * n[2])
+
+    def get_state(self):
+        return {**super().get_state(), "scale": self.scale}
+
+    def set_state(self, state):
+        super().set_state(state)
+        self.scale = float(state.get("scale", self.sigma))
 
 
 class GpsReceiver(_Seeded):

@@ -1,21 +1,25 @@
 """The NEIGHBOR mission from deployment to re-entry, run through the master, with the thesis'
 figures and a summary beside the published numbers.
 
-    neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell] [--gnc closed-loop|thesis]
+    neighbor-cosim mission [--scenario 420km] [--orbit averaged|cowell]
+                           [--gnc closed-loop|closed-loop-truth|thesis]
                            [--out results/mission] [--ssv FILE] [--set COMP.VAR=VALUE]
 
 Runs build/ssp/neighbor_mission_lifetime.ssp (orbit-averaged orbit, the default; about a
-minute) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
+two minutes) or neighbor_mission.ssp (Cowell orbit, `--orbit cowell`) with the scenario's parameter
 set (system_ssp/systems/parameters/neighbor_mission_<scenario>.ssv). `--gnc closed-loop` (the
 default) flies the coupled loop: the burn attitude from the orbit, thrust along the body axis,
-flight settle criteria; `--gnc thesis` applies parameters/mission_gnc_thesis.ssv, the thesis'
-guidance and control, which gives its published numbers (system_ssp/systems/generators/mission.py).
+flight settle criteria, the controllers on the attitude estimator (sensors with noise);
+`--gnc closed-loop-truth` the same on the true state (parameters/mission_gnc_truth.ssv); `--gnc
+thesis` applies parameters/mission_gnc_thesis.ssv, the thesis' guidance and control on the true
+state, which gives its published numbers (system_ssp/systems/generators/mission.py).
 It writes into --out:
 - timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode), their units
                    in timeseries.units.json;
 - summary.json     every computed figure beside the thesis' (also printed as a table);
 - altitude.png (Fig. 11), detumble.png (Fig. 20-22), slew.png (Fig. 27-29), tracking.png
-  (Fig. 43-44), battery.png (Fig. 46), data.png (Fig. 47).
+  (Fig. 43-44), battery.png (Fig. 46), data.png (Fig. 47); estimation.png (the estimator's
+  attitude error against its 3-sigma, and its rate error; not with truth feedback).
 `--profile` adds the wall time per component and of the master to the summary. The folder is
 written as one unit (replacing an earlier one only when complete); a failed or interrupted run
 leaves <out>.partial with the rows so far and PARTIAL.txt saying why.
@@ -38,7 +42,9 @@ from . import (DEFAULT_SSP_DIR, add_console_arguments, console_settings, deorbit
                staged_results, thesis)
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
-GNC = {"closed-loop": None, "thesis": "mission_gnc_thesis.ssv"}  # the parameter set each applies
+# the parameter set each applies: the closed loop on the estimator (the system's own values), on
+# the true state (truth feedback), and the thesis' guidance and control (its numbers)
+GNC = {"closed-loop": None, "closed-loop-truth": "mission_gnc_truth.ssv", "thesis": "mission_gnc_thesis.ssv"}
 SCENARIOS = ("420km", "475km", "525km")
 WH = 3600.0
 # Thesis figures per scenario. Every scenario: the attitude validation cases the mission's
@@ -58,6 +64,8 @@ THESIS["420km"].update(tracking_propellant_g=propulsion_report.THESIS["tracking_
                        soc_after_burn_percent=79.65, energy_used_Wh=2.2, energy_left_Wh=8.6,
                        battery_empty_days_after_burn=14.0, max_storage_MB=0.1, contacts_to_downlink=2)
 RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
+           "mission.determination_timeouts", "estimator.initialized", "estimator.attitude_error",
+           "estimator.rate_error", *[f"estimator.sigma_attitude[{i}]" for i in (1, 2, 3)],
            "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
            "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
            "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
@@ -134,9 +142,12 @@ def summarize(r, scenario, orbit):
         s["profile_s"] = r.profile
     timeouts = {"detumble": int(d["mission.detumble_timeouts"][-1]), "slew": int(d["mission.slew_timeouts"][-1])}
     s["phase_timeouts"] = timeouts
-    s["fault_management"] = "; ".join(
-        f"the {name} timed out {n} time(s): retried, then the mission went on with the next phase"
-        for name, n in timeouts.items() if n) or "none needed"
+    faults = [f"the {name} timed out {n} time(s): retried, then the mission went on with the next phase"
+              for name, n in timeouts.items() if n]
+    if int(d["mission.determination_timeouts"][-1]):
+        faults.insert(0, "the attitude determination timed out without a valid attitude: the detumble started "
+                         "anyway (it needs rates only)")
+    s["fault_management"] = "; ".join(faults) or "none needed"
 
     def phase_start(p):
         i = _first((mode == MissionMode.DEORBIT) & (phase == p))
@@ -169,6 +180,12 @@ def summarize(r, scenario, orbit):
     burning = (t >= starts[DeorbitPhase.BURN][1] + 10.0) & (t < t_mon)
     pointing = np.degrees(d["tracking.pointing_error"][burning])
     s["burn_pointing_error_deg"] = float(pointing.max()) if pointing.size else None
+    # attitude knowledge: the estimator against the rigid body (zero with truth feedback)
+    knowledge = np.degrees(d["estimator.attitude_error"][burning])
+    s["burn_knowledge_error_deg"] = float(knowledge.max()) if knowledge.size else None
+    s["burn_knowledge_error_rms_deg"] = float(np.sqrt(np.mean(knowledge ** 2))) if knowledge.size else None
+    s["burn_rate_error_rms_deg_s"] = float(np.degrees(np.sqrt(np.mean(d["estimator.rate_error"][burning] ** 2)))) \
+        if knowledge.size else None
     s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
     s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
     soc, energy = d["power.state_of_charge"], d["power.energy"]
@@ -207,6 +224,9 @@ def table(s):
             ("slew propellant (g)", "slew_propellant_g", "{:.3f}"),
             ("tracking propellant during the burn (g)", "tracking_propellant_g", "{:.3f}"),
             ("largest thrust-axis pointing error in the burn (deg, after 10 s)", "burn_pointing_error_deg", "{:.3f}"),
+            ("attitude-knowledge error in the burn, RMS (deg, estimator vs truth; 0: truth feedback)",
+             "burn_knowledge_error_rms_deg", "{:.3f}"),
+            ("attitude-knowledge error in the burn, largest (deg, after 10 s)", "burn_knowledge_error_deg", "{:.3f}"),
             ("total propellant (kg; thesis: sized for the worst-case slew)", "total_propellant_kg", "{:.4f}"),
             ("battery after the de-orbit maneuver (%)", "soc_after_burn_percent", "{:.2f}"),
             ("energy used to the end of the burn (Wh)", "energy_used_Wh", "{:.3f}"),
@@ -344,6 +364,8 @@ def plot(d, s, out):
         axes[0].set_title(title)
         save(fig, name)
 
+    _plot_estimation(plt, d, s, save, legend)
+
     # battery and data from the end of the grace period to a few days after the burn
     i3 = _first(mode >= MissionMode.AWAITING)
     if i3 is not None:
@@ -383,13 +405,54 @@ def plot(d, s, out):
             save(fig, name)
 
 
+def _plot_estimation(plt, d, s, save, legend):
+    """estimation.png: the estimator's attitude error against its own 3-sigma (the whole de-orbit,
+    then the first minutes after the fix with the phases marked) and its rate error; skipped
+    with truth feedback."""
+    t, mode, phase = d["time"], d["mission.mode"], d["mission.phase"]
+    sel = (mode == MissionMode.DEORBIT) & (d["estimator.initialized"] > 0)
+    if not sel.any() or not np.any(d["estimator.attitude_error"][sel] > 0.0):
+        return
+    t0 = t[_first(mode == MissionMode.DEORBIT)]
+    tm = (t[sel] - t0) / 60.0
+    err = np.degrees(d["estimator.attitude_error"][sel])
+    sigma3 = 3.0 * np.degrees(np.max([d[f"estimator.sigma_attitude[{i}]"][sel] for i in (1, 2, 3)], axis=0))
+    fig, axes = plt.subplots(3, 1, figsize=(9, 9))
+    zoom = (tm - tm[0]) * 60.0 <= 180.0
+    for ax, x, keep in ((axes[0], tm, slice(None)), (axes[1], (tm - tm[0]) * 60.0, zoom)):
+        ax.semilogy(x[keep], err[keep], color="k", linewidth=0.6, label="attitude error (estimate vs truth)")
+        ax.semilogy(x[keep], sigma3[keep], color="tab:red", linewidth=0.9,
+                    label="3 sigma, largest axis (filter covariance)")
+        ax.set_ylabel("attitude knowledge (deg)")
+    axes[0].set_xlabel("minutes since the de-orbit start (from the first attitude fix)")
+    axes[1].set_xlabel("seconds since the first attitude fix")
+    for p, name in ((DeorbitPhase.DETUMBLE, "detumble"), (DeorbitPhase.SLEW, "slew"), (DeorbitPhase.BURN, "burn")):
+        i = _first(phase[sel] == p)
+        if i is not None and zoom[i]:
+            x = (tm[i] - tm[0]) * 60.0
+            axes[1].axvline(x, color="0.4", linestyle="--", linewidth=0.8)
+            axes[1].annotate(f"{name} starts", (x, 0.97), xycoords=("data", "axes fraction"), xytext=(3, 0),
+                             textcoords="offset points", fontsize=8, va="top")
+    axes[2].semilogy(tm, np.degrees(np.maximum(d["estimator.rate_error"][sel], 1e-9)), color="tab:blue",
+                     linewidth=0.6, label="|rate estimate - truth|")
+    axes[2].set_ylabel("rate knowledge (deg/s)")
+    axes[2].set_xlabel("minutes since the de-orbit start")
+    for a in axes:
+        legend(a, loc="lower right")
+        a.grid(alpha=0.3, which="both")
+    axes[0].set_title("Attitude estimator (TRIAD start, MEKF on the gyro with nadir and Sun vectors)")
+    save(fig, "estimation.png")
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
     ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
     ap.add_argument("--gnc", choices=list(GNC), default="closed-loop",
                     help="guidance and control: closed-loop (burn attitude from the orbit, thrust along the body "
-                         "axis, flight settle criteria; default) or thesis (the thesis' laws and its numbers)")
+                         "axis, flight settle criteria, controllers on the attitude estimator; default), "
+                         "closed-loop-truth (the same on the true state) or thesis (the thesis' laws on the true "
+                         "state, and its numbers)")
     ap.add_argument("--out", default="results/mission")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)

@@ -3,7 +3,7 @@ import math
 import numbers
 
 from ..errors import SSPError
-from ..ssp.reader import ANNOTATION_TYPE
+from ..ssp.reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES
 from .connections import KIND, NUMERIC
 from .graph import toposort
 from .names import near, split_name
@@ -151,15 +151,15 @@ def _schedule(system, algorithm, multiples):
                        "with it")
     names = [c.name for c in system.comps]
 
-    def output(comp, conn, types, what, origin):
+    def output(comp, conn, types, what, origin, causalities=("output",)):
         if comp not in system.by_name:
             raise SSPError(f"{origin}: {what} names unknown component {comp!r}{near(comp, names)}")
         c = system.by_name[comp]
         if conn not in c.vars:
             raise SSPError(f"{origin}: {what} names unknown variable {comp}.{conn}{near(conn, list(c.vars))}")
         v = c.vars[conn]
-        if v.causality != "output" or v.type not in types:
-            raise SSPError(f"{origin}: {what} {comp}.{conn} must be an output of type "
+        if v.causality not in causalities or v.type not in types:
+            raise SSPError(f"{origin}: {what} {comp}.{conn} must be {' or '.join(causalities)} of type "
                            f"{' or '.join(types)} (it is a {v.causality} {v.type})")
         return c.index, conn, KIND[v.type]
 
@@ -174,7 +174,7 @@ def _schedule(system, algorithm, multiples):
                                + ", ".join(f"{u!r}{near(u, names)}" for u in unknown))
             active = [c.name in m.active for c in system.comps]
         conds = tuple(output(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}",
-                             m.origin)[:2] + (vals,) for c, v, vals in m.conditions)
+                             m.origin, CONDITION_CAUSALITIES)[:2] + (vals,) for c, v, vals in m.conditions)
         mult = [1] * len(system.comps)
         for comp, k in m.every.items():
             if comp not in system.by_name:

@@ -26,6 +26,9 @@ NS_SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 NS_SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
 NS_NC = "https://neighbor-cosim.org/ssp/master"
 ANNOTATION_TYPE = "org.neighbor-cosim.master"
+# What an nc:When condition of our master annotation may test: an output, or a parameter (a
+# choice fixed for the run, e.g. by a parameter set).
+CONDITION_CAUSALITIES = ("output", "parameter")
 
 NS = {"ssd": NS_SSD, "ssc": NS_SSC, "ssv": NS_SSV, "ssm": NS_SSM, "nc": NS_NC}
 

@@ -14,7 +14,7 @@ from xml.sax.saxutils import quoteattr
 from fmpy import read_model_description
 
 from ..atomic import write_text_atomic
-from .reader import ANNOTATION_TYPE, NS_NC, NS_SSC, NS_SSD, NS_SSV
+from .reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES, NS_NC, NS_SSC, NS_SSD, NS_SSV
 from .units import SI_BASE_UNITS
 
 NS_OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
@@ -213,10 +213,11 @@ def _system_parameters_xml(name, spec, comp_vars):
 
 def _schedule_xml(name, schedule, comp_vars):
     """nc:Schedule lines, checked against the FMUs' variables."""
-    def check(comp, var, types):
+    def check(comp, var, types, causalities=("output",)):
         v = comp_vars.get(comp, {}).get(var)
-        if v is None or v.causality != "output" or v.type not in types:
-            raise GeneratorError(f"{name}: schedule signal {comp}.{var} must be an output of type {' or '.join(types)}")
+        if v is None or v.causality not in causalities or v.type not in types:
+            raise GeneratorError(f"{name}: schedule signal {comp}.{var} must be {' or '.join(causalities)} of type "
+                                 f"{' or '.join(types)}")
 
     out = ["          <nc:Schedule>"]
     for mode, step, active, every, when, *multiples in schedule["modes"]:
@@ -236,7 +237,7 @@ def _schedule_xml(name, schedule, comp_vars):
             continue
         out.append(f"            <nc:Mode {attrs}>")
         for comp, var, values in when:
-            check(comp, var, ("Integer", "Enumeration", "Boolean"))
+            check(comp, var, ("Integer", "Enumeration", "Boolean"), CONDITION_CAUSALITIES)
             out.append(f'              <nc:When component="{comp}" connector="{var}" '
                        f'values="{" ".join(str(int(v)) for v in values)}"/>')
         out.append("            </nc:Mode>")

@@ -75,9 +75,9 @@ def test_record_every_and_fixed_step_fallback(fmus, tmp_path):
     ('<nc:Schedule><nc:Mode name="a" stepSize="1" active="integ nosuch"/></nc:Schedule>',
      "active lists unknown component"),
     ('<nc:Schedule><nc:Mode name="a" stepSize="1"><nc:When component="integ" connector="x" values="1"/>'
-     '</nc:Mode><nc:Mode name="b" stepSize="1"/></nc:Schedule>', "must be an output of type Integer"),
+     '</nc:Mode><nc:Mode name="b" stepSize="1"/></nc:Schedule>', "must be output or parameter of type Integer"),
     ('<nc:Schedule><nc:Mode name="a" stepSize="1"/><nc:NextEvent component="timer" connector="expired"/>'
-     '</nc:Schedule>', "must be an output of type Real"),
+     '</nc:Schedule>', "must be output of type Real"),
     ('<nc:Schedule><nc:Mode name="a" stepSize="1"><nc:When component="timer" connector="expired" values="1"/>'
      '</nc:Mode></nc:Schedule>', "no nc:Mode matches"),
 ])

@@ -57,6 +57,8 @@ def _rows(folder):
     (('slow_x = "wmax > 0.1"', 'slow_x = "vmax > 0.1"'), r"probabilities.slow_x = 'vmax > 0.1': expected"),
     (("[metrics]", "[metric]"), r"unknown table\(s\) metric"),
     (('end_s = "stop_time"', 'end_s = "last:orbit.sma"'), r"metrics.end_s = 'last:orbit.sma': expected"),
+    (("[metrics]", '[dispersions."dynamics.omega0[3]"]\ndistribution = "integers"\nlow = 0\nhigh = 2.5\n[metrics]'),
+     r"omega0\[3\]'.high = 2.5: expected an integer"),
 ])
 def test_spec_errors_name_file_key_and_allowed(ssp_paths, tmp_path, change, pattern):
     text = DETUMBLE.replace(*change).format(system=ssp_paths["detumble"], runs=2)
@@ -73,6 +75,10 @@ def test_draws_depend_on_seed_and_index_only(ssp_paths, tmp_path):
     assert [spec.inputs(i) for i in reversed(range(6))] == forward[::-1]
     assert [v["dynamics.omega0[2]"] for _, v in forward] == [0.05] * 3 + [0.1] * 3  # sweep point = index // runs
     assert len({s for s, _ in forward}) == 6
+    seed_table = '[dispersions."gyro.seed"]\ndistribution = "integers"\nlow = 1\nhigh = 3\n[metrics]'
+    seeded = _spec(tmp_path, DETUMBLE.replace("[metrics]", seed_table).format(system="detumble", runs=60), "s.toml")
+    seeds = [seeded.inputs(i)[1]["gyro.seed"] for i in range(60)]
+    assert set(seeds) == {1, 2, 3} and all(type(x) is int for x in seeds)  # both ends, integers
     assert wilson(0, 10)[0] == 0.0 and wilson(10, 10)[1] == pytest.approx(1.0)
     assert wilson(5, 10)[0] < 0.5 < wilson(5, 10)[1]
 

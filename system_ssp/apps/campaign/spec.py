@@ -21,7 +21,8 @@ else:  # pragma: no cover - Python 3.10
     import tomli as tomllib
 
 DISTRIBUTIONS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
-                 "truncnormal": ("mean", "std", "low", "high"), "choice": ("values",)}
+                 "truncnormal": ("mean", "std", "low", "high"), "choice": ("values",),
+                 "integers": ("low", "high")}  # integers: low..high inclusive (e.g. a sensor's noise seed)
 METRIC_KINDS = ("stop_time", "stop_reason", "steps", "final", "min", "max", "time_when")
 HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f107_scale and points the "
                              "orbit's space_weather_file at the scaled copy"}
@@ -42,6 +43,8 @@ class Dispersion:
         a = self.args
         if self.kind == "uniform":
             return float(rng.uniform(a["low"], a["high"]))
+        if self.kind == "integers":
+            return int(rng.integers(a["low"], a["high"], endpoint=True))
         if self.kind == "normal":
             return float(rng.normal(a["mean"], a["std"]))
         if self.kind == "truncnormal":
@@ -232,10 +235,10 @@ def _dispersion(path, name, d, helper):
             raise SSPError(f"{path}: {key}.values: expected a non-empty list")
         args = {"values": list(d["values"])}
     else:
-        args = {k: _number(path, f"{key}.{k}", d[k]) for k in need}
+        args = {k: _number(path, f"{key}.{k}", d[k], integer=kind == "integers") for k in need}
         if "std" in args and args["std"] < 0:
             raise SSPError(f"{path}: {key}.std = {args['std']!r}: expected a number >= 0")
-        if "low" in args and not args["low"] < args["high"]:
+        if "low" in args and not (args["low"] <= args["high"] if kind == "integers" else args["low"] < args["high"]):
             raise SSPError(f"{path}: [{key}]: low {args['low']!r} must be below high {args['high']!r}")
     also = d.get("also", [])
     if not isinstance(also, list) or not all(isinstance(a, str) for a in also):

@@ -12,6 +12,11 @@ re-entry. Components (instance: FMU):
   selector: TorqueSelector -> thrusters: RcsThrusterSet (the 16 thrusters one by one) -> dynamics;
   the RCS propellant comes out of the propulsion's tank (propulsion.rcs_propellant lowers the mass)
   power: Power (LG HG2 cell, Table 5 loads)   data: DataStorage (256 kB flash, 9600 baud)
+  attitude knowledge (section 3.3.1): sun: SunEphemeris, shadow: EarthShadow, gps: GpsReceiver,
+  horizon: HorizonSensor, sun_sensor: SunSensor (the fine one, +x, 60 deg), coarse_sun: SunSensor
+  (the coarse sensors on the faces, whole sky), gyro: Gyro -> estimator: AttitudeEstimator (TRIAD,
+  then MEKF and the rate filter) -> the three controllers' q_BN, omega_BN_B (and the detumble's
+  omega_dot); estimator.attitude_valid ends the attitude determination (mission.attitude_valid)
 `neighbor_mission_lifetime` is the same system with orbit = OrbitAveraged (the fidelity swap).
 
 Mode-dependent steps (nc:Schedule, first match wins), events landed exactly on
@@ -19,15 +24,21 @@ mission.next_event_time and host.next_event_time:
   detumble, slew, burn   mode 5, phases 2, 3, 4: 15 ms, the attitude loop with the phase's own
                  controller (the other two suspended); orbit, ground, host, power and data every
                  33rd step (0.495 s), in the burn also the manager and the propulsion
-  determination  mode 5, phase 1 (10 min of attitude determination): 1 s, no attitude loop
+  determination  mode 5, phase 1 (at least 10 min of attitude determination, until the estimate is
+                 valid): 0.1 s with the tumbling rigid body, the sensors and the estimator (the bus
+                 every 10th step); with truth feedback 1 s, no attitude loop (the thesis' timer)
   contact        mode 4 (final-confirmation contact): 1 s
   awaiting       mode 3: 5 s while ground.near_contact, else 240 s (no contact can begin sooner)
   monitoring     mode 6 (GPS beacon during contacts): 10 s while ground.near_contact, else 240 s;
                  without host and propulsion
   decay          mode 7 (battery empty: only the orbit left until re-entry): 1 day
   idle           modes 1-2 (idle, grace period): 6 h, only host, mission, power and orbit
-The attitude loop (dynamics, controllers, thrusters) is suspended until the detumble starts, so
-the host's tumble at takeover is the rigid body's initial state (10 deg/s per axis, Eq. 7).
+Each maneuver mode comes twice: with truth feedback (estimator.truth_feedback, a parameter the
+nc:When tests) without the sensors, and with estimation, the vector sensors every 7th step
+(about 10 Hz) and the ephemeris, shadow and GPS every 33rd. With truth feedback the attitude loop
+(dynamics, controllers, thrusters) is suspended until the detumble starts, so the host's tumble at
+takeover is the rigid body's initial state at the detumble (10 deg/s per axis, Eq. 7); with
+estimation the host tumbles on, torque-free, through the determination.
 
 Scenarios (one .ssv each, names component.variable): the thesis' 420, 475 and 525 km cases.
 The de-orbit starts, as in the thesis' lifetime study, on 2023-01-01 from the scenario altitude:
@@ -36,13 +47,16 @@ deployed at the altitude from which it decays to the scenario altitude by then (
 the orbit-averaged model and the same Jacchia-Roberts atmosphere and space weather), and the
 heartbeat lost 5 years after deployment. The burn spends the scenario's Eq. 2-3 propellant.
 
-Guidance, navigation and control come in two sets (system_ssp.apps.mission.GNC picks one after
+Guidance, navigation and control come in three sets (system_ssp.apps.mission.GNC picks one after
 the scenario's parameter set):
   closed-loop  (the system's own bindings) the orbit thrusts along the body's thrust axis, the
                guidance FMU computes the burn attitude and its rate from the orbit's r and v, the
                slew and the tracking take it as their target; flight settle criteria and an
-               impulse-bit rate deadband end the maneuvers off the nominal point; RK4 attitude.
-  thesis       (parameters/mission_gnc_thesis.ssv) the thesis' numbers: thrust along -v
+               impulse-bit rate deadband end the maneuvers off the nominal point; RK4 attitude;
+               the controllers fly on the estimator (sensor noise on, seeds in the sensor files).
+  closed-loop-truth  (parameters/mission_gnc_truth.ssv) the same on the true state: truth feedback.
+  thesis       (parameters/mission_gnc_thesis.ssv) the thesis' numbers: truth feedback (the
+               estimator passes the rigid body's state through), thrust along -v
                whatever the attitude (orbit.retrograde, the lower-fidelity option), identity slew
                target, tracking at the Eq. 67 rate of Re + 400 km latched from the attitude at the
                burn start, single-sample stop tests, Euler attitude integration.
@@ -60,6 +74,7 @@ from components.mission.modes import DeorbitPhase as Phase, MissionMode as Mode
 from components.mission.power_bus import LOAD_NAMES
 
 from ...ssp.writer import vec
+from . import attitude_determination as ad
 
 KM = 1000.0
 IDLE_DAYS = 1825.0  # 5 years (Appendix I: 1855 days of idle + grace)
@@ -101,6 +116,15 @@ COMPONENTS = {
     "thrusters": ("RcsThrusterSet", ["thrusters"], set()),
     "power": ("Power", ["mission_power"], {"idle", "bus", "monitor", "slow"}),
     "data": ("DataStorage", ["mission_data"], {"bus", "monitor", "slow"}),
+    # attitude knowledge: ephemeris, shadow, sensors and the estimator (truth feedback: the estimator only)
+    "sun": ("SunEphemeris", ["mission_sun"], {"sense", "sense_slow"}),
+    "shadow": ("EarthShadow", [], {"sense", "sense_slow"}),
+    "gps": ("GpsReceiver", ["mission_gps"], {"sense", "sense_slow"}),
+    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense", "sense_vector"}),
+    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense", "sense_vector"}),
+    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense", "sense_vector"}),
+    "gyro": ("Gyro", ["mission_gyro"], {"sense"}),
+    "estimator": ("AttitudeEstimator", ["mission_estimator"], {"sense", "truth"}),
 }
 MANEUVERS = ("detumble", "slew", "burn")
 # Gauss-Seidel order. The mission manager decides at a step's start from its inputs there;
@@ -109,8 +133,18 @@ MANEUVERS = ("detumble", "slew", "burn")
 # states held at the step's start; a timed event the manager reaches at the step's end (a
 # wake-up) applies from then on, not to the step before. The rest follow the feedthrough edges
 # (propulsion -> orbit, orbit -> ground, controllers -> selector -> thrusters -> dynamics).
+# The sensors and the estimator come last: they read the rigid body at the step's end, so the
+# estimate (or, with truth feedback, the true state) the controllers read at the next step's
+# start is the state at that time, as if they read the rigid body itself.
 ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", "ground", "detumble", "slew",
-         "tracking", "selector", "thrusters", "dynamics"]
+         "tracking", "selector", "thrusters", "dynamics", "sun", "shadow", "gps", "horizon", "sun_sensor", "coarse_sun",
+         "gyro", "estimator"]
+# The vector sensors sample at about 10 Hz in the 15 ms maneuvers (every 7th step, 0.105 s; the
+# estimator uses each sample once), the gyro and the estimator every step; determination runs at
+# the gyro's 0.1 s.
+SENSOR_EVERY = 7
+DETERMINATION_STEP = 0.1
+DETERMINATION_EVERY = 10
 
 
 # Flight tolerances sized from the impulse bit: the rate change of one 15 ms firing (the attitude
@@ -123,9 +157,22 @@ BITS = thruster_control.impulse_bit_rates(
 DETUMBLE_FLIGHT = {**vec("omega_tol", [0.75 * b for b in BITS]), "settle_time": 1.0}
 SLEW_FLIGHT = {"target_from_input": True, **vec("omega_tol", [2.0 * b for b in BITS]),
                **vec("rate_deadband", [1.5 * b for b in BITS]), "settle_time": 3.0, "settle_angle": math.radians(1.0)}
+# Sensors: the gyro's bias left after a ground calibration (about 0.06 deg/s; the estimator
+# learns it); the rate filter's unmodelled acceleration, 2 % of one pair's about the x axis (the
+# thruster force and direction errors of the dispersion are of that order).
+GYRO_BIAS = [1e-3, -5e-4, 2e-4]
+# The thesis' one fine Sun sensor (+x, 60 deg half field) may never see the Sun from a tumbling host
+# (with the Eq. 7 tumble at the 420 km epoch it did not in 6 h): coarse sun sensors on the faces
+# (as the sunline module's CSS) give a 2 deg Sun vector whenever the fine one has none.
+COARSE_SUN_SIGMA = math.radians(2.0)
+# The detumble waits (after the 10 minutes of determination) until the estimator's largest
+# 1-sigma attitude error is below this: a TRIAD fix right at the end would start it at 1-2 deg.
+VALID_SIGMA = math.radians(0.25)
+ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / rigid_body.box_inertia(propulsion.MASS0, 0.1, 0.2, 0.3)[0, 0]
 # What the thesis parameter set restores (names component.variable); every value the closed loop
 # changes appears here.
-GNC_THESIS = {"orbit.retrograde": True, "dynamics.integrator": "euler", "tracking.target_from_input": False,
+GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
+              "tracking.target_from_input": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
               **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
@@ -137,13 +184,15 @@ GNC_THESIS = {"orbit.retrograde": True, "dynamics.integrator": "euler", "trackin
 # propulsion's initial mass together.
 SPACECRAFT_PARAMETERS = {
     "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", propulsion.MASS0,
-                        [("dynamics", "mass"), ("tracking", "mass"), ("propulsion", "mass0")]),
+                        [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0")]),
     "spacecraft_edge_a": ("Box edge a along body y, m (Appendix A: 0.1 m); also the x thruster pairs' spacing",
-                          0.1, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("thrusters", "edge_a")]),
+                          0.1, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("estimator", "edge_a"),
+                                ("thrusters", "edge_a")]),
     "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", 0.2,
-                          [("dynamics", "edge_b"), ("tracking", "edge_b")]),
+                          [("dynamics", "edge_b"), ("tracking", "edge_b"), ("estimator", "edge_b")]),
     "spacecraft_edge_c": ("Box edge c along body x, m (Appendix A: 0.3 m); also the y and z thruster pairs' arms",
-                          0.3, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("thrusters", "edge_c")]),
+                          0.3, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("estimator", "edge_c"),
+                                ("thrusters", "edge_c")]),
     "spacecraft_Cd": ("Drag coefficient (Table 2: 2.2)", 2.2, [("orbit", "Cd")]),
     "spacecraft_drag_area": ("Drag area facing the flow, m2 (Table 2: 0.02 m2)", 0.02, [("orbit", "area")]),
     "rcs_thrust": ("Force of one RCS thruster, N (Appendix A: 25 mN)", 0.025, [("thrusters", "thrust")]),
@@ -155,15 +204,34 @@ def having(role):
     return [c for c, (_, _, roles) in COMPONENTS.items() if role in roles]
 
 
-def maneuver_active(phase):
-    """Every component but the other maneuvers' controllers, in Gauss-Seidel order."""
+def maneuver_active(phase, truth=False):
+    """Every component but the other maneuvers' controllers, in Gauss-Seidel order; with truth
+    feedback no sensors (the estimator passes the rigid body's state through)."""
     others = {c for c, (_, _, roles) in COMPONENTS.items() if roles & set(MANEUVERS) - {phase}}
+    if truth:
+        others |= set(having("sense")) - set(having("truth"))
     return [c for c in ORDER if c not in others]
 
 
-def maneuver_every(phase):
+def maneuver_every(phase, truth=False):
     slow = having("slow") + (having("slow_burn") if phase == "burn" else [])
-    return {c: SLOW_EVERY for c in slow}
+    every = {c: SLOW_EVERY for c in slow}
+    if not truth:
+        every.update({c: SLOW_EVERY for c in having("sense_slow")})
+        every.update({c: SENSOR_EVERY for c in having("sense_vector")})
+    return every
+
+
+def determination_active():
+    """Estimation: the bus, the tumbling rigid body, the sensors and the estimator."""
+    return [c for c in ORDER if c in set(having("bus")) | set(having("sense")) | {"dynamics"}]
+
+
+def determination_every():
+    """In the 0.1 s determination steps the bus (but the manager, whose timers land exactly), the
+    ephemeris, the shadow and the GPS step every second."""
+    slow = (set(having("bus")) - {"mission"}) | set(having("sense_slow"))
+    return {c: DETERMINATION_EVERY for c in determination_active() if c in slow}
 
 
 def deployment_altitude(target_km, density="jacchia_roberts"):
@@ -189,6 +257,20 @@ def deployment_altitude(target_km, density="jacchia_roberts"):
     return 0.5 * (lo + hi)
 
 
+TRUTH = ("estimator", "truth_feedback", [1])
+
+
+def maneuver_modes():
+    """The 15 ms attitude phases, each twice: with truth feedback (no sensors) and with estimation."""
+    modes = []
+    for name, phase in (("detumble", Phase.DETUMBLE), ("slew", Phase.SLEW), ("burn", Phase.BURN)):
+        when = [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [phase])]
+        modes.append((f"{name}_truth", 0.015, maneuver_active(name, truth=True), 20, when + [TRUTH],
+                      maneuver_every(name, truth=True)))
+        modes.append((name, 0.015, maneuver_active(name), 20, when, maneuver_every(name)))
+    return modes
+
+
 def system(orbit_fmu):
     comps = [(name, orbit_fmu if fmu == ORBIT else fmu, files) for name, (fmu, files, _) in COMPONENTS.items()]
     conns = [("host", "heartbeat", "mission", "heartbeat", 0),
@@ -210,12 +292,12 @@ def system(orbit_fmu):
              ("guidance", "omega_target_B", "slew", "omega_target_B", 3),
              ("guidance", "q_target_BN", "tracking", "q_target_BN", 4),
              ("guidance", "omega_target_B", "tracking", "omega_target_B", 3),
-             ("dynamics", "omega_BN_B", "detumble", "omega_BN_B", 3),
-             ("dynamics", "omega_dot_BN_B", "detumble", "omega_dot_BN_B", 3),
-             ("dynamics", "q_BN", "slew", "q_BN", 4),
-             ("dynamics", "omega_BN_B", "slew", "omega_BN_B", 3),
-             ("dynamics", "q_BN", "tracking", "q_BN", 4),
-             ("dynamics", "omega_BN_B", "tracking", "omega_BN_B", 3),
+             ("estimator", "omega_est_B", "detumble", "omega_BN_B", 3),
+             ("estimator", "omega_dot_est_B", "detumble", "omega_dot_BN_B", 3),
+             ("estimator", "q_est_BN", "slew", "q_BN", 4),
+             ("estimator", "omega_est_B", "slew", "omega_BN_B", 3),
+             ("estimator", "q_est_BN", "tracking", "q_BN", 4),
+             ("estimator", "omega_est_B", "tracking", "omega_BN_B", 3),
              ("mission", "detumble_enable", "detumble", "enabled", 0),
              ("mission", "slew_enable", "slew", "enabled", 0),
              ("mission", "tracking_enable", "tracking", "enabled", 0),
@@ -231,7 +313,36 @@ def system(orbit_fmu):
              ("thrusters", "torque_B", "dynamics", "torque_B", 3),
              ("mission", "data_recording", "data", "data_recording", 0),
              ("mission", "downlink_enable", "data", "downlink_enable", 0),
-             ("ground", "visible", "data", "ground_contact", 0)]
+             ("ground", "visible", "data", "ground_contact", 0),
+             # attitude knowledge
+             ("orbit", "r_BN_N", "shadow", "r_BN_N", 3),
+             ("sun", "r_SN_N", "shadow", "r_SN_N", 3),
+             ("orbit", "r_BN_N", "gps", "r_BN_N", 3),
+             ("orbit", "r_BN_N", "horizon", "r_BN_N", 3),
+             ("dynamics", "q_BN", "horizon", "q_BN", 4),
+             ("sun", "r_SN_N", "sun_sensor", "r_SN_N", 3),
+             ("orbit", "r_BN_N", "sun_sensor", "r_BN_N", 3),
+             ("dynamics", "q_BN", "sun_sensor", "q_BN", 4),
+             ("shadow", "orbit_day", "sun_sensor", "sunlit", 0),
+             ("sun", "r_SN_N", "coarse_sun", "r_SN_N", 3),
+             ("orbit", "r_BN_N", "coarse_sun", "r_BN_N", 3),
+             ("dynamics", "q_BN", "coarse_sun", "q_BN", 4),
+             ("shadow", "orbit_day", "coarse_sun", "sunlit", 0),
+             ("coarse_sun", "sun_B", "estimator", "coarse_sun_B", 3),
+             ("coarse_sun", "valid", "estimator", "coarse_sun_valid", 0),
+             ("dynamics", "omega_BN_B", "gyro", "omega_BN_B", 3),
+             ("horizon", "nadir_B", "estimator", "nadir_B", 3),
+             ("horizon", "valid", "estimator", "nadir_valid", 0),
+             ("sun_sensor", "sun_B", "estimator", "sun_B", 3),
+             ("sun_sensor", "valid", "estimator", "sun_valid", 0),
+             ("gyro", "omega_meas_B", "estimator", "omega_meas_B", 3),
+             ("gps", "r_meas_N", "estimator", "r_BN_N", 3),
+             ("sun", "r_SN_N", "estimator", "r_SN_N", 3),
+             ("selector", "torque_cmd_B", "estimator", "torque_cmd_B", 3),
+             ("dynamics", "q_BN", "estimator", "q_true_BN", 4),
+             ("dynamics", "omega_BN_B", "estimator", "omega_true_B", 3),
+             ("dynamics", "omega_dot_BN_B", "estimator", "omega_dot_true_B", 3),
+             ("estimator", "attitude_valid", "mission", "attitude_valid", 0)]
     conns += [("mission", name, "power", name, 0) for name in LOAD_NAMES]
     return {
         "description": f"NEIGHBOR mission from deployment to re-entry ({orbit_fmu} orbit): operating modes, "
@@ -249,13 +360,10 @@ def system(orbit_fmu):
         # the attitude loop, which every phase is correct at. The schedule only saves the steps.
         "step_size": 0.015,
         "schedule": {"modes": [
-            ("detumble", 0.015, maneuver_active("detumble"), 20,
-             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.DETUMBLE])], maneuver_every("detumble")),
-            ("slew", 0.015, maneuver_active("slew"), 20,
-             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.SLEW])], maneuver_every("slew")),
-            ("burn", 0.015, maneuver_active("burn"), 20,
-             [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [Phase.BURN])], maneuver_every("burn")),
-            ("determination", 1.0, having("bus"), 10, [("mission", "mode", [Mode.DEORBIT])]),
+            *maneuver_modes(),
+            ("determination_truth", 1.0, having("bus"), 10, [("mission", "mode", [Mode.DEORBIT]), TRUTH]),
+            ("determination", DETERMINATION_STEP, determination_active(), 10, [("mission", "mode", [Mode.DEORBIT])],
+             determination_every()),
             ("contact", 1.0, having("bus"), 10, [("mission", "mode", [Mode.CONTACT])]),
             ("awaiting_near", 5.0, having("bus"), 12,
              [("mission", "mode", [Mode.AWAITING]), ("ground", "near_contact", [1])]),
@@ -316,6 +424,29 @@ def generate(writer):
                "The thesis' guidance and control (its published numbers): thrust along -v whatever the attitude, "
                "identity slew target, tracking at the Eq. 67 rate latched at the burn start, single-sample stop "
                "tests, Euler attitude integration", GNC_THESIS)
+    writer.ssv("mission_sun", "Sun ephemeris from the mission epoch", {"epoch": MISSION_EPOCH})
+    writer.ssv("mission_gps", "GPS receiver (OEM7700): 1.5 m per axis, seed", {"sigma": ad.GPS_SIGMA, "seed": 14})
+    writer.ssv("mission_horizon", "Horizon sensor (CubeIR class): 0.25 deg RMS, seed", {"sigma": ad.HORIZON_SIGMA,
+                                                                                         "seed": 11})
+    writer.ssv("mission_sun_sensor", "Sun sensor (nanoSSOC-D60) on +x: 60 deg half field of view, 0.5 deg 3 sigma, "
+               "seed", {**vec("boresight_B", [1.0, 0.0, 0.0]), "half_fov": math.radians(60.0), "sigma": ad.SUN_SIGMA,
+                        "seed": 12})
+    writer.ssv("mission_coarse_sun", "Coarse sun sensors on the six faces, taken together: the Sun anywhere in the "
+               f"sky when sunlit, {math.degrees(COARSE_SUN_SIGMA):g} deg RMS (Earth albedo not modelled), seed",
+               {"half_fov": math.pi, "sigma": COARSE_SUN_SIGMA, "seed": 15})
+    writer.ssv("mission_gyro", "Gyro (BMG160): 0.032 deg/s per 0.1 s sample (0.014 deg/s/sqrt(Hz)) at any sampling "
+               "step, a calibration residual bias of 0.06 deg/s, seed",
+               {**vec("bias", GYRO_BIAS), "sigma": ad.GYRO_SIGMA, "sigma_sample_time": ad.STEP, "seed": 13})
+    writer.ssv("mission_estimator", "Attitude estimator: the sensors' accuracies, each vector sample used once "
+               "(vector sensors at about 10 Hz), rate filter trusting the torque model to 2 % of one pair's "
+               "acceleration, coarse Sun vectors when the fine sensor has none, attitude valid at 0.25 deg 1-sigma",
+               {"nadir_sigma": ad.HORIZON_SIGMA, "sun_sigma": ad.SUN_SIGMA, "gyro_sigma": ad.GYRO_SIGMA,
+                "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": 0.09, "accel_sigma": ACCEL_SIGMA,
+                "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA})
+    writer.ssv("mission_gnc_truth",
+               "Closed-loop guidance and control on the true state (a fidelity choice): the estimator passes the "
+               "rigid body's attitude, rate and acceleration through; the sensors are not stepped",
+               {"estimator.truth_feedback": True})
     writer.ssv("mission_power", "LG HG2 cell: 3.0 Ah x 3.6 V = 10.8 Wh, full",
                {"capacity": 10.8 * 3600.0, "initial_state_of_charge": 1.0})
     writer.ssv("mission_data", "256 kB flash, Table 7 rate, 9600 baud downlink",

@@ -368,7 +368,7 @@ def test_mission_fmu(build_one, tmp_path):
     path = build_one("neighbor_mission.py")
     deps = check_declarations(path)
     assert set(deps) == {"mode", "phase", "end_reason", "next_event_time", "time_in_mode", "time_in_phase",
-                         "detumble_timeouts", "slew_timeouts", *LOAD_NAMES, *mm.COMMANDS}
+                         "detumble_timeouts", "slew_timeouts", "determination_timeouts", *LOAD_NAMES, *mm.COMMANDS}
     assert all(d == [] for d in deps.values())  # state outputs: no direct feedthrough
     fmu, vr = instantiate(path, tmp_path, "mission", start_time=1000.0)
     fmu.setReal([vr["grace_period"]], [100.0])
@@ -442,3 +442,30 @@ def test_a_phase_that_never_finishes_times_out_retries_and_moves_on():
         _in_phase(mm.SLEW, slew_timeout=-1.0)
     with pytest.raises(ValueError, match=r"phase_retries = 1.5 must be an integer >= 0"):
         _in_phase(mm.SLEW, phase_retries=1.5)
+
+
+def test_attitude_determination_waits_for_a_valid_attitude_then_times_out():
+    """Without a fix at the end of the 600 s (no Sun in eclipse) the determination goes on until
+    attitude_valid holds; with attitude_determination_timeout > 0 the detumble starts then anyway."""
+    m = _in_phase(mm.ATTITUDE_DETERMINATION)
+    m.step(0.0, 600.0, {"attitude_valid": False})
+    assert m.phase == mm.ATTITUDE_DETERMINATION and m.att_det_waiting and m.next_event_time == 1e300
+    m.step(600.0, 900.0, {"attitude_valid": False})
+    assert m.phase == mm.ATTITUDE_DETERMINATION
+    m.step(1500.0, 1.0, {"attitude_valid": True})  # the fix, seen at the step start
+    assert (m.phase, m.phase_entry, m.determination_timeouts) == (mm.DETUMBLE, 1500.0, 0)
+    # valid already at the end of the duration: on time, as before
+    m = _in_phase(mm.ATTITUDE_DETERMINATION)
+    m.step(0.0, 700.0, {"attitude_valid": True})
+    assert (m.phase, m.phase_entry) == (mm.DETUMBLE, 600.0)
+    # the timeout counts from the phase start and is announced as the next event
+    m = _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=3000.0)
+    m.step(0.0, 600.0, {"attitude_valid": False})
+    assert m.next_event_time == 3000.0
+    m.step(600.0, 2500.0, {"attitude_valid": False})
+    assert (m.phase, m.phase_entry, m.determination_timeouts) == (mm.DETUMBLE, 3000.0, 1)
+    state = m.get_state()
+    m.set_state(state)
+    assert m.get_state() == state
+    with pytest.raises(ValueError, match=r"attitude_determination_timeout = -5.0 s must be >= 0"):
+        _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=-5.0)

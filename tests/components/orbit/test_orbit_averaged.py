@@ -244,6 +244,21 @@ def test_get_set_state_and_exact_landing():
         m.advance_to(0.0)
 
 
+def test_short_steps_years_after_the_epoch_are_integrated():
+    """0.1 s steps five years after the epoch (the mission's attitude determination) move the
+    orbit as one 1 s step does; a tolerance relative to the time once dropped them."""
+    a, b = oa.OrbitAveraged(None, sma0=6798137.0), oa.OrbitAveraged(None, sma0=6798137.0)
+    t0 = 1.6e8
+    a.advance_to(t0)
+    b.advance_to(t0)
+    u0 = a.mean_arg_latitude
+    for k in range(1, 11):
+        a.advance_to(t0 + 0.1 * k)
+    b.advance_to(t0 + 1.0)
+    assert a.mean_arg_latitude - u0 == pytest.approx(math.sqrt(3.986004418e14 / 6798137.0 ** 3), rel=0.01)
+    assert a.mean_arg_latitude - b.mean_arg_latitude == pytest.approx(0.0, abs=1e-9)
+
+
 def test_bad_parameters_are_named():
     for kwargs, name in (({"inc0": 0.0}, "inc0"), ({"ecc0": 1.0}, "ecc0"), ({"sma0": -1.0}, "sma0"),
                          ({"Cd": -1.0}, "Cd"), ({"quadrature_nodes": 4}, "quadrature_nodes"),

@@ -7,6 +7,7 @@ import math
 import numpy as np
 import pytest
 
+from components.attitude import rigid_body
 from components.core import rotations
 from components.sensing import triad
 from components.sensing.mekf import AttitudeMEKF
@@ -83,43 +84,67 @@ def test_bad_use_is_refused():
 
 
 def test_fmu_equals_the_component_and_declares_its_dependencies(build_one, tmp_path):
-    """AttitudeEstimator through FMPy: TRIAD start, MEKF updates and gyro propagation give the
-    component's estimate bit for bit; only the bias-corrected rate is direct feedthrough."""
+    """AttitudeEstimator through FMPy: TRIAD start, MEKF updates, gyro propagation and the rate
+    filter give the component's estimate bit for bit; no output is direct feedthrough (all are
+    computed in do_step); truth feedback passes the true state through."""
     from fmu_helpers import check_declarations, instantiate
     from components.sensing.mekf import AttitudeEstimator
 
     path = build_one("neighbor_attitude_estimator.py")
     deps = check_declarations(path)
-    assert deps["omega_est_B[2]"] == [f"omega_meas_B[{i}]" for i in (1, 2, 3)]
-    assert deps["q_est_BN[1]"] == [] and deps["sigma_attitude[3]"] == [] and deps["initialized"] == []
+    assert all(d == [] for d in deps.values())
     fmu, vr = instantiate(path, tmp_path, "estimator", initialize=True)
-    model = AttitudeEstimator()
+    model = AttitudeEstimator(inertia=rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3))  # the FMU default
     rng = np.random.default_rng(5)
     q_true = rotations.from_axis_angle((0.2, 0.9, -0.1), 1.1)
     omega = np.array([0.001, 0.00113, -0.002])
     r_BN, r_SN = [6798137.0, 0.0, 0.0], [0.0, -1.496e11, 0.0]
+    torque = [2.5e-3, 0.0, -2.5e-3]
     names = ([f"nadir_B[{i}]" for i in (1, 2, 3)] + [f"sun_B[{i}]" for i in (1, 2, 3)]
              + [f"omega_meas_B[{i}]" for i in (1, 2, 3)] + [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-             + [f"r_SN_N[{i}]" for i in (1, 2, 3)])
+             + [f"r_SN_N[{i}]" for i in (1, 2, 3)] + [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
+             + [f"q_true_BN[{i}]" for i in (1, 2, 3, 4)])
     try:
         fmu.setReal([vr[f"r_BN_N[{i}]"] for i in (1, 2, 3)], r_BN)
         for k in range(300):
+            q_true = triad.propagate(q_true, omega, H)  # the truth at the step's end: the measurements' time
             A = np.array(rotations.attitude_matrix(q_true))
             nadir = _noisy(A @ -np.array(r_BN) / r_BN[0], NADIR_SIGMA, rng)
             sun = _noisy(A @ (np.array(r_SN) - r_BN) / np.linalg.norm(np.array(r_SN) - r_BN), SUN_SIGMA, rng)
             w = omega + BIAS + rng.normal(0.0, GYRO_SIGMA, 3)
             sunlit = k < 200  # then eclipse
-            fmu.setReal([vr[n] for n in names], [*nadir, *sun, *w, *r_BN, *r_SN])
+            fmu.setReal([vr[n] for n in names], [*nadir, *sun, *w, *r_BN, *r_SN, *torque, *q_true])
             fmu.setBoolean([vr["nadir_valid"], vr["sun_valid"]], [True, sunlit])
             fmu.doStep(k * H, H)
-            model.step((tuple(nadir), True, tuple(sun), sunlit, r_BN, r_SN), tuple(w), H)
-            q_true = triad.propagate(q_true, omega, H)
+            model.step((tuple(nadir), True, tuple(sun), sunlit, r_BN, r_SN), tuple(w), H, torque)
         got = fmu.getReal([vr[f"q_est_BN[{i}]"] for i in (1, 2, 3, 4)])
         assert got == list(model.filter.q)
+        assert fmu.getReal([vr[f"omega_est_B[{i}]"] for i in (1, 2, 3)]) == list(model.rate)
         assert fmu.getBoolean([vr["initialized"]]) == [True]
-        assert triad.error_angle(got, q_true) < math.radians(0.3)
+        error = fmu.getReal([vr["attitude_error"]])[0]
+        assert error == pytest.approx(triad.error_angle(got, q_true), abs=1e-15) and error < math.radians(0.3)
         bias = fmu.getReal([vr[f"bias_est_B[{i}]"] for i in (1, 2, 3)])
         assert np.abs(np.array(bias) - BIAS).max() < 2e-4
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+    # truth feedback: the outputs are the truth inputs of the step
+    fmu, vr = instantiate(path, tmp_path, "truth")
+    try:
+        fmu.setBoolean([vr["truth_feedback"]], [True])
+        fmu.enterInitializationMode()
+        truth = {"q_true_BN": [0.1, 0.2, 0.3, math.sqrt(0.86)], "omega_true_B": [0.01, -0.02, 0.03],
+                 "omega_dot_true_B": [1e-3, 2e-3, -3e-3]}
+        for name, values in truth.items():
+            fmu.setReal([vr[f"{name}[{i}]"] for i in range(1, len(values) + 1)], values)
+        fmu.exitInitializationMode()
+        assert fmu.getReal([vr[f"q_est_BN[{i}]"] for i in (1, 2, 3, 4)]) == truth["q_true_BN"]
+        fmu.setReal([vr["omega_true_B[1]"]], [0.5])
+        assert fmu.getReal([vr["omega_est_B[1]"]]) == [0.01]  # a state output: changes in do_step
+        fmu.doStep(0.0, 0.015)
+        assert fmu.getReal([vr[f"omega_est_B[{i}]"] for i in (1, 2, 3)]) == [0.5, -0.02, 0.03]
+        assert fmu.getReal([vr[f"omega_dot_est_B[{i}]"] for i in (1, 2, 3)]) == truth["omega_dot_true_B"]
+        assert fmu.getBoolean([vr["initialized"]]) == [True]
     finally:
         fmu.terminate()
         fmu.freeInstance()
