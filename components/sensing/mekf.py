@@ -252,15 +252,12 @@ class AttitudeEstimator:
         return tuple(self.rates.omega_dot)
 
     def _new(self, name, vector):
+        """A new sample of this sensor: not the one used last, and update_interval after it."""
         used, when = self.last[name]
         return tuple(vector) != used and self.time - when >= self.update_interval - 1e-9
 
-    def _fresh(self, name, vector):
-        """A new sample of this sensor (then marked used)?"""
-        if not self._new(name, vector):
-            return False
+    def _mark(self, name, vector):
         self.last[name] = (tuple(vector), self.time)
-        return True
 
     def step(self, measurements, omega_meas, h, torque=(0.0, 0.0, 0.0), coarse_sun=None):
         """measurements = (nadir_B, nadir_valid, sun_B, sun_valid, r_BN_N, r_SN_N);
@@ -278,23 +275,22 @@ class AttitudeEstimator:
         if not f.initialized:
             self._initialize(measurements, coarse)
         else:
-            if self.cov_pending >= COVARIANCE_STEP - 1e-9 or self._due(nadir_valid, nadir_B, sun_valid, sun_B, coarse):
-                self._propagate_covariance()
-            if nadir_valid and self._fresh("nadir", nadir_B):
-                f.update(nadir_B, [-x for x in r_BN_N], self.nadir_sigma)
             sun_N = [s - r for s, r in zip(r_SN_N, r_BN_N)]
+            updates = []  # (sensor, measured vector, reference direction, sigma) of the new samples
+            if nadir_valid and self._new("nadir", nadir_B):
+                updates.append(("nadir", nadir_B, [-x for x in r_BN_N], self.nadir_sigma))
             if sun_valid:
-                if self._fresh("sun", sun_B):
-                    f.update(sun_B, sun_N, self.sun_sigma)
-            elif coarse is not None and self._fresh("coarse", coarse[0]):
-                f.update(coarse[0], sun_N, self.coarse_sigma)
+                if self._new("sun", sun_B):
+                    updates.append(("sun", sun_B, sun_N, self.sun_sigma))
+            elif coarse is not None and self._new("coarse", coarse[0]):
+                updates.append(("coarse", coarse[0], sun_N, self.coarse_sigma))
+            if updates or self.cov_pending >= COVARIANCE_STEP - 1e-9:
+                self._propagate_covariance()  # the covariance must be current before an update
+            for name, b, r, sigma in updates:
+                self._mark(name, b)
+                f.update(b, r, sigma)
         self.held_rate = tuple(float(x) for x in omega_meas)
         self.rates.update(f.rate(self.held_rate), h)
-
-    def _due(self, nadir_valid, nadir_B, sun_valid, sun_B, coarse):
-        """Would a vector update this step (then the covariance must be current first)?"""
-        return ((nadir_valid and self._new("nadir", nadir_B)) or (sun_valid and self._new("sun", sun_B))
-                or (not sun_valid and coarse is not None and self._new("coarse", coarse[0])))
 
     def _propagate_covariance(self):
         if self.cov_pending > 0.0:
@@ -316,8 +312,8 @@ class AttitudeEstimator:
         first, second = sorted((self.nadir_sigma, sun_sigma))
         sigma = triad.triad_error_rms(first * math.sqrt(2.0), second * math.sqrt(2.0), angle) / math.sqrt(3.0)
         self.filter.initialize(q, max(sigma, 1e-6), sigma_bias=self.sigma_bias0)
-        self._fresh("nadir", nadir_B)
-        self._fresh(*sun_used)
+        self._mark("nadir", nadir_B)
+        self._mark(*sun_used)
 
     def get_state(self):
         return {"filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
