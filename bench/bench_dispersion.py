@@ -69,7 +69,8 @@ def main():
     print(distribution("RCS propellant (g)", [1e3 * r["rcs_propellant_kg"] for r in ok]))
     print(distribution("burn propellant (kg)", [r["burn_propellant_kg"] for r in ok]))
     print(distribution("attitude determination (s)", [r["detumble_start_s"] - r["determination_start_s"] for r in ok]))
-    print(distribution("largest knowledge error, whole run (deg)", [np.degrees(r["knowledge_error_max_rad"]) for r in ok]))
+    print(distribution("largest knowledge error, whole run (deg)",
+                       [np.degrees(r["knowledge_error_max_rad"]) for r in ok]))
     per_run = np.mean([r["wall_s"] for r in rows]) if rows else float("nan")
     workers = args.workers or len(os.sched_getaffinity(0))
     print(f"wall {wall:.0f} s for {len(rows) - summary['resumed_from']} new runs; {per_run:.1f} s per run in a worker; "
