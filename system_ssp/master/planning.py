@@ -151,7 +151,7 @@ def _schedule(system, algorithm, multiples):
                        "with it")
     names = [c.name for c in system.comps]
 
-    def output(comp, conn, types, what, origin, causalities=("output",)):
+    def signal(comp, conn, types, what, origin, causalities=("output",)):
         if comp not in system.by_name:
             raise SSPError(f"{origin}: {what} names unknown component {comp!r}{near(comp, names)}")
         c = system.by_name[comp]
@@ -173,7 +173,7 @@ def _schedule(system, algorithm, multiples):
                 raise SSPError(f"{m.origin}: nc:Mode {m.name!r} active lists unknown component(s) "
                                + ", ".join(f"{u!r}{near(u, names)}" for u in unknown))
             active = [c.name in m.active for c in system.comps]
-        conds = tuple(output(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}",
+        conds = tuple(signal(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}",
                              m.origin, CONDITION_CAUSALITIES)[:2] + (vals,) for c, v, vals in m.conditions)
         mult = [1] * len(system.comps)
         for comp, k in m.every.items():
@@ -186,5 +186,5 @@ def _schedule(system, algorithm, multiples):
             mult[system.by_name[comp].index] = k
         modes.append(ScheduleMode(name=m.name, step_size=m.step_size, active=tuple(active),
                                   record_every=m.record_every, conditions=conds, multiples=tuple(mult)))
-    events = tuple(output(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events)
+    events = tuple(signal(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events)
     return SchedulePlan(modes=tuple(modes), events=events, origin=sched.origin)
