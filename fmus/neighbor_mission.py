@@ -54,7 +54,7 @@ INPUTS = (
     ("reentered", None, bool, "Spacecraft has re-entered (orbit FMU)"),
 )
 APPENDED_INPUTS = (
-    ("attitude_valid", None, bool, "The attitude is known (AttitudeEstimator.initialized): attitude determination "
+    ("attitude_valid", None, bool, "The attitude is known (AttitudeEstimator.attitude_valid): attitude determination "
                                    "lasts at least attitude_determination_duration and until this holds"),
 )
 # When the manager switches a load beyond the plain mode table (components.mission.manager).

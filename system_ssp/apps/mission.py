@@ -349,7 +349,8 @@ def plot(d, s, out):
             axes[1].set_ylabel("angle turned, Eq. 31 (deg)")
         if burn:
             err = np.degrees(d["tracking.attitude_error"][sel])
-            _envelope(axes[2], tt, err, "k", "angle from the desired attitude", linewidth=0.8)
+            _envelope(axes[2], tt, err, "k", "angle from the desired attitude (the law's, on its attitude input)",
+                      linewidth=0.8)
             axes[2].set_ylabel("tracking error (deg)")
             settled = err[tt >= 10.0]
             if settled.size and err.max() > 3.0 * settled.max() > 0.0:
