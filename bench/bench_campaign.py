@@ -16,9 +16,9 @@ import time
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
-from system_ssp.apps.campaign import load_spec  # noqa: E402
-from system_ssp.apps.campaign import runner  # noqa: E402
-from system_ssp.apps.campaign.worker import run_one  # noqa: E402
+from system_ssp.tools.campaign import load_spec  # noqa: E402
+from system_ssp.tools.campaign import runner  # noqa: E402
+from system_ssp.tools.campaign.worker import run_one  # noqa: E402
 
 CASES = {
     "deorbit": """

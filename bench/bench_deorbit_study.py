@@ -16,7 +16,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from system_ssp.apps import deorbit_study  # noqa: E402
+from system_ssp.neighbor import deorbit_study  # noqa: E402
 
 
 def main():

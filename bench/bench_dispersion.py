@@ -24,8 +24,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from components.core.constants import YEAR  # noqa: E402
-from system_ssp.apps.campaign import load_spec, run_campaign  # noqa: E402
-from system_ssp.apps.campaign.runner import _read_rows, wilson  # noqa: E402
+from system_ssp.tools.campaign import load_spec, run_campaign  # noqa: E402
+from system_ssp.tools.campaign.runner import _read_rows, wilson  # noqa: E402
 
 SPEC = Path(__file__).resolve().parents[1] / "examples" / "campaigns" / "mission_dispersion_420km.toml"
 PHASES = {"detumble (s)": ("detumble_start_s", "slew_start_s", 1.0),

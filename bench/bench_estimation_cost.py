@@ -25,8 +25,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from components.mission.modes import DeorbitPhase, MissionMode  # noqa: E402
-from system_ssp.apps import mission  # noqa: E402
-from system_ssp.apps.campaign import load_spec  # noqa: E402
+from system_ssp.neighbor import mission  # noqa: E402
+from system_ssp.tools.campaign import load_spec  # noqa: E402
 
 SPEC = Path(__file__).resolve().parents[1] / "examples" / "campaigns" / "mission_dispersion_420km.toml"
 PHASE_KEYS = ("detumble_propellant_g", "slew_propellant_g", "tracking_propellant_g", "detumble_time_s",

@@ -22,7 +22,7 @@ ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
 import system_ssp  # noqa: E402
-from system_ssp.apps import thesis  # noqa: E402
+from system_ssp.neighbor import thesis  # noqa: E402
 from system_ssp.master import instances  # noqa: E402
 
 SSP = ROOT / "build" / "ssp"

@@ -16,8 +16,9 @@ import sys
 import traceback
 
 from . import __version__
-from .apps import (add_console_arguments, campaign, console_settings, deorbit_study, flatten, mission, parse_sets,
-                   replace, thesis, validation)
+from .neighbor import deorbit_study, mission, thesis, validation
+from .tools import campaign, flatten, replace
+from .tools.console import add_console_arguments, console_settings, parse_sets
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.info import system_info

@@ -62,7 +62,7 @@ def ssp_paths(built):
 @pytest.fixture(scope="session")
 def thesis_cases(ssp_paths):
     """The thesis' detumble and slew cases (euler), run once for every test that reads them."""
-    from system_ssp.apps import thesis
+    from system_ssp.neighbor import thesis
 
     return thesis.run_cases(ssp_paths["detumble"].parent, "euler")
 
@@ -70,7 +70,7 @@ def thesis_cases(ssp_paths):
 @pytest.fixture(scope="session")
 def mission_420km(ssp_paths, tmp_path_factory):
     """(summary, result, results folder) of one 420 km mission run (orbit-averaged, about a minute)."""
-    from system_ssp.apps import mission
+    from system_ssp.neighbor import mission
 
     out = tmp_path_factory.mktemp("mission")
     summary, result = mission.run_mission("420km", "averaged", ssp_dir=ssp_paths["neighbor_mission"].parent, out=out,
@@ -80,8 +80,8 @@ def mission_420km(ssp_paths, tmp_path_factory):
 
 def pytest_sessionfinish(session, exitstatus):
     """The validation table's guard: every published number whose guarding test ran in this
-    session must have been checked by that test (system_ssp.apps.validation.assert_reproduces)."""
-    from system_ssp.apps import validation
+    session must have been checked by that test (system_ssp.neighbor.validation.assert_reproduces)."""
+    from system_ssp.neighbor import validation
 
     ran = {item.nodeid.split("[")[0] for item in session.items}
     missing = []

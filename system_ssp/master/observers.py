@@ -9,9 +9,11 @@ import time
 
 import numpy as np
 
-from components.core.constants import DAY, YEAR
-
 from .instances import read_ops
+
+# The progress bar's display units (the master knows nothing of the models, so not from components).
+DAY = 86400.0  # s
+YEAR = 365.25 * DAY  # s, Julian year
 
 RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_}
 

@@ -1,11 +1,13 @@
 """Each FMU on its own through FMPy: a valid model description, standalone simulation,
 get/set of the full state, and the incremental build."""
 import math
+import re
 import zipfile
 
 import fmpy
 import pytest
 
+from build_fmus import wrapper_scripts
 from fmu_helpers import check_declarations, instantiate
 
 EXPECTED = {"RigidBody", "DetumbleController", "SlewController", "RcsThrusters"}
@@ -17,6 +19,18 @@ def test_every_fmu_is_built_valid_and_fully_declared(fmu_paths):
         check_declarations(path)
 
 
+def wrapper_module(fmu_name):
+    """The one naming rule for wrappers: fmus/neighbor_<the FMU name in snake case>.py."""
+    return "neighbor_" + re.sub(r"(?<!^)(?=[A-Z])", "_", fmu_name).lower()
+
+
+def test_wrapper_files_are_named_after_their_fmus():
+    for script in wrapper_scripts():
+        classes = re.findall(r"^class (\w+)\(NeighborSlave\)", script.read_text(), re.M)
+        assert len(classes) == 1, f"{script.name}: one FMU class per wrapper, found {classes}"
+        assert script.stem == wrapper_module(classes[0]), f"{script.name} builds {classes[0]}"
+
+
 def test_module_names_are_unique(fmu_paths):
     """Every FMU's code lives in one package named for the FMU and its build: no two FMUs (or two
     builds of one) can load each other's modules in one process."""
@@ -26,7 +40,7 @@ def test_module_names_are_unique(fmu_paths):
             text = zf.read("resources/neighbor_runtime.txt").decode()
             config = dict(line.split("=", 1) for line in text.splitlines())
             package, module, cls = config["slave"].split()
-            assert cls == name and module.startswith("neighbor_")
+            assert cls == name and module == wrapper_module(name)
             assert package.startswith(f"nc_{name.lower()}_") and f"resources/{package}/{module}.py" in zf.namelist()
             assert not any(n.startswith(("resources/components", "resources/pythonfmu")) for n in zf.namelist())
         packages.append(package)
@@ -150,7 +164,7 @@ def test_feedthrough_cache_follows_parameters_and_restored_state():
     from build_fmus import FMU_SOURCES
 
     sys.path.insert(0, str(FMU_SOURCES))
-    from neighbor_detumble import DetumbleController
+    from neighbor_detumble_controller import DetumbleController
 
     d = DetumbleController(instance_name="d")
     vr = {v.name: v.value_reference for v in d.vars.values()}

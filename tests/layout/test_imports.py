@@ -100,3 +100,26 @@ def test_components_has_only_domain_packages():
     assert loose == []
     domains = sorted(p.name for p in (REPO / "components").iterdir() if (p / "__init__.py").is_file())
     assert domains == ["acs", "attitude", "core", "environment", "mission", "orbit", "sensing"]
+
+
+def _imports_from(prefix, forbidden):
+    """`file:line imports X` for every import of a module under `forbidden` by a module under `prefix`."""
+    modules = project_modules()
+    return [f"{path.relative_to(REPO)}:{line} imports {t}" for name, path in modules.items()
+            if name == prefix or name.startswith(prefix + ".")
+            for t, line, _ in imports_of(name, path, modules)
+            if any(t == f or t.startswith(f + ".") for f in forbidden)]
+
+
+def test_master_and_ssp_know_no_models_and_no_application():
+    """The master and the SSP files serve any system: nothing of the models or of NEIGHBOR."""
+    for pkg in ("system_ssp.master", "system_ssp.ssp"):
+        assert _imports_from(pkg, ("components", "system_ssp.neighbor", "system_ssp.tools")) == []
+
+
+def test_generic_tools_know_no_application():
+    """The tools serve any SSP system. The one model they use is the space-weather file the
+    campaign's `solar_activity` helper scales (an Earth-orbit helper, not a NEIGHBOR one)."""
+    assert _imports_from("system_ssp.tools", ("system_ssp.neighbor",)) == []
+    assert _imports_from("system_ssp.tools", ("components",)) == [
+        "system_ssp/tools/campaign/worker.py:11 imports components.environment.space_weather"]

@@ -6,7 +6,7 @@ import pyarrow.parquet as pq
 import pytest
 
 from master_fixtures import helpers as h
-from system_ssp.apps.campaign import load_spec, run_campaign
+from system_ssp.tools.campaign import load_spec, run_campaign
 from test_master_core import loop_system
 
 

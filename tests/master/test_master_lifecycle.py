@@ -20,7 +20,7 @@ from master_fixtures import helpers as h
 from paths import REPO
 import system_ssp
 from system_ssp import SimulationError, SSPError
-from system_ssp.apps import add_console_arguments, console_settings
+from system_ssp.tools.console import add_console_arguments, console_settings
 from system_ssp.atomic import StagedFolder, atomic_write
 from system_ssp.master import instances
 from system_ssp.master.observers import ProgressBar, StepInfo

@@ -8,7 +8,7 @@ import pytest
 
 import system_ssp
 from system_ssp import SSPError
-from system_ssp.apps.flatten import flatten_system_parameters
+from system_ssp.tools.flatten import flatten_system_parameters
 from system_ssp.master.parameters import collect_parameters
 
 MASS_USERS = [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0")]

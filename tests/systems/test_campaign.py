@@ -9,8 +9,8 @@ import pyarrow.parquet as pq
 import pytest
 
 from system_ssp import SSPError
-from system_ssp.apps.campaign import load_spec, run_campaign
-from system_ssp.apps.campaign.runner import wilson
+from system_ssp.tools.campaign import load_spec, run_campaign
+from system_ssp.tools.campaign.runner import wilson
 
 DETUMBLE = """
 [campaign]

@@ -8,8 +8,8 @@ import pytest
 from components.orbit import propulsion
 import system_ssp
 from system_ssp import SimulationError, SSPError
-from system_ssp.apps import deorbit_study
-from system_ssp.apps.validation import assert_reproduces
+from system_ssp.neighbor import deorbit_study
+from system_ssp.neighbor.validation import assert_reproduces
 from system_ssp.systems import PARAMETERS_DIR
 
 PARAMS = PARAMETERS_DIR

@@ -12,7 +12,7 @@ import pytest
 
 from paths import MASTER_FIXTURES
 import system_ssp
-from system_ssp.apps.flatten import flatten_system_parameters
+from system_ssp.tools.flatten import flatten_system_parameters
 
 SYSTEMS = ["detumble", "slew", "air_bearing", "acs_modes", "attitude_determination", "deorbit", "deorbit_lifetime",
            "sun_avoidance_slew", "sun_eclipse", "sunline", "neighbor_mission", "neighbor_mission_lifetime"]

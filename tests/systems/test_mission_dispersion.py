@@ -11,8 +11,8 @@ from pathlib import Path
 import pytest
 
 from components.core.constants import YEAR
-from system_ssp.apps.campaign import load_spec, run_campaign
-from system_ssp.apps.campaign.runner import _read_rows
+from system_ssp.tools.campaign import load_spec, run_campaign
+from system_ssp.tools.campaign.runner import _read_rows
 
 SPEC = Path(__file__).resolve().parents[2] / "examples" / "campaigns" / "mission_dispersion_420km.toml"
 RUNS = 10

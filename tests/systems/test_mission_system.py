@@ -11,8 +11,8 @@ import pytest
 
 from paths import REPO
 from system_ssp import SimulationError, SSPError, System, cli
-from system_ssp.apps import mission
-from system_ssp.apps.validation import assert_reproduces
+from system_ssp.neighbor import mission
+from system_ssp.neighbor.validation import assert_reproduces
 from system_ssp.systems import PARAMETERS_DIR
 
 THESIS = mission.THESIS["420km"]

@@ -8,8 +8,8 @@ import pytest
 
 from paths import REPO
 from system_ssp import cli
-from system_ssp.apps import mission, propulsion_report, validation
-from system_ssp.apps.validation import assert_reproduces
+from system_ssp.neighbor import mission, propulsion_report, validation
+from system_ssp.neighbor.validation import assert_reproduces
 
 
 def test_worst_case_budget_reproduces_section_339(thesis_cases, mission_420km):

@@ -12,7 +12,7 @@ import pytest
 from components.core.constants import YEAR
 from paths import REPO
 import system_ssp
-from system_ssp.apps.replace import ReplaceRefused, replace_component
+from system_ssp.tools.replace import ReplaceRefused, replace_component
 from system_ssp.ssp.interface import FmuInterface, compare, describe_fmu
 from system_ssp.systems import PARAMETERS_DIR
 

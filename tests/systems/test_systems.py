@@ -10,8 +10,8 @@ import pytest
 
 from paths import REPO
 import system_ssp
-from system_ssp.apps import thesis
-from system_ssp.apps.validation import assert_reproduces
+from system_ssp.neighbor import thesis
+from system_ssp.neighbor.validation import assert_reproduces
 
 
 @pytest.fixture(scope="module")

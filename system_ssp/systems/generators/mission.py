@@ -47,7 +47,7 @@ deployed at the altitude from which it decays to the scenario altitude by then (
 the orbit-averaged model and the same Jacchia-Roberts atmosphere and space weather), and the
 heartbeat lost 5 years after deployment. The burn spends the scenario's Eq. 2-3 propellant.
 
-Guidance, navigation and control come in three sets (system_ssp.apps.mission.GNC picks one after
+Guidance, navigation and control come in three sets (system_ssp.neighbor.mission.GNC picks one after
 the scenario's parameter set):
   closed-loop  (the system's own bindings) the orbit thrusts along the body's thrust axis, the
                guidance FMU computes the burn attitude and its rate from the orbit's r and v, the

@@ -2,7 +2,7 @@
 the sunline-ephemeris FMU, with fixed Sun and spacecraft positions.
 
     python -c "import build_fmus; from pathlib import Path; [build_fmus.build_fmu(Path(s), Path('build/fmus'))
-               for s in ('fmus/neighbor_rigid_body.py', 'fmus/neighbor_sunline.py')]"
+               for s in ('fmus/neighbor_rigid_body.py', 'fmus/neighbor_sunline_ephemeris.py')]"
     python system_ssp/systems/generate_sunline.py
 
 Parameter files (system_ssp/systems/parameters/):

@@ -256,7 +256,8 @@ def sas_build(tmp_path_factory):
 
     d = tmp_path_factory.mktemp("sas_fmus")
     fmus = {Path(s).stem: build_fmus.build_fmu(REPO / "fmus" / f"{s}.py", d)
-            for s in ("neighbor_sas_guidance", "neighbor_reference_tracking", "neighbor_rigid_body")}
+            for s in ("neighbor_sun_avoidance_guidance", "neighbor_reference_tracking_controller",
+                      "neighbor_rigid_body")}
     ssp = build_fmus.pack_ssp(REPO / "system_ssp" / "systems" / "sun_avoidance_slew.ssd", d, d)
     return fmus, ssp
 
@@ -268,18 +269,18 @@ def test_fmus_validate_and_simulate_alone(sas_build):
     fmus, _ = sas_build
     for path in fmus.values():
         assert validate_fmu(str(path)) == []
-    md = fmpy.read_model_description(str(fmus["neighbor_sas_guidance"]))
+    md = fmpy.read_model_description(str(fmus["neighbor_sun_avoidance_guidance"]))
     assert md.outputs and all(not u.dependencies for u in md.outputs)  # time-only outputs
     params = {f"sun_N[{i}]": v for i, v in enumerate(gen.sun_near(), 1)}
     params.update({f"q_f[{i}]": v for i, v in enumerate(gen.Q_F, 1)})
-    res = fmpy.simulate_fmu(str(fmus["neighbor_sas_guidance"]), stop_time=140.0, output_interval=0.1,
+    res = fmpy.simulate_fmu(str(fmus["neighbor_sun_avoidance_guidance"]), stop_time=140.0, output_interval=0.1,
                             start_values=params, output=["done", "duration", "segment_count", "sun_angle",
                                                          "q_ref_BN[1]", "q_ref_BN[2]", "q_ref_BN[3]", "q_ref_BN[4]"])
     g = plan(gen.sun_near())
     assert res["duration"][-1] == pytest.approx(g.duration) and res["segment_count"][-1] == 3
     assert res["done"][-1] and not res["done"][0] and res["sun_angle"].min() >= EPS
     assert q_close([res[f"q_ref_BN[{i}]"][-1] for i in range(1, 5)], gen.Q_F) < 1e-12
-    res = fmpy.simulate_fmu(str(fmus["neighbor_reference_tracking"]), stop_time=1.0, output_interval=0.5,
+    res = fmpy.simulate_fmu(str(fmus["neighbor_reference_tracking_controller"]), stop_time=1.0, output_interval=0.5,
                             start_values={"q_BN[1]": 0.1, "q_BN[4]": 1.0, "guidance_done": True})
     assert res["torque_cmd_B[1]"][-1] < 0 and not res["done"][-1]
 
@@ -291,7 +292,7 @@ def test_guidance_fmu_state_restore(sas_build):
     from fmpy.fmi2 import FMU2Slave
 
     fmus, _ = sas_build
-    path = str(fmus["neighbor_sas_guidance"])
+    path = str(fmus["neighbor_sun_avoidance_guidance"])
     md = fmpy.read_model_description(path)
     vr = {v.name: v.valueReference for v in md.modelVariables}
     unz = fmpy.extract(path)

@@ -150,7 +150,7 @@ def test_bad_parameters_are_clear_errors(kwargs, match):
 
 # ---- FMU ------------------------------------------------------------------------------------
 def test_fmu_declarations(build_one):
-    deps = check_declarations(build_one("neighbor_tracking.py"))
+    deps = check_declarations(build_one("neighbor_tracking_controller.py"))
     q_in = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
     w_in = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
     target = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
@@ -165,7 +165,7 @@ def test_fmu_closed_loop_with_rigid_body_matches_component(build_one, tmp_path):
     """Tracking FMU and RigidBody FMU (euler), 15 ms steps, wired like the slew controller
     (thrusters' rounding passes the quantized command unchanged): bit-identical to the
     component loop; then disabling releases q_d and get/set FMU state restores it."""
-    trk, tv = instantiate(build_one("neighbor_tracking.py"), tmp_path, "tracking")
+    trk, tv = instantiate(build_one("neighbor_tracking_controller.py"), tmp_path, "tracking")
     body, bv = instantiate(build_one("neighbor_rigid_body.py"), tmp_path, "dynamics")
     q_out = [bv[f"q_BN[{i}]"] for i in (1, 2, 3, 4)]
     w_out = [bv[f"omega_BN_B[{i}]"] for i in (1, 2, 3)]
@@ -230,7 +230,7 @@ def test_fmu_rejects_bad_gain(build_one):
     import fmpy
     from fmpy.fmi1 import FMICallException
 
-    path = str(build_one("neighbor_tracking.py"))
+    path = str(build_one("neighbor_tracking_controller.py"))
     for start, words in [({"G[2]": -0.1}, ["G (diagonal", "-0.1", "positive"]),
                          ({"e[3]": 0.0}, ["saturation thresholds", "positive"]),
                          ({"k": 0.0}, ["k = 0.0", "positive"])]:

@@ -161,7 +161,7 @@ def test_state_round_trip():
 
 # ---- FMU ------------------------------------------------------------------------------------
 def test_data_storage_fmu(build_one, tmp_path):
-    path = build_one("neighbor_data.py")
+    path = build_one("neighbor_data_storage.py")
     deps = check_declarations(path)
     assert deps == {"storage_used": [], "storage_free": [], "bytes_lost": [], "overflow": [], "downlinked": []}
     md = fmpy.read_model_description(str(path))

@@ -161,7 +161,7 @@ def test_ground_command_and_parameters():
 
 
 def test_ground_station_fmu(build_one, tmp_path):
-    path = build_one("neighbor_ground.py")
+    path = build_one("neighbor_ground_station.py")
     deps = check_declarations(path)
     r = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
     assert deps == {name: r for name in ("visible", "elevation", "azimuth", "range", "near_contact", "ground_command")}

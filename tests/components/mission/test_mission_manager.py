@@ -342,7 +342,7 @@ def test_host_schedule():
 
 # ---- FMUs -----------------------------------------------------------------------------------
 def test_host_fmu(build_one, tmp_path):
-    path = build_one("neighbor_host.py")
+    path = build_one("neighbor_host_spacecraft.py")
     assert check_declarations(path) == {"heartbeat": [], "next_event_time": []}
     fmu, vr = instantiate(path, tmp_path, "host")
     fmu.setReal([vr["heartbeat_loss_time"]], [50.0])
@@ -365,7 +365,7 @@ def test_host_fmu(build_one, tmp_path):
 
 
 def test_mission_fmu(build_one, tmp_path):
-    path = build_one("neighbor_mission.py")
+    path = build_one("neighbor_mission_manager.py")
     deps = check_declarations(path)
     assert set(deps) == {"mode", "phase", "end_reason", "next_event_time", "time_in_mode", "time_in_phase",
                          "detumble_timeouts", "slew_timeouts", "determination_timeouts", *LOAD_NAMES, *mm.COMMANDS}

@@ -8,7 +8,7 @@ import pytest
 from components.core import constants
 from components.orbit import propulsion as p
 from fmu_helpers import check_declarations, instantiate
-from system_ssp.apps.validation import assert_reproduces
+from system_ssp.neighbor.validation import assert_reproduces
 
 REL = 0.005  # the brief's 0.5 %
 

@@ -305,7 +305,7 @@ def ab_fmus(tmp_path_factory):
     import build_fmus
 
     d = tmp_path_factory.mktemp("air_bearing_fmus")
-    for script in ("neighbor_air_bearing.py", "neighbor_attitude_to_dcm.py", "neighbor_rigid_body.py"):
+    for script in ("neighbor_air_bearing_kinematics.py", "neighbor_attitude_to_dcm.py", "neighbor_rigid_body.py"):
         build_fmus.build_fmu(REPO / "fmus" / script, d)
     return d
 

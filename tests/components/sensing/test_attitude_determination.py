@@ -18,7 +18,7 @@ from paths import REPO
 import system_ssp
 
 WRAPPERS = {"HorizonSensor": "neighbor_horizon_sensor", "SunSensor": "neighbor_sun_sensor", "Gyro": "neighbor_gyro",
-            "GpsReceiver": "neighbor_gps", "AttitudeDetermination": "neighbor_attitude_determination"}
+            "GpsReceiver": "neighbor_gps_receiver", "AttitudeDetermination": "neighbor_attitude_determination"}
 SSD = REPO / "system_ssp" / "systems" / "attitude_determination.ssd"
 DEG = math.pi / 180.0
 R_LEO = (6798137.0, 0.0, 0.0)

@@ -38,8 +38,8 @@ from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import (DEFAULT_SSP_DIR, add_console_arguments, console_settings, deorbit_study, parse_sets, propulsion_report,
-               staged_results, thesis)
+from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
+from . import deorbit_study, propulsion_report, thesis
 
 SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
 # the parameter set each applies: the closed loop on the estimator (the system's own values), on
@@ -483,7 +483,7 @@ def main(argv=None):
 
 
 def main_propulsion(argv=None):
-    """`neighbor-cosim propulsion` (system_ssp.apps.propulsion_report): the budget of the worst
+    """`neighbor-cosim propulsion` (system_ssp.neighbor.propulsion_report): the budget of the worst
     case and of a mission run, read from --mission or run here."""
     ap = argparse.ArgumentParser(prog="neighbor-cosim propulsion",
                                  description=propulsion_report.__doc__.split("\n\n")[0])

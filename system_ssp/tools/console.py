@@ -1,6 +1,6 @@
-"""The product's applications on top of the master: the thesis validation cases (`thesis`), the
-de-orbit lifetime study (`deorbit_study`) and the NEIGHBOR mission (`mission`). Each has a
-`main(argv)` behind a subcommand of `neighbor-cosim` / `python -m system_ssp`."""
+"""What every command shares, the generic tools and the NEIGHBOR application alike: the console
+options (--progress/--quiet, --log-level), a results folder written as one unit, --set parsing,
+and where `python build_fmus.py` packs the systems."""
 from contextlib import contextmanager
 import logging
 from pathlib import Path

@@ -3,7 +3,7 @@ and the propulsion assembly mass (section 3.3.9, Appendix H), from simulated man
 
     neighbor-cosim propulsion [--scenario 420km] [--mission results/mission/summary.json]
 
-The command lives in system_ssp.apps.mission (`main_propulsion`), as it may run the mission.
+The command lives in system_ssp.neighbor.mission (`main_propulsion`), as it may run the mission.
 Two columns beside the thesis':
 - **worst case**: the thesis' sizing rule (section 3.3.9: detumble + the worst-case slew, case
   3's three 180 deg rotations, + attitude control during the burn, + the burn), with detumble
@@ -17,7 +17,8 @@ the thesis column is empty for the others.
 from components.orbit import propulsion
 
 from ..errors import SSPError
-from . import DEFAULT_SSP_DIR, thesis
+from ..tools.console import DEFAULT_SSP_DIR
+from . import thesis
 
 # Section 3.2, 3.3.9, Appendix H, Table 4 (420 km scenario; display units as printed).
 THESIS = {"delta_v_m_s": 19.84, "burn_propellant_kg": 0.564, "detumble_propellant_g": 2.36,

@@ -21,8 +21,8 @@ import sys
 
 from ..atomic import write_text_atomic
 from ..errors import SSPError
-from . import (DEFAULT_SSP_DIR, add_console_arguments, console_settings, deorbit_study, mission, propulsion_report,
-               thesis)
+from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from . import deorbit_study, mission, propulsion_report, thesis
 
 
 @dataclass(frozen=True)

@@ -32,7 +32,7 @@ from ..atomic import atomic_write, write_text_atomic
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import System, write_result
 from ..systems import PARAMETERS_DIR
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
+from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
 
 KM = 1000.0
 SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}

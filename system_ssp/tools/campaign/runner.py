@@ -31,7 +31,7 @@ import numpy as np
 from ... import __version__
 from ...atomic import atomic_write, write_text_atomic
 from ...errors import SSPError
-from .. import add_console_arguments, console_settings
+from ..console import add_console_arguments, console_settings
 from .spec import load_spec
 from .worker import run_batch
 

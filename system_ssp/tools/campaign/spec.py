@@ -13,7 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
-from .. import DEFAULT_SSP_DIR
+from ..console import DEFAULT_SSP_DIR
 
 if sys.version_info >= (3, 11):
     import tomllib

@@ -24,7 +24,7 @@ from pathlib import Path
 from components.core import rotations
 
 from ..master import System
-from . import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
