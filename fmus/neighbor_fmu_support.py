@@ -23,6 +23,8 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.fmi2slave import Fmi2Slave
 from pythonfmu.variables import Boolean, Integer, Real, String
 
+from components.mission.neighbor import SPACECRAFT
+
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
 Scalar = Union[float, int, bool, str]
 
@@ -175,10 +177,10 @@ class NeighborSlave(Fmi2Slave):
     def inertia_parameters(self, mass_description):
         """The spacecraft inertia parameters shared by RigidBody and the controllers that use
         the inertia: mass and box edges (Eq. 4) or a full tensor inertia_B[i,j]."""
-        self.parameter("mass", 12.0, "kg", mass_description)
-        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
-        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
-        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
+        self.parameter("mass", SPACECRAFT.mass, "kg", mass_description)
+        self.parameter("edge_a", SPACECRAFT.edge_a, "m", "Box edge a along body y (Appendix A a = 0.1 m)")
+        self.parameter("edge_b", SPACECRAFT.edge_b, "m", "Box edge b along body z (Appendix A b = 0.2 m)")
+        self.parameter("edge_c", SPACECRAFT.edge_c, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
         self.parameter("inertia_from_box", True, None,
                        "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
         for i in range(1, 4):

@@ -6,6 +6,9 @@ file (build_fmus.py bundles what a wrapper imports)."""
 import math
 import os
 
+from components.mission.neighbor import SPACECRAFT
+
+
 def orbit_interface(slave, default_sma, mu, epoch, mean):
     """Parameters and inputs every orbit FMU shares (the Orbit / OrbitAveraged connector
     contract), so that a system swaps one for the other by replacing a component. `mean`:
@@ -29,8 +32,8 @@ def orbit_interface(slave, default_sma, mu, epoch, mean):
     slave.parameter_array("r0_N", [a, 0.0, 0.0], "m", "Initial position in N, used when cartesian0 is true")
     slave.parameter_array("v0_N", [0.0, v * math.cos(math.radians(51.6)), v * math.sin(math.radians(51.6))], "m/s",
                           "Initial velocity in N, used when cartesian0 is true (must give a closed orbit)")
-    slave.parameter("Cd", 2.2, "1", "Drag coefficient (> 0, <= 10; thesis Table 2: 2.2)")
-    slave.parameter("area", 0.02, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
+    slave.parameter("Cd", SPACECRAFT.Cd, "1", "Drag coefficient (> 0, <= 10; thesis Table 2: 2.2)")
+    slave.parameter("area", SPACECRAFT.drag_area, "m2", "Drag area facing the flow (> 0; thesis Table 2: 0.02 m2)")
     slave.parameter("reentry_altitude", 250e3, "m", "Re-entry altitude (thesis: 250 km), compared with the "
                     + ("mean perigee altitude" if mean else "geodetic altitude") + "; an initial perigee "
                     "altitude sma0 (1 - ecc0) - 6378136.3 m below it is an error")
@@ -43,7 +46,7 @@ def orbit_interface(slave, default_sma, mu, epoch, mean):
     slave.input("retrograde", False, None,
                 "When true the thrust acts along -v (velocity relative to N) with magnitude |F_thrust_B|, "
                 "ignoring q_BN", bool)
-    slave.input("mass", 12.0, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
+    slave.input("mass", SPACECRAFT.mass, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
 
 
 # ---- atmosphere parameters shared by the Atmosphere, Orbit and OrbitAveraged FMUs ------------

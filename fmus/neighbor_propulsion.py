@@ -12,9 +12,12 @@ communication point. The orbit FMUs take `mass` and `F_thrust_B` as inputs.
 """
 from neighbor_fmu_support import NeighborSlave
 
+from components.mission.neighbor import DEFAULT_SCENARIO, SCENARIOS
 from components.orbit import propulsion
 
-_DEFAULT_BUDGET = propulsion.deorbit_scenario(420e3, 350e3)["propellant"]
+_KM = 1000.0
+_DEFAULT_BUDGET = propulsion.deorbit_scenario(SCENARIOS[DEFAULT_SCENARIO].altitude_km * _KM,
+                                              SCENARIOS[DEFAULT_SCENARIO].target_perigee_km * _KM)["propellant"]
 
 
 class Propulsion(NeighborSlave):

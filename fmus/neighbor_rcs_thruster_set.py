@@ -12,6 +12,7 @@ adds the axial thrusters' torque, a disturbance when they are misaligned.
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import thruster_set
+from components.mission.neighbor import SPACECRAFT
 
 CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
 N = 16
@@ -24,11 +25,13 @@ class RcsThrusterSet(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.parameter("thrust", 0.025, "N", "Nominal force of one RCS thruster (25 mN)")
-        self.parameter("edge_a", 0.1, "m", "Edge a of the host: the module's side, x-pair spacing (Eq. 16)")
-        self.parameter("edge_c", 0.3, "m", "Edge c of the host along x: the y/z pairs' arms c/2, c/2 - c/3 (Eq. 16)")
-        self.parameter("Isp", 42.0, "s", "Specific impulse of the thrusters")
-        self.parameter("g0", 9.81, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
+        self.parameter("thrust", SPACECRAFT.rcs_thrust, "N", "Nominal force of one RCS thruster (25 mN)")
+        self.parameter("edge_a", SPACECRAFT.edge_a, "m",
+                       "Edge a of the host: the module's side, x-pair spacing (Eq. 16)")
+        self.parameter("edge_c", SPACECRAFT.edge_c, "m",
+                       "Edge c of the host along x: the y/z pairs' arms c/2, c/2 - c/3 (Eq. 16)")
+        self.parameter("Isp", SPACECRAFT.isp, "s", "Specific impulse of the thrusters")
+        self.parameter("g0", SPACECRAFT.g0, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
         self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
         self.output_array("torque_B", 3, lambda: self.feedthrough(self._force_torque)[1], "N.m",
                           "Torque of the firing thrusters, sum of l x F (Eq. 13)",

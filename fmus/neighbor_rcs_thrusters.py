@@ -7,6 +7,7 @@ accumulated over the steps (states).
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import thrusters
+from components.mission.neighbor import SPACECRAFT
 
 CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
 
@@ -18,10 +19,10 @@ class RcsThrusters(NeighborSlave):
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
         self.parameter("thrust", thrusters.tc.F_THRUSTER, "N", "Force of one RCS thruster (25 mN)")
-        self.parameter("edge_a", 0.1, "m", "Edge a of the host (x-axis pair lever arm a/2, Eq. 16)")
-        self.parameter("edge_c", 0.3, "m", "Edge c of the host (y/z-axis pair lever arms, Eq. 16)")
-        self.parameter("Isp", 42.0, "s", "Specific impulse of the thrusters")
-        self.parameter("g0", 9.81, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
+        self.parameter("edge_a", SPACECRAFT.edge_a, "m", "Edge a of the host (x-axis pair lever arm a/2, Eq. 16)")
+        self.parameter("edge_c", SPACECRAFT.edge_c, "m", "Edge c of the host (y/z-axis pair lever arms, Eq. 16)")
+        self.parameter("Isp", SPACECRAFT.isp, "s", "Specific impulse of the thrusters")
+        self.parameter("g0", SPACECRAFT.g0, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
         self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
 
         self.output_array("torque_B", 3, lambda: self.feedthrough(self._applied), "N.m",

@@ -13,6 +13,7 @@ import math
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import rigid_body, sun_avoidance
+from components.mission.neighbor import SPACECRAFT
 
 MAX_SEGMENTS = 3
 
@@ -39,10 +40,11 @@ class SunAvoidanceGuidance(NeighborSlave):
         self.input_array("q_BN", [0.0] * 4, "1",
                          "Spacecraft attitude q_BN, scalar last (connect to the dynamics): must equal q0 at the "
                          "start; all zeros (not connected) skips the check")
-        self.parameter("mass", 12.0, "kg", "Spacecraft mass for the box inertia of the feed-forward torque (Eq. 4)")
-        self.parameter("edge_a", 0.1, "m", "Box edge a along body y (Ix uses a, b; Iz uses a, c)")
-        self.parameter("edge_b", 0.2, "m", "Box edge b along body z (Ix uses a, b; Iy uses b, c)")
-        self.parameter("edge_c", 0.3, "m", "Box edge c along body x (Iy uses b, c; Iz uses a, c)")
+        self.parameter("mass", SPACECRAFT.mass, "kg",
+                       "Spacecraft mass for the box inertia of the feed-forward torque (Eq. 4)")
+        self.parameter("edge_a", SPACECRAFT.edge_a, "m", "Box edge a along body y (Ix uses a, b; Iz uses a, c)")
+        self.parameter("edge_b", SPACECRAFT.edge_b, "m", "Box edge b along body z (Ix uses a, b; Iy uses b, c)")
+        self.parameter("edge_c", SPACECRAFT.edge_c, "m", "Box edge c along body x (Iy uses b, c; Iz uses a, c)")
 
         ref = self._reference  # cached per (model, time); outputs depend on time only
         self.output_array("q_ref_BN", 4, lambda: ref()["q"], "1", "Reference attitude quaternion q_BN, scalar last")

@@ -6,10 +6,12 @@ the pair torque), a smaller command fires nothing (Appendix C, every controller)
 """
 import math
 
-F_THRUSTER = 0.025  # N, one cold-gas RCS thruster (MarCO heritage, Appendix A)
+from ..mission.neighbor import SPACECRAFT
+
+F_THRUSTER = SPACECRAFT.rcs_thrust  # N, one cold-gas RCS thruster (MarCO heritage, Appendix A)
 
 
-def pair_torques(force=F_THRUSTER, a=0.1, c=0.3):
+def pair_torques(force=F_THRUSTER, a=SPACECRAFT.edge_a, c=SPACECRAFT.edge_c):
     """Torque of one thruster pair about x, y, z (Eq. 16, Appendix A `Lx`, `Ly`, `Lz`).
 
     x: two thrusters at +-a/2 from the axis;  y and z: one thruster at c/2 and one at

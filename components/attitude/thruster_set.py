@@ -27,6 +27,7 @@ per thruster; with nominal forces, 2 F t per pair as the thesis counts it).
 import math
 
 from ..core import checks, rotations
+from ..mission.neighbor import SPACECRAFT
 from . import thruster_control as tc
 
 AXES = ("x", "y", "z")
@@ -79,7 +80,8 @@ class ThrusterSet:
     0.02 = 2 % strong); misalignment: per-thruster pair of small angles (rad); min_on_time (s);
     isp, g0 for the propellant. Commands are -1/0/+1 per axis (the controllers' thrust flags)."""
 
-    def __init__(self, force=0.025, a=0.1, c=0.3, isp=42.0, g0=9.81, min_on_time=0.0, force_error=None,
+    def __init__(self, force=SPACECRAFT.rcs_thrust, a=SPACECRAFT.edge_a, c=SPACECRAFT.edge_c, isp=SPACECRAFT.isp,
+                 g0=SPACECRAFT.g0, min_on_time=0.0, force_error=None,
                  misalignment=None):
         self.layout = thesis_layout(a, c)
         n = len(self.layout)

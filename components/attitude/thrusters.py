@@ -11,11 +11,13 @@ where t_fire is summed over the three axes (the scripts add dt once per firing a
 """
 import math
 
+from ..mission.neighbor import SPACECRAFT
 from . import thruster_control as tc
 
 
 class ThrusterPairs:
-    def __init__(self, force=tc.F_THRUSTER, a=0.1, c=0.3, isp=42.0, g0=9.81):
+    def __init__(self, force=tc.F_THRUSTER, a=SPACECRAFT.edge_a, c=SPACECRAFT.edge_c, isp=SPACECRAFT.isp,
+                 g0=SPACECRAFT.g0):
         self.levels = tc.pair_torques(force, a, c)
         for name, value in (("Isp", isp), ("g0", g0)):
             if not (math.isfinite(value) and value > 0):

@@ -65,6 +65,7 @@ from ..core.jit import njit
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
 
 from ..environment import geodesy
+from ..mission.neighbor import SPACECRAFT
 from . import elements
 from ..core import time_utils
 
@@ -290,7 +291,8 @@ class OrbitAveraged:
     Time t is seconds since `epoch`; advance_to(t, ...) integrates to t exactly."""
 
     def __init__(self, density_model, epoch=time_utils.DEFAULT_EPOCH, sma0=R_EQ + 420e3, ecc0=0.0,
-                 inc0=math.radians(51.6), raan0=0.0, argp0=0.0, ta0=0.0, Cd=2.2, area=0.02,
+                 inc0=math.radians(51.6), raan0=0.0, argp0=0.0, ta0=0.0, Cd=SPACECRAFT.Cd,
+                 area=SPACECRAFT.drag_area,
                  reentry_altitude=250e3, mu=MU_EARTH, j2=J2, r_eq=R_EQ, omega_atm=OMEGA_EARTH,
                  quadrature_nodes=16, max_step=DAY, max_da_step=1000.0, thrust_step=10.0, t0=0.0):
         self.jd_epoch = time_utils.julian_date(epoch)  # validates the epoch string
@@ -420,7 +422,7 @@ class OrbitAveraged:
     def _perigee_margin(self, y):
         return y[0] * (1.0 - math.hypot(y[1], y[2])) - R_EQ - self.reentry_altitude
 
-    def thrust_acceleration(self, F_thrust_B, q_BN=(0.0, 0.0, 0.0, 1.0), retrograde=False, mass=12.0):
+    def thrust_acceleration(self, F_thrust_B, q_BN=(0.0, 0.0, 0.0, 1.0), retrograde=False, mass=SPACECRAFT.mass):
         """None when the thrust is zero, else (f_N m/s^2, retro magnitude m/s^2) for _thrust_rates."""
         F = np.array([float(x) for x in F_thrust_B])
         if F.shape != (3,) or not np.all(np.isfinite(F)):
@@ -433,7 +435,7 @@ class OrbitAveraged:
         return quaternion_to_dcm(q_BN).T @ F / mass, 0.0
 
     def advance_to(self, t_end, F_thrust_B=(0.0, 0.0, 0.0), q_BN=(0.0, 0.0, 0.0, 1.0), retrograde=False,
-                   mass=12.0):
+                   mass=SPACECRAFT.mass):
         """Integrate to t_end (s since the epoch) with the inputs held; stops integrating at
         re-entry (the clock still moves to t_end)."""
         t_end = time_utils.check_time(t_end, "time")

@@ -44,6 +44,7 @@ from ..environment import atmosphere, geodesy
 from ..core.checks import positive
 from ..environment.gravity import accel_zonal, zonal_coefficients
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
+from ..mission.neighbor import SPACECRAFT
 from . import dop853
 from .elements import kepler_to_cartesian, osculating_ecc, osculating_sma
 
@@ -219,7 +220,8 @@ class CowellOrbit:
     t0: simulation time (s since `epoch`) of the initial elements."""
 
     def __init__(self, epoch=time_utils.DEFAULT_EPOCH, sma0=R_EQ + 420e3, ecc0=0.0, inc0=math.radians(51.6),
-                 raan0=0.0, argp0=0.0, ta0=0.0, Cd=2.2, area=0.02, mass=12.0, reentry_altitude=250e3,
+                 raan0=0.0, argp0=0.0, ta0=0.0, Cd=SPACECRAFT.Cd, area=SPACECRAFT.drag_area,
+                 mass=SPACECRAFT.mass, reentry_altitude=250e3,
                  density_model=None, drag=True, zonal_degree=6, mu=MU_EARTH, t0=0.0, space_weather=None,
                  rtol=RTOL, atol_position=ATOL_POSITION, atol_velocity=ATOL_VELOCITY):
         self.epoch = epoch

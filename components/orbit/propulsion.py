@@ -37,12 +37,14 @@ import math
 from ..core import checks
 from ..core.constants import MU_EARTH, R_EQ
 from ..core.checks import positive
+from ..mission.neighbor import SPACECRAFT
 
-G0 = 9.81  # m/s^2, thesis Eq. 3
-ISP = 42.0  # s, thesis Section 3.2 (MarCO thruster)
-THRUST_PER_THRUSTER = 0.025  # N
-N_THRUSTERS = 4  # de-orbit thrusters fired together (0.1 N)
-MASS0 = 12.0  # kg, host spacecraft total mass (Table 2)
+# The spacecraft's values, from the mission definition (components.mission.neighbor)
+G0 = SPACECRAFT.g0  # m/s^2, thesis Eq. 3
+ISP = SPACECRAFT.isp  # s, thesis Section 3.2 (MarCO thruster)
+THRUST_PER_THRUSTER = SPACECRAFT.deorbit_thrust_per_thruster  # N
+N_THRUSTERS = SPACECRAFT.n_deorbit_thrusters  # de-orbit thrusters fired together (0.1 N)
+MASS0 = SPACECRAFT.mass  # kg, host spacecraft total mass (Table 2)
 
 # Appendix H constants
 R_GAS = 8.314  # J/(K mol)

@@ -27,6 +27,7 @@ from components.environment import space_weather
 from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
+from components.mission.neighbor import DEORBIT_RECORD, DEORBIT_SYSTEMS, SCENARIOS, scenario_set
 
 from ..atomic import atomic_write, write_text_atomic
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
@@ -35,24 +36,17 @@ from ..systems import PARAMETERS_DIR
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
 
 KM = 1000.0
-SYSTEMS = {"averaged": "deorbit_lifetime", "cowell": "deorbit"}
-# Section 3.2: (initial altitude km, target perigee km, delta-V m/s, propellant kg, burn min,
-# lifetime without / with NEIGHBOR in years)
-THESIS = {"420km": dict(h0=420.0, target=350.0, delta_v=19.84, propellant=0.564, burn_min=38.74,
-                        life_no_burn=4.38, life_burn=2.20, figure=11),
-          "475km": dict(h0=475.0, target=350.0, delta_v=35.18, propellant=0.982, burn_min=67.42,
-                        life_no_burn=25.04, life_burn=3.44, figure=12),
-          "525km": dict(h0=525.0, target=300.0, delta_v=63.21, propellant=1.707, burn_min=117.20,
-                        life_no_burn=97.41, life_burn=3.19, figure=13)}
+SYSTEMS = DEORBIT_SYSTEMS
+# Section 3.2 per scenario, from the mission definition: initial altitude and target perigee (km),
+# delta-V (m/s), propellant (kg), burn (min), lifetime without / with NEIGHBOR (years), figure
+THESIS = {name: dict(h0=s.altitude_km, target=s.target_perigee_km, **s.thesis) for name, s in SCENARIOS.items()}
 # `--space-weather thesis`: a stand-in for the thesis' space-weather file (docs/models/orbit.md,
 # "Lifetimes"): the bundled history to the scenarios' start, then the solar-cycle-25 maximum at the
 # level the predictions of the time gave (130 sfu, ap 9) and, from 2030, the solar-minimum entry a
 # file of that time ended with and FreeFlyer held for ever after (75 sfu, ap 7).
 THESIS_SPACE_WEATHER = (("2023-01-01", 130.0, 9), ("2030-01-01", 75.0, 7))
 THESIS_SPACE_WEATHER_FILE = "space_weather_thesis.txt"
-RECORD = ["orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",
-          "orbit.reentered", "orbit.density", "propulsion.mass", "propulsion.propellant_used",
-          "propulsion.burn_time", "propulsion.burning"]
+RECORD = list(DEORBIT_RECORD)
 
 
 def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_dir=DEFAULT_SSP_DIR, out=None,
@@ -93,7 +87,7 @@ def _run_all(ssp, scenarios, model, density, overrides, max_years, progress, out
         for name in scenarios:
             for burn in (True, False):
                 run = name + ("" if burn else "_no_burn")
-                ssv = PARAMETERS_DIR / f"deorbit_{run}.ssv"
+                ssv = PARAMETERS_DIR / f"{scenario_set(DEORBIT_SYSTEMS['cowell'], name, burn)}.ssv"
                 try:
                     r = system.run(stop_time=max_years * YEAR, parameter_sets=[str(ssv)], parameters=overrides,
                                    outputs=RECORD, progress=progress)

@@ -33,6 +33,8 @@ import numpy as np
 
 from components.core.constants import DAY, MU_EARTH, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
+from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS, MISSION_RECORD, MISSION_SYSTEMS,
+                                         SCENARIOS as DEFINED_SCENARIOS, scenario_set)
 
 from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
@@ -41,11 +43,11 @@ from ..systems import PARAMETERS_DIR
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
 from . import deorbit_study, propulsion_report, thesis
 
-SYSTEMS = {"cowell": "neighbor_mission", "averaged": "neighbor_mission_lifetime"}
+SYSTEMS = MISSION_SYSTEMS
 # the parameter set each applies: the closed loop on the estimator (the system's own values), on
 # the true state (truth feedback), and the thesis' guidance and control (its numbers)
-GNC = {"closed-loop": None, "closed-loop-truth": "mission_gnc_truth.ssv", "thesis": "mission_gnc_thesis.ssv"}
-SCENARIOS = ("420km", "475km", "525km")
+GNC = GNC_SETS
+SCENARIOS = tuple(DEFINED_SCENARIOS)
 WH = 3600.0
 # Thesis figures per scenario. Every scenario: the attitude validation cases the mission's
 # detumble and slew are (section 3.3.5-3.3.6) and the section 3.2 burn and lifetime; 420 km also the
@@ -59,25 +61,15 @@ _ATTITUDE = {"detumble_time_s": thesis.THESIS["detumble_case1"]["duration"],
 THESIS = {name: {**_ATTITUDE, "burn_time_min": ref["burn_min"], "burn_propellant_kg": ref["propellant"],
                  "lifetime_with_burn_years": ref["life_burn"]} for name, ref in deorbit_study.THESIS.items()}
 # section 3.3.9 (sized for 420 km), 3.5 and 3.6
-THESIS["420km"].update(tracking_propellant_g=propulsion_report.THESIS["tracking_propellant_g"],
+THESIS[DEFAULT_SCENARIO].update(tracking_propellant_g=propulsion_report.THESIS["tracking_propellant_g"],
                        total_propellant_kg=propulsion_report.THESIS["total_propellant_kg"],
                        soc_after_burn_percent=79.65, energy_used_Wh=2.2, energy_left_Wh=8.6,
                        battery_empty_days_after_burn=14.0, max_storage_MB=0.1, contacts_to_downlink=2)
-RECORD = (["mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
-           "mission.determination_timeouts", "estimator.initialized", "estimator.attitude_error",
-           "estimator.rate_error", *[f"estimator.sigma_attitude[{i}]" for i in (1, 2, 3)],
-           "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
-           "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
-           "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
-           "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
-           "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked"]
-          + [f"dynamics.omega_BN_B[{i}]" for i in (1, 2, 3)] + [f"dynamics.euler123[{i}]" for i in (1, 2, 3)]
-          + [f"dynamics.euler_integrated[{i}]" for i in (1, 2, 3)]
-          + [f"dynamics.q_BN[{i}]" for i in (1, 2, 3, 4)])
+RECORD = list(MISSION_RECORD)  # components.mission.neighbor
 
 
-def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
-                parameters=None, profile=False, progress=False, parameter_sets=(), gnc="closed-loop"):
+def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
+                parameters=None, profile=False, progress=False, parameter_sets=(), gnc=DEFAULT_GNC):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
     `gnc` (GNC) picks the guidance and control parameter set, applied after the scenario's;
     `parameter_sets` (files, names component.variable) apply after it and `parameters`
@@ -94,7 +86,8 @@ def run_mission(scenario="420km", orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out
                        "may run before re-entry)")
     if gnc not in GNC:
         raise SSPError(f"unknown guidance and control set {gnc!r} (expected one of: {', '.join(GNC)})")
-    ssv = [PARAMETERS_DIR / f"neighbor_mission_{scenario}.ssv"] + ([PARAMETERS_DIR / GNC[gnc]] if GNC[gnc] else [])
+    ssv = [PARAMETERS_DIR / f"{scenario_set(SYSTEMS['cowell'], scenario)}.ssv"] + (
+        [PARAMETERS_DIR / f"{GNC[gnc]}.ssv"] if GNC[gnc] else [])
     with staged_results(out, lambda err: "timeseries.csv") as staged:
         with System(ssp) as system:
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
@@ -447,9 +440,9 @@ def _plot_estimation(plt, d, s, save, legend):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
+    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO)
     ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
-    ap.add_argument("--gnc", choices=list(GNC), default="closed-loop",
+    ap.add_argument("--gnc", choices=list(GNC), default=DEFAULT_GNC,
                     help="guidance and control: closed-loop (burn attitude from the orbit, thrust along the body "
                          "axis, flight settle criteria, controllers on the attitude estimator; default), "
                          "closed-loop-truth (the same on the true state) or thesis (the thesis' laws on the true "
@@ -487,7 +480,7 @@ def main_propulsion(argv=None):
     case and of a mission run, read from --mission or run here."""
     ap = argparse.ArgumentParser(prog="neighbor-cosim propulsion",
                                  description=propulsion_report.__doc__.split("\n\n")[0])
-    ap.add_argument("--scenario", choices=SCENARIOS, default="420km")
+    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO)
     ap.add_argument("--mission", metavar="SUMMARY_JSON",
                     help="summary.json of a mission run of the scenario (default: run the mission now)")
     ap.add_argument("--gnc", choices=list(GNC), default="thesis",

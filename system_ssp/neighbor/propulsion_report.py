@@ -14,6 +14,7 @@ The mission run is read from --mission (a mission results folder's summary.json)
 (orbit-averaged, about a minute). The thesis sizes its tank for the 420 km scenario only, so
 the thesis column is empty for the others.
 """
+from components.mission.neighbor import DEFAULT_SCENARIO, SCENARIOS
 from components.orbit import propulsion
 
 from ..errors import SSPError
@@ -21,7 +22,8 @@ from ..tools.console import DEFAULT_SSP_DIR
 from . import thesis
 
 # Section 3.2, 3.3.9, Appendix H, Table 4 (420 km scenario; display units as printed).
-THESIS = {"delta_v_m_s": 19.84, "burn_propellant_kg": 0.564, "detumble_propellant_g": 2.36,
+THESIS = {"delta_v_m_s": SCENARIOS[DEFAULT_SCENARIO].thesis["delta_v"],
+          "burn_propellant_kg": SCENARIOS[DEFAULT_SCENARIO].thesis["propellant"], "detumble_propellant_g": 2.36,
           "slew_propellant_g": 16.03, "tracking_propellant_g": 4.75, "rcs_propellant_g": 23.14,
           "total_propellant_kg": 0.587, "moles": 3.86, "volume_cm3": 376.4, "inner_radius_cm": 4.48,
           "wall_thickness_cm": 0.41, "outer_radius_cm": 4.88, "outer_volume_cm3": 488.2, "shell_volume_cm3": 111.8,
@@ -100,7 +102,7 @@ def worst_case(mission_summary, ssp_dir=DEFAULT_SSP_DIR, cases=None):
 
 
 def report(worst, mission_budget, scenario):
-    thesis_col = THESIS if scenario == "420km" else {}
+    thesis_col = THESIS if scenario == DEFAULT_SCENARIO else {}
     lines = [f"Propulsion budget, {scenario} scenario (thesis section 3.3.9, Eq. 75-79, Table 4, Appendix H)",
              "| quantity | worst case (detumble 1 + slew 3 simulated) | this mission | thesis | worst vs thesis |",
              "|---|---|---|---|---|"]

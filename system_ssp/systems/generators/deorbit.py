@@ -29,21 +29,20 @@ Scenario files (names component.variable), one per thesis case, with and without
   scenario's target perigee (350, 350, 300 km). Without the burn, burn_enable stays false
   (the host alone, 12 kg).
 """
-import math
-
-
+from components.mission.neighbor import DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS, SPACECRAFT, \
+    scenario_set
 from components.orbit import propulsion
-from components.core import time_utils
 from components.core.constants import DAY, R_EQ, YEAR
 
 KM = 1000.0
-# (initial altitude, target perigee altitude) in km, thesis Section 3.2
-SCENARIOS = {"420km": (420.0, 350.0), "475km": (475.0, 350.0), "525km": (525.0, 300.0)}
-ORBIT = {"epoch": time_utils.DEFAULT_EPOCH, "sma0": R_EQ + 420.0 * KM, "ecc0": 0.0, "inc0": math.radians(51.6),
-         "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": 2.2, "area": 0.02, "reentry_altitude": 250.0 * KM,
-         "density_model": "jacchia_roberts", "space_weather_file": "", "use_constant_space_weather": False}
+BASE = SCENARIOS[DEFAULT_SCENARIO]  # the component-level files start from it
+ORBIT = {"epoch": HOST_ORBIT.deorbit_epoch, "sma0": R_EQ + BASE.altitude_km * KM, "ecc0": 0.0,
+         "inc0": HOST_ORBIT.inclination, "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": SPACECRAFT.Cd,
+         "area": SPACECRAFT.drag_area, "reentry_altitude": HOST_ORBIT.reentry_altitude_km * KM,
+         "density_model": HOST_ORBIT.density_model, "space_weather_file": "", "use_constant_space_weather": False}
 BURN_STEP = 0.5  # s, thesis Section 3.2
-COAST_STEP = {"deorbit": 3600.0, "deorbit_lifetime": DAY}
+COAST_STEP = {"cowell": 3600.0, "averaged": DAY}
+FMU = {"cowell": "Orbit", "averaged": "OrbitAveraged"}
 STOP_TIME = 150.0 * YEAR  # longer than the 97-year case
 
 
@@ -76,22 +75,27 @@ def generate(writer):
     writer.ssv("deorbit_orbit",
                "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
                "space weather); retrograde thrust since no attitude is simulated", orbit)
-    dv = propulsion.deorbit_scenario(420.0 * KM, 350.0 * KM)
+    dv = propulsion.deorbit_scenario(BASE.altitude_km * KM, BASE.target_perigee_km * KM)
     writer.ssv("deorbit_propulsion",
-               "Main de-orbit thrusters (4 x 25 mN, Isp 42 s, g0 9.81; thesis Section 3.2, Appendix A), 12 kg, "
-               "the 420 km -> 350 km propellant budget (Eq. 2-3)",
+               f"Main de-orbit thrusters ({propulsion.N_THRUSTERS} x {propulsion.THRUST_PER_THRUSTER * 1e3:g} mN, "
+               f"Isp {propulsion.ISP:g} s, g0 {propulsion.G0:g}; thesis Section 3.2, Appendix A), "
+               f"{propulsion.MASS0:g} kg, the {BASE.altitude_km:g} km -> {BASE.target_perigee_km:g} km propellant "
+               "budget (Eq. 2-3)",
                {"thrust_per_thruster": propulsion.THRUST_PER_THRUSTER, "n_thrusters": propulsion.N_THRUSTERS,
                "isp": propulsion.ISP, "g0": propulsion.G0, "mass0": propulsion.MASS0,
                "propellant_budget": dv["propellant"]})
-    for name, (h0, target) in SCENARIOS.items():
-        writer.ssv(f"deorbit_{name}",
+    cowell, averaged = DEORBIT_SYSTEMS["cowell"], DEORBIT_SYSTEMS["averaged"]
+    for s in SCENARIOS.values():
+        h0, target = s.altitude_km, s.target_perigee_km
+        writer.ssv(scenario_set(cowell, s.name),
                    f"Thesis scenario {h0:g} km -> {target:g} km perigee, with the NEIGHBOR burn",
                    scenario(h0, target, True))
-        writer.ssv(f"deorbit_{name}_no_burn",
-                   f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, 12 kg)", scenario(h0, target, False))
-    # deorbit_lifetime_*.ssv are the same scenario files under the lifetime system's name
+        writer.ssv(scenario_set(cowell, s.name, burn=False),
+                   f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, {SPACECRAFT.mass:g} kg)",
+                   scenario(h0, target, False))
+    # the lifetime system's scenario files are the same files under its name
     for name in SCENARIOS:
-        for suffix in ("", "_no_burn"):
-            writer.ssv_copy(f"deorbit_{name}{suffix}", f"deorbit_lifetime_{name}{suffix}")
-    writer.ssd("deorbit", system("Orbit", COAST_STEP["deorbit"]))
-    writer.ssd("deorbit_lifetime", system("OrbitAveraged", COAST_STEP["deorbit_lifetime"]))
+        for burn in (True, False):
+            writer.ssv_copy(scenario_set(cowell, name, burn), scenario_set(averaged, name, burn))
+    for orbit, name in DEORBIT_SYSTEMS.items():
+        writer.ssd(name, system(FMU[orbit], COAST_STEP[orbit]))

@@ -18,15 +18,18 @@ from components.attitude.rigid_body import RigidBody, box_inertia
 from components.attitude.thruster_control import pair_torques
 from components.attitude.thrusters import ThrusterPairs
 from components.core import rotations
+from components.mission.neighbor import SPACECRAFT
 
 from ...ssp.writer import vec
 
 DT = 0.015  # thesis time step (s)
 
-SPACECRAFT = {"mass": 12.0, "edge_a": 0.1, "edge_b": 0.2, "edge_c": 0.3, "inertia_from_box": True}
-THRUSTERS = {"thrust": 0.025, "edge_a": 0.1, "edge_c": 0.3, "Isp": 42.0, "g0": 9.81}
+BODY = {"mass": SPACECRAFT.mass, "edge_a": SPACECRAFT.edge_a, "edge_b": SPACECRAFT.edge_b, "edge_c": SPACECRAFT.edge_c,
+        "inertia_from_box": True}
+THRUSTERS = {"thrust": SPACECRAFT.rcs_thrust, "edge_a": SPACECRAFT.edge_a, "edge_c": SPACECRAFT.edge_c,
+             "Isp": SPACECRAFT.isp, "g0": SPACECRAFT.g0}
 RATE_TOL = math.radians(0.01)
-LEVELS = pair_torques(0.025, 0.1, 0.3)
+LEVELS = pair_torques(SPACECRAFT.rcs_thrust, SPACECRAFT.edge_a, SPACECRAFT.edge_c)
 
 DETUMBLE_GAINS = {**vec("Kp", [100.0] * 3), **vec("Kd", [1.0] * 3), **vec("omega_d", [0.0] * 3),
                   **vec("omega_tol", [RATE_TOL] * 3), **vec("torque_level", LEVELS)}
@@ -49,7 +52,7 @@ def detumble_end_state(q0):
     and slew case 2 does not converge within 200 s. The slew case files therefore carry the
     end state computed here with the same component code the FMUs run (a test checks that
     it equals the co-simulated detumble end state)."""
-    inertia = box_inertia(SPACECRAFT["mass"], SPACECRAFT["edge_a"], SPACECRAFT["edge_b"], SPACECRAFT["edge_c"])
+    inertia = box_inertia(SPACECRAFT.mass, *SPACECRAFT.edges)
     body = RigidBody(inertia, q0, W0_DETUMBLE, "euler")
     ctrl = DetumbleController(DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD, torque_level=LEVELS)
     pairs = ThrusterPairs()
@@ -142,7 +145,7 @@ SYSTEMS = {
     },
 }
 
-CONCERNS = {"spacecraft": ("Host spacecraft mass and box edges (thesis Appendix A)", SPACECRAFT),
+CONCERNS = {"spacecraft": ("Host spacecraft mass and box edges (thesis Appendix A)", BODY),
             "thrusters": ("RCS thruster force, lever-arm edges, Isp and g0 (Appendix A, Eq. 16, 74)", THRUSTERS),
             "detumble_gains": ("Detumble PD gains and tolerances (Eq. 8, 32-33, Appendix D)", DETUMBLE_GAINS),
             "slew_gains": ("Slew PD gains, target and tolerances (Eq. 40, 45, Appendix E)", SLEW_GAINS)}

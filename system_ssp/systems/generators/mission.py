@@ -47,7 +47,7 @@ deployed at the altitude from which it decays to the scenario altitude by then (
 the orbit-averaged model and the same Jacchia-Roberts atmosphere and space weather), and the
 heartbeat lost 5 years after deployment. The burn spends the scenario's Eq. 2-3 propellant.
 
-Guidance, navigation and control come in three sets (system_ssp.neighbor.mission.GNC picks one after
+Guidance, navigation and control come in three sets (components.mission.neighbor.GNC_SETS; the mission picks one after
 the scenario's parameter set):
   closed-loop  (the system's own bindings) the orbit thrusts along the body's thrust axis, the
                guidance FMU computes the burn attitude and its rate from the orbit's r and v, the
@@ -71,6 +71,8 @@ from components.orbit import averaged, propulsion
 from components.core import time_utils
 from components.core.constants import DAY, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase as Phase, MissionMode as Mode
+from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS,
+                                         SPACECRAFT, scenario_set)
 from components.mission.power_bus import LOAD_NAMES
 
 from ...ssp.writer import vec
@@ -79,10 +81,9 @@ from . import attitude_determination as ad
 KM = 1000.0
 IDLE_DAYS = 1825.0  # 5 years (Appendix I: 1855 days of idle + grace)
 GRACE_DAYS = 30.0
-DEORBIT_EPOCH = time_utils.DEFAULT_EPOCH  # the thesis' start date for the de-orbit
+DEORBIT_EPOCH = HOST_ORBIT.deorbit_epoch  # the thesis' start date for the de-orbit
 MISSION_EPOCH = (time_utils.parse_epoch(DEORBIT_EPOCH)
                  - dt.timedelta(days=IDLE_DAYS + GRACE_DAYS)).strftime("%Y-%m-%dT%H:%M:%SZ")
-SCENARIOS = {"420km": (420.0, 350.0), "475km": (475.0, 350.0), "525km": (525.0, 300.0)}
 W0_TAKEOVER = [math.radians(10.0)] * 3  # Eq. 7
 
 # During the 15 ms attitude phases the slow components (orbit, ground station, host, power, data)
@@ -151,9 +152,9 @@ DETERMINATION_EVERY = 10
 # loop's step, the shortest pulse) at the nominal 12 kg, 0.017-0.043 deg/s per axis. They hold for
 # any mass down to 8 kg (the bit grows as the mass falls: 1.5x at 8 kg).
 MIN_ON_TIME = 0.015
-BITS = thruster_control.impulse_bit_rates(
-    thruster_control.pair_torques(), [rigid_body.box_inertia(propulsion.MASS0, 0.1, 0.2, 0.3)[i, i] for i in range(3)],
-    MIN_ON_TIME)
+INERTIA = rigid_body.box_inertia(SPACECRAFT.mass, *SPACECRAFT.edges)
+BITS = thruster_control.impulse_bit_rates(thruster_control.pair_torques(), [INERTIA[i, i] for i in range(3)],
+                                          MIN_ON_TIME)
 DETUMBLE_FLIGHT = {**vec("omega_tol", [0.75 * b for b in BITS]), "settle_time": 1.0}
 SLEW_FLIGHT = {"target_from_input": True, **vec("omega_tol", [2.0 * b for b in BITS]),
                **vec("rate_deadband", [1.5 * b for b in BITS]), "settle_time": 3.0, "settle_angle": math.radians(1.0)}
@@ -168,7 +169,7 @@ COARSE_SUN_SIGMA = math.radians(2.0)
 # The detumble waits (after the 10 minutes of determination) until the estimator's largest
 # 1-sigma attitude error is below this: a TRIAD fix right at the end would start it at 1-2 deg.
 VALID_SIGMA = math.radians(0.25)
-ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / rigid_body.box_inertia(propulsion.MASS0, 0.1, 0.2, 0.3)[0, 0]
+ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / INERTIA[0, 0]
 # What the thesis parameter set restores (names component.variable); every value the closed loop
 # changes appears here.
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
@@ -183,19 +184,21 @@ GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynam
 # uses it: `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
 # propulsion's initial mass together.
 SPACECRAFT_PARAMETERS = {
-    "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", propulsion.MASS0,
+    "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", SPACECRAFT.mass,
                         [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0")]),
     "spacecraft_edge_a": ("Box edge a along body y, m (Appendix A: 0.1 m); also the x thruster pairs' spacing",
-                          0.1, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("estimator", "edge_a"),
+                          SPACECRAFT.edge_a, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("estimator", "edge_a"),
                                 ("thrusters", "edge_a")]),
-    "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", 0.2,
+    "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", SPACECRAFT.edge_b,
                           [("dynamics", "edge_b"), ("tracking", "edge_b"), ("estimator", "edge_b")]),
     "spacecraft_edge_c": ("Box edge c along body x, m (Appendix A: 0.3 m); also the y and z thruster pairs' arms",
-                          0.3, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("estimator", "edge_c"),
+                          SPACECRAFT.edge_c, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("estimator", "edge_c"),
                                 ("thrusters", "edge_c")]),
-    "spacecraft_Cd": ("Drag coefficient (Table 2: 2.2)", 2.2, [("orbit", "Cd")]),
-    "spacecraft_drag_area": ("Drag area facing the flow, m2 (Table 2: 0.02 m2)", 0.02, [("orbit", "area")]),
-    "rcs_thrust": ("Force of one RCS thruster, N (Appendix A: 25 mN)", 0.025, [("thrusters", "thrust")]),
+    "spacecraft_Cd": ("Drag coefficient (Table 2: 2.2)", SPACECRAFT.Cd, [("orbit", "Cd")]),
+    "spacecraft_drag_area": ("Drag area facing the flow, m2 (Table 2: 0.02 m2)", SPACECRAFT.drag_area,
+                             [("orbit", "area")]),
+    "rcs_thrust": ("Force of one RCS thruster, N (Appendix A: 25 mN)", SPACECRAFT.rcs_thrust,
+                   [("thrusters", "thrust")]),
 }
 
 
@@ -234,10 +237,10 @@ def determination_every():
     return {c: DETERMINATION_EVERY for c in determination_active() if c in slow}
 
 
-def deployment_altitude(target_km, density="jacchia_roberts"):
+def deployment_altitude(target_km, density=HOST_ORBIT.density_model):
     """Mean altitude (km) at MISSION_EPOCH from which the host decays to `target_km` at the
     de-orbit epoch (1855 days later), found by bisection with the orbit-averaged model."""
-    model = atmosphere.make_density_model(density, inclination=math.radians(51.6))
+    model = atmosphere.make_density_model(density, inclination=HOST_ORBIT.inclination)
     span = (IDLE_DAYS + GRACE_DAYS) * DAY
 
     def end_altitude(h0_km):
@@ -378,7 +381,8 @@ def system(orbit_fmu):
 
 
 def generate(writer):
-    takeover_altitudes = {name: deployment_altitude(h0) for name, (h0, _) in SCENARIOS.items()}
+    takeover_altitudes = {name: deployment_altitude(s.altitude_km) for name, s in SCENARIOS.items()}
+    base = SCENARIOS[DEFAULT_SCENARIO]  # the component-level files start from it
     writer.ssv("mission_host",
                "Host heartbeat: lost 5 years after deployment (Appendix I: 1825 days of idle)",
                {"heartbeat_loss_time": IDLE_DAYS * DAY, "heartbeat_return_times": ""})
@@ -387,23 +391,25 @@ def generate(writer):
                "in monitoring one GPS beacon contact a day (operators choose the frequency, Section 3.6)",
                {"grace_period": GRACE_DAYS * DAY, "wake_period": DAY, "wake_duration": 5.0,
                "attitude_determination_duration": 600.0, "beacon_interval": DAY})
-    h420 = takeover_altitudes["420km"]
+    h_base = takeover_altitudes[base.name]
     writer.ssv("mission_orbit",
-               f"Host orbit at deployment ({MISSION_EPOCH}, 51.6 deg; {h420:.2f} km decays to 420 km by "
-               f"{DEORBIT_EPOCH}), Cd 2.2, 0.02 m^2, Jacchia-Roberts with the bundled space weather, thrust along "
-               "the body's thrust axis (q_BN from the rigid body)",
-               {"epoch": MISSION_EPOCH, "sma0": R_EQ + h420 * KM, "ecc0": 0.0, "inc0": math.radians(51.6),
-               "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": 2.2, "area": 0.02, "reentry_altitude": 250.0 * KM,
-               "density_model": "jacchia_roberts", "space_weather_file": "", "use_constant_space_weather": False,
-               "retrograde": False})
+               f"Host orbit at deployment ({MISSION_EPOCH}, {HOST_ORBIT.inclination_deg:g} deg; {h_base:.2f} km decays "
+               f"to {base.altitude_km:g} km by {DEORBIT_EPOCH}), Cd {SPACECRAFT.Cd:g}, {SPACECRAFT.drag_area:g} m^2, "
+               "Jacchia-Roberts with the bundled space weather, thrust along the body's thrust axis (q_BN from the "
+               "rigid body)",
+               {"epoch": MISSION_EPOCH, "sma0": R_EQ + h_base * KM, "ecc0": 0.0, "inc0": HOST_ORBIT.inclination,
+               "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": SPACECRAFT.Cd, "area": SPACECRAFT.drag_area,
+               "reentry_altitude": HOST_ORBIT.reentry_altitude_km * KM, "density_model": HOST_ORBIT.density_model,
+               "space_weather_file": "", "use_constant_space_weather": False, "retrograde": False})
     writer.ssv("mission_ground",
                "UIUC ground station (40.1020 N, 88.2272 W), horizon mask (Appendix I sets none)",
                {"epoch": MISSION_EPOCH})
-    budget = {name: propulsion.deorbit_scenario(h0 * KM, target * KM)["propellant"]
-              for name, (h0, target) in SCENARIOS.items()}
+    budget = {name: propulsion.deorbit_scenario(s.altitude_km * KM, s.target_perigee_km * KM)["propellant"]
+              for name, s in SCENARIOS.items()}
     writer.ssv("mission_propulsion",
-               "Main de-orbit thrusters, 12 kg, the 420 km -> 350 km budget (Eq. 2-3: 0.564 kg)",
-               {"mass0": propulsion.MASS0, "propellant_budget": budget["420km"]})
+               f"Main de-orbit thrusters, {SPACECRAFT.mass:g} kg, the {base.altitude_km:g} km -> "
+               f"{base.target_perigee_km:g} km budget (Eq. 2-3: {base.thesis['propellant']:g} kg)",
+               {"mass0": SPACECRAFT.mass, "propellant_budget": budget[base.name]})
     writer.ssv("mission_takeover",
                "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), RK4 attitude integration",
                {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "rk4"})
@@ -420,7 +426,7 @@ def generate(writer):
                "The spacecraft's physical values, each once: system parameters handed to every component that uses "
                "them (the system's parameter connections)",
                {name: value for name, (_, value, _) in SPACECRAFT_PARAMETERS.items()})
-    writer.ssv("mission_gnc_thesis",
+    writer.ssv(GNC_SETS["thesis"],
                "The thesis' guidance and control (its published numbers): thrust along -v whatever the attitude, "
                "identity slew target, tracking at the Eq. 67 rate latched at the burn start, single-sample stop "
                "tests, Euler attitude integration", GNC_THESIS)
@@ -443,7 +449,7 @@ def generate(writer):
                {"nadir_sigma": ad.HORIZON_SIGMA, "sun_sigma": ad.SUN_SIGMA, "gyro_sigma": ad.GYRO_SIGMA,
                 "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": 0.09, "accel_sigma": ACCEL_SIGMA,
                 "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA})
-    writer.ssv("mission_gnc_truth",
+    writer.ssv(GNC_SETS["closed-loop-truth"],
                "Closed-loop guidance and control on the true state (a fidelity choice): the estimator passes the "
                "rigid body's attitude, rate and acceleration through; the sensors are not stepped",
                {"estimator.truth_feedback": True})
@@ -451,13 +457,15 @@ def generate(writer):
                {"capacity": 10.8 * 3600.0, "initial_state_of_charge": 1.0})
     writer.ssv("mission_data", "256 kB flash, Table 7 rate, 9600 baud downlink",
                {"capacity": 256e3, "downlink_rate": 1200.0})
-    for name, (h0, target) in SCENARIOS.items():
-        writer.ssv(f"neighbor_mission_{name}",
+    cowell, averaged = MISSION_SYSTEMS["cowell"], MISSION_SYSTEMS["averaged"]
+    for name, s in SCENARIOS.items():
+        h0, target = s.altitude_km, s.target_perigee_km
+        writer.ssv(scenario_set(cowell, name),
                    f"Thesis scenario {h0:g} km -> {target:g} km: deployed at {takeover_altitudes[name]:.2f} km on "
                    f"{MISSION_EPOCH}, at {h0:g} km when the de-orbit starts ({DEORBIT_EPOCH})",
                    {"orbit.sma0": R_EQ + takeover_altitudes[name] * KM,
                    "propulsion.propellant_budget": budget[name]})
-    writer.ssd("neighbor_mission", system("Orbit"))
-    writer.ssd("neighbor_mission_lifetime", system("OrbitAveraged"))
+    writer.ssd(cowell, system("Orbit"))
+    writer.ssd(averaged, system("OrbitAveraged"))
     for name in SCENARIOS:
-        writer.ssv_copy(f"neighbor_mission_{name}", f"neighbor_mission_lifetime_{name}")
+        writer.ssv_copy(scenario_set(cowell, name), scenario_set(averaged, name))

@@ -24,9 +24,9 @@ import math
 from components.core import rotations
 from components.attitude import reference_tracking as rt
 from components.attitude import sun_avoidance as sa
+from components.mission.neighbor import SPACECRAFT
 
 from ...ssp.writer import vec
-from .maneuvers import SPACECRAFT
 
 NAME = "sun_avoidance_slew"
 BORESIGHT = (0.0, 0.0, 1.0)
@@ -63,8 +63,8 @@ def sun_far():
 def guidance_params(sun):
     return {**vec("boresight_B", list(BORESIGHT)), **vec("sun_N", sun), "epsilon": EPSILON, "margin": MARGIN,
             **vec("q0", list(Q0)), **vec("q_f", list(Q_F)), "w_max": W_MAX, "a_max": A_MAX, "t_start": 0.0,
-            "mass": SPACECRAFT["mass"], "edge_a": SPACECRAFT["edge_a"], "edge_b": SPACECRAFT["edge_b"],
-            "edge_c": SPACECRAFT["edge_c"]}
+            "mass": SPACECRAFT.mass, "edge_a": SPACECRAFT.edge_a, "edge_b": SPACECRAFT.edge_b,
+            "edge_c": SPACECRAFT.edge_c}
 
 
 TRACKER = {**vec("Kp", list(rt.DEFAULT_KP)), **vec("Kd", list(rt.DEFAULT_KD)), **vec("max_torque", [0.0025] * 3),
