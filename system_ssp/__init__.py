@@ -1,8 +1,9 @@
 """system_ssp: a co-simulation master for flat SSP 1.0 systems of FMI 2.0 co-simulation FMUs.
 
     result = system_ssp.simulate("build/ssp/detumble.ssp", stop_time=20.0)
+    options = system_ssp.RunOptions(parameter_sets=["parameters/slew_case2.ssv"], outputs=["dynamics.q_BN[4]"])
     with system_ssp.System("build/ssp/slew.ssp") as system:   # load once, run many times
-        r = system.run(parameter_sets=["parameters/slew_case2.ssv"], outputs=["dynamics.q_BN[4]"])
+        r = system.run(options, observers=[my_observer])        # keywords: a shorthand for RunOptions fields
 
 `SSPError` names the file and line, component, variable or connection of a bad input;
 `SimulationError` (a subclass) an FMU that failed, with the messages it logged; `RunInterrupted`
@@ -13,7 +14,7 @@ in docs/master.md.
 import logging
 
 from .errors import RunInterrupted, SimulationError, SSPError
-from .master import Result, System, simulate, write_csv_atomic, write_result
+from .master import Observer, Result, RunOptions, RunView, StepInfo, System, simulate, write_csv_atomic, write_result
 
 __version__ = "0.2.0"
 
@@ -21,5 +22,5 @@ __version__ = "0.2.0"
 # loggers for the application to show (the command line does, see --log-level).
 logging.getLogger("system_ssp").addHandler(logging.NullHandler())
 
-__all__ = ["simulate", "System", "Result", "SSPError", "SimulationError", "RunInterrupted", "write_csv_atomic",
-           "write_result", "__version__"]
+__all__ = ["simulate", "System", "RunOptions", "Result", "Observer", "RunView", "StepInfo", "SSPError",
+           "SimulationError", "RunInterrupted", "write_csv_atomic", "write_result", "__version__"]

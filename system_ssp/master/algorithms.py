@@ -6,10 +6,35 @@ a stop condition and calls the observers after every macro step; `finish` at the
 `refresh_for_record` brings the values a recorded row shows up to date."""
 import ctypes
 import math
+from typing import Callable, Dict, List, Optional, Protocol, Sequence
 
 from ..errors import SimulationError
 from .connections import KIND
 from .instances import CTYPE, GET, StepFailed
+from .observers import StepInfo
+
+Stepper = Callable[[float, float], None]  # (t, h): set a component's inputs, doStep, get its outputs
+
+
+class Algorithm(Protocol):
+    """What the execution asks of a master algorithm (FixedStepAlgorithm, ScheduledAlgorithm)."""
+
+    steppers: List[Stepper]  # per component, in SSD order (a profiler may wrap them)
+
+    def start(self, info: StepInfo) -> None:
+        """After initialization: set the start time and the recording interval in `info`."""
+
+    def run(self, info: StepInfo, observe: Sequence[Callable[[StepInfo], None]]) -> None:
+        """Step until the stop time or until `info.fired`, calling `observe` after every macro step."""
+
+    def refresh_for_record(self) -> None:
+        """Bring the values a recorded row shows up to date."""
+
+    def finish(self, info: StepInfo) -> None:
+        """After the last step (the inputs set as they stand at the end)."""
+
+    def statistics(self) -> Optional[Dict[str, Dict[str, float]]]:
+        """Per schedule mode: steps and simulated time; None for a fixed-step run."""
 
 
 class FixedStepAlgorithm:

@@ -4,16 +4,17 @@ interrupted raises with the rows recorded so far (`err.result`)."""
 import signal
 
 from ..errors import RunInterrupted, RunTimedOut, SimulationError
-from .algorithms import FixedStepAlgorithm, ScheduledAlgorithm
+from .algorithms import Algorithm, FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
 from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallClockLimit
-from .observers import Observer, ProgressBar, Profiler, Recorder, StepInfo, StopConditions
+from .observers import Observer, ProgressBar, Profiler, Recorder, RunView, StepInfo, StopConditions
 from .result import Result
 
 
-def execute(system, plan, progress=False, timeout=None):
+def execute(system, plan, progress=False, timeout=None, observers=()):
     """Run `plan` on `system` with fresh FMU instances; returns a Result (wall_time 0: the
-    caller measures it). `timeout`: seconds of wall time from the first step, or None."""
+    caller measures it). `timeout`: seconds of wall time from the first step, or None;
+    `observers`: the caller's, after the master's own."""
     table = InstanceTable(system, plan)
     run = _Run(system, plan, table)
     with SignalWatch() as watch:
@@ -21,7 +22,7 @@ def execute(system, plan, progress=False, timeout=None):
             table.instantiate()
             table.prepare()
             table.initialize()
-            return run.loop(progress, watch, timeout)
+            return run.loop(progress, watch, timeout, observers)
         except StepFailed as f:
             err = table.error(f.ci, f.call, status=f.status, names=f.names)
             err.result = run.partial(f"failed at t={table.t:g} s")
@@ -52,9 +53,9 @@ class _Run:
         self.system, self.plan, self.table = system, plan, table
         self.recorder = self.info = None
 
-    def loop(self, progress, watch, timeout=None):
+    def loop(self, progress, watch, timeout=None, callers=()):
         system, plan, table = self.system, self.plan, self.table
-        algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
+        algorithm: Algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
         observers = [recorder]
@@ -67,6 +68,10 @@ class _Run:
         if plan.profile and plan.schedule is not None:
             profiler = Profiler(algorithm, [c.name for c in system.comps])
             observers.append(profiler)
+        view = RunView(table, algorithm.refresh_for_record)
+        for obs in callers:
+            obs.attach(view)
+            observers.append(obs)
         if timeout is not None:
             observers.append(WallClockLimit(timeout))
         observers.append(Interruption(watch))  # last: the row of this step is recorded first

@@ -6,10 +6,12 @@ recorder knows whether the run stops here), and at the end (`finish`). They shar
 that the algorithm fills in."""
 import sys
 import time
+from typing import Dict, List, Sequence, Union
 
 import numpy as np
 
 from .instances import read_ops
+from .names import split_name
 
 # The progress bar's display units (the master knows nothing of the models, so not from components).
 DAY = 86400.0  # s
@@ -32,14 +34,55 @@ class StepInfo:
         self.fired = None  # name of the stop signal that is true, once one is
 
 
+class RunView:
+    """What an observer may read of the run it watches: the current values of variables, by
+    'component.variable' name (inputs and outputs brought up to date as for a recorded row)."""
+
+    def __init__(self, table, refresh):
+        self._table, self._refresh = table, refresh
+        self._ops = {}
+
+    @property
+    def component_names(self) -> List[str]:
+        return [c.name for c in self._table.system.comps]
+
+    def read(self, names: Sequence[str]) -> Dict[str, Union[float, int, bool]]:
+        """{name: current value} of the named Real, Integer or Boolean variables; SSPError names
+        an unknown one."""
+        key = tuple(names)
+        ops = self._ops.get(key)
+        if ops is None:
+            comps = self._table.system.comps
+            wanted = []
+            for name in key:
+                comp, var = split_name(comps, name, "observed variable")
+                wanted.append((comp.index, var))
+            ops = self._ops[key] = read_ops(self._table, wanted)[0]
+        self._refresh()
+        out: Dict[str, Union[float, int, bool]] = {}
+        for op in ops:
+            boolean = op.call == "fmi2GetBoolean"
+            for name, value in zip(op.names, op.read().tolist()):
+                out[name] = bool(value) if boolean else value
+        return out
+
+
 class Observer:
-    def start(self, info):
+    """Watches a run: `attach` once before the run (a `RunView` to read values through), `start`
+    after initialization, `step` after every macro step (`info.t`, `info.steps`; set
+    `info.fired` to a text to stop the run there) and `finish` at the end. Pass instances as
+    `System.run(..., observers=[...])`; override only what you need."""
+
+    def attach(self, run: RunView) -> None:
         pass
 
-    def step(self, info):
+    def start(self, info: StepInfo) -> None:
         pass
 
-    def finish(self, info):
+    def step(self, info: StepInfo) -> None:
+        pass
+
+    def finish(self, info: StepInfo) -> None:
         pass
 
 

@@ -1,13 +1,51 @@
-"""What one run will do, resolved against the loaded FMUs before the first FMU is instantiated.
+"""What one run will do: the caller's `RunOptions`, and the `RunPlan` resolved from them and the
+SSD's master annotation against the loaded FMUs before the first FMU is instantiated.
 
-`System.run` turns its arguments and the SSD's master annotation into a `RunPlan`; the
-execution and the algorithms read nothing else. Components are referred to by their index in
-`System.comps` (SSD order), variables by name."""
-from dataclasses import dataclass
+`System.run` turns its options into a `RunPlan`; the execution and the algorithms read nothing
+else. Components are referred to by their index in `System.comps` (SSD order), variables by name."""
+from dataclasses import dataclass, field, fields
+from os import PathLike
 from types import MappingProxyType
-from typing import Mapping, Optional
+from typing import Any, Mapping, Optional, Sequence, Tuple, Union
 
 ALGORITHMS = ("gauss-seidel", "jacobi")
+
+Path_ = Union[str, "PathLike[str]"]
+
+
+@dataclass(frozen=True)
+class RunOptions:
+    """What a run should do; every field left at None takes the system's own setting (the SSD's
+    DefaultExperiment and the org.neighbor-cosim.master annotation). One options object serves
+    any number of runs (`dataclasses.replace(options, stop_time=...)` for a variant).
+
+    - `stop_time`, `step_size`, `start_time`: seconds;
+    - `parameters`: {"component.variable" or system parameter: value}, applied after every file;
+    - `parameter_sets`: .ssv files (names component.variable), applied after the SSD's bindings;
+    - `outputs`: the variables to record ("comp.var" names, or one comma-separated string; None:
+      every numeric input and output);
+    - `algorithm`: "gauss-seidel" or "jacobi"; `order`: the component order (names);
+    - `step_multiples`: {component: k}, stepped every k-th communication step;
+    - `stop_when`: Boolean outputs that end the run at the first communication point one is true;
+    - `record_every`: record a row every this many steps; `schedule`: False runs a system with an
+      nc:Schedule at its fixed step; `profile`: wall time per component in `Result.profile`."""
+    stop_time: Optional[float] = None
+    step_size: Optional[float] = None
+    start_time: Optional[float] = None
+    parameters: Mapping[str, Any] = field(default_factory=dict)
+    parameter_sets: Sequence[Path_] = ()
+    outputs: Union[None, str, Sequence[str]] = None
+    algorithm: Optional[str] = None
+    order: Union[None, str, Sequence[str]] = None
+    step_multiples: Mapping[str, int] = field(default_factory=dict)
+    stop_when: Optional[Sequence[str]] = None
+    record_every: int = 1
+    schedule: bool = True
+    profile: bool = False
+
+    @classmethod
+    def field_names(cls) -> Tuple[str, ...]:
+        return tuple(f.name for f in fields(cls))
 
 
 @dataclass(frozen=True, slots=True)

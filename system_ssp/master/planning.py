@@ -1,6 +1,7 @@
-"""Turning `System.run`'s arguments and the SSD's master annotation into a `RunPlan`."""
+"""Turning `System.run`'s `RunOptions` and the SSD's master annotation into a `RunPlan`."""
 import math
 import numbers
+from typing import Any, Optional
 
 from ..errors import SSPError
 from ..ssp.reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES
@@ -8,7 +9,7 @@ from .connections import KIND, NUMERIC
 from .graph import toposort
 from .names import near, split_name
 from .parameters import collect_parameters
-from .plan import ALGORITHMS, RunPlan, ScheduleMode, SchedulePlan
+from .plan import ALGORITHMS, RunOptions, RunPlan, ScheduleMode, SchedulePlan
 
 
 # The most communication steps a fixed-step run may take: a day of wall time at the master's
@@ -93,10 +94,12 @@ def _recorded(system, outputs):
     return rec
 
 
-def make_plan(system, stop_time=None, step_size=None, start_time=None, parameters=None, parameter_sets=None,
-              outputs=None, algorithm=None, order=None, step_multiples=None, stop_when=None, record_every=1,
-              schedule=True, profile=False):
-    """A RunPlan from the arguments of System.run (None: the SSD's own settings)."""
+def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
+    """The RunPlan of `options` on `system` (a loaded `System`; a field left at None: the SSD's
+    own setting)."""
+    o = options if options is not None else RunOptions()
+    stop_time, step_size, start_time, algorithm, order = o.stop_time, o.step_size, o.start_time, o.algorithm, o.order
+    record_every, schedule, profile = o.record_every, o.schedule, o.profile
     d, m = system.desc, system.desc.master
     start = start_time if start_time is not None else (d.start_time if d.start_time is not None else 0.0)
     stop = stop_time if stop_time is not None else d.stop_time
@@ -119,16 +122,16 @@ def make_plan(system, stop_time=None, step_size=None, start_time=None, parameter
     if algo not in ALGORITHMS:
         raise SSPError(f"unknown algorithm {algo!r} (expected one of: {', '.join(ALGORITHMS)})")
     order_idx = _order(system, order, algo)
-    mult = _multiples(system, step_multiples)
-    stops = _stops(system, stop_when)
-    rec = _recorded(system, outputs)
+    mult = _multiples(system, o.step_multiples)
+    stops = _stops(system, o.stop_when)
+    rec = _recorded(system, o.outputs)
     if isinstance(record_every, bool) or not isinstance(record_every, numbers.Integral) or record_every < 1:
         raise SSPError(f"record_every must be an integer >= 1, got {record_every!r}")
     n_float = (stop - start) / h
     n_steps = int(round(n_float))
     if abs(n_float - n_steps) > 1e-9 * max(1.0, n_float):
         n_steps = int(math.ceil(n_float))
-    params = collect_parameters(system, parameter_sets, parameters)
+    params = collect_parameters(system, o.parameter_sets, o.parameters)
     sched = None
     if schedule and m.schedule:
         sched = _schedule(system, algo, mult)

@@ -1,11 +1,12 @@
 """A loaded SSP system: `System(path)` reads and checks it once; `run()` simulates it any
 number of times, each with fresh FMU instances."""
+import dataclasses
 import logging
 from pathlib import Path
 import shutil
 import tempfile
 import time
-from typing import Iterable, Mapping, Optional, Sequence, Union
+from typing import Any, Mapping, Optional, Sequence, Union
 import zipfile
 
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
@@ -17,6 +18,8 @@ from .execution import execute
 from .info import describe_system
 from .names import split_name
 from .parameters import collect_parameters
+from .observers import Observer
+from .plan import RunOptions
 from .planning import make_plan
 from .result import Result, check_output_file, partial_path, write_result
 
@@ -104,26 +107,28 @@ class System:
         return describe_system(self)
 
     # ---- running ------------------------------------------------------------------------
-    def run(self, stop_time: Optional[float] = None, step_size: Optional[float] = None,
-            start_time: Optional[float] = None, parameters: Optional[Mapping[str, object]] = None,
-            parameter_sets: Optional[Sequence[PathLike]] = None, outputs: Union[None, str, Iterable[str]] = None,
-            algorithm: Optional[str] = None, order: Union[None, str, Sequence[str]] = None,
-            step_multiples: Optional[Mapping[str, int]] = None, stop_when: Optional[Sequence[str]] = None,
-            output_file: Optional[PathLike] = None, progress: bool = False, record_every: int = 1,
-            schedule: bool = True, profile: bool = False, timeout: Optional[float] = None) -> Result:
-        """Run one simulation with fresh FMU instances; see `system_ssp.simulate` for the
-        arguments. schedule=False runs a system that has an nc:Schedule with the fixed step;
-        `timeout` (s of wall time) stops the run with RunTimedOut (rows so far in err.result)."""
+    def run(self, options: Optional[RunOptions] = None, *, observers: Sequence[Observer] = (),
+            output_file: Optional[PathLike] = None, progress: bool = False, timeout: Optional[float] = None,
+            **settings: Any) -> Result:
+        """Run one simulation with fresh FMU instances and return its `Result`.
+
+        `options` (`RunOptions`) says what to run; keyword `settings` are a shorthand for its
+        fields (`run(stop_time=10.0)` is `run(RunOptions(stop_time=10.0))`; given with `options`
+        they replace those fields). The rest is about this call, not the run's values:
+        `observers` are called after initialization, after every macro step and at the end,
+        after the master's own (see `Observer`); `output_file` (.csv or .parquet) is checked
+        before the first step and written at the end, or with the rows so far when the run
+        stops early; `progress` shows a progress bar on stderr; `timeout` (s of wall time) stops
+        the run with RunTimedOut (rows so far in err.result)."""
         wall0 = time.perf_counter()
-        plan = make_plan(self, stop_time, step_size, start_time, parameters, parameter_sets, outputs, algorithm,
-                         order, step_multiples, stop_when, record_every, schedule, profile)
+        plan = make_plan(self, run_options(options, settings))
         if output_file is not None:
             check_output_file(output_file)  # before the first step, not after the whole run
         LOG.info("%s: %d components, %s, t = %g .. %g s%s", self.desc.display, len(self.comps), plan.algorithm,
                  plan.start, plan.stop, f", {plan.n_steps} steps of {plan.step_size:g} s" if plan.schedule is None
                  else ", nc:Schedule")
         try:
-            result = execute(self, plan, progress, timeout)
+            result = execute(self, plan, progress, timeout, observers)
         except (SimulationError, RunInterrupted, RunTimedOut) as err:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
@@ -157,16 +162,22 @@ class System:
             pass
 
 
-def simulate(path: PathLike, stop_time: Optional[float] = None, step_size: Optional[float] = None,
-             start_time: Optional[float] = None, parameters: Optional[Mapping[str, object]] = None,
-             parameter_sets: Optional[Sequence[PathLike]] = None, outputs: Union[None, str, Iterable[str]] = None,
-             algorithm: Optional[str] = None, order: Union[None, str, Sequence[str]] = None,
-             step_multiples: Optional[Mapping[str, int]] = None, stop_when: Optional[Sequence[str]] = None,
-             output_file: Optional[PathLike] = None, progress: bool = False, validate: bool = True,
-             record_every: int = 1, schedule: bool = True, profile: bool = False) -> Result:
-    """Load and run an SSP system; returns a `Result`. See the `system_ssp` package docstring."""
+def run_options(options: Optional[RunOptions], settings: Mapping[str, Any]) -> RunOptions:
+    """`options` with the keyword `settings` applied to its fields; a keyword that is not a field
+    is refused with the list of those that are."""
+    unknown = sorted(set(settings) - set(RunOptions.field_names()))
+    if unknown:
+        raise TypeError(f"unknown run setting(s) {', '.join(unknown)} (RunOptions fields: "
+                        f"{', '.join(RunOptions.field_names())}; also observers, output_file, progress, timeout)")
+    base = options if options is not None else RunOptions()
+    return dataclasses.replace(base, **settings) if settings else base
+
+
+def simulate(path: PathLike, options: Optional[RunOptions] = None, *, validate: bool = True,
+             observers: Sequence[Observer] = (), output_file: Optional[PathLike] = None, progress: bool = False,
+             timeout: Optional[float] = None, **settings: Any) -> Result:
+    """Load and run an SSP system; returns a `Result`. `validate` checks the files against the
+    SSP schemas; the rest as `System.run` (keyword settings: the fields of `RunOptions`)."""
     with System(path, validate=validate) as system:
-        return system.run(stop_time=stop_time, step_size=step_size, start_time=start_time, parameters=parameters,
-                          parameter_sets=parameter_sets, outputs=outputs, algorithm=algorithm, order=order,
-                          step_multiples=step_multiples, stop_when=stop_when, output_file=output_file,
-                          progress=progress, record_every=record_every, schedule=schedule, profile=profile)
+        return system.run(options, observers=observers, output_file=output_file, progress=progress, timeout=timeout,
+                          **settings)

@@ -24,6 +24,7 @@ from system_ssp.tools.console import add_console_arguments, console_settings
 from system_ssp.atomic import StagedFolder, atomic_write
 from system_ssp.master import instances
 from system_ssp.master.observers import ProgressBar, StepInfo
+from system_ssp.master.plan import RunOptions
 from system_ssp.master.planning import make_plan
 from test_master_core import loop_system
 
@@ -235,7 +236,7 @@ def test_progress_bar_units_and_totals(fmus, tmp_path):
     ssd = loop_system(tmp_path, fmus)
     with system_ssp.System(ssd) as system:
         for stop, step, unit in ((100.0, 0.1, "s"), (10 * 86400.0, 3600.0, "d"), (5 * 3.15576e7, 86400.0, "yr")):
-            bar = ProgressBar(make_plan(system, stop_time=stop, step_size=step))
+            bar = ProgressBar(make_plan(system, RunOptions(stop_time=stop, step_size=step)))
             bar.start(StepInfo(0.0, 1))
             try:
                 assert bar.unit == unit and bar.bar.total == pytest.approx(stop / bar.scale)
@@ -246,7 +247,7 @@ def test_progress_bar_units_and_totals(fmus, tmp_path):
                 assert bar.bar.n == pytest.approx(stop / 2 / bar.scale)
             finally:
                 bar.close()
-        bar = ProgressBar(make_plan(system, stop_time=100.0, step_size=0.1, stop_when=["thr.done"]))
+        bar = ProgressBar(make_plan(system, RunOptions(stop_time=100.0, step_size=0.1, stop_when=["thr.done"])))
         bar.start(StepInfo(0.0, 1))
         try:
             assert bar.bar.total is None  # may stop before 100 s: no percentage, no ETA

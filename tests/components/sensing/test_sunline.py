@@ -185,7 +185,7 @@ def sunline_fmus(tmp_path_factory):
 
     d = tmp_path_factory.mktemp("sunline_fmus")
     return {p.stem: p for p in (build_fmus.build_fmu(REPO / "fmus" / f"neighbor_{m}.py", d)
-                                for m in ("sunline", "rigid_body"))}
+                                for m in ("sunline_ephemeris", "rigid_body"))}
 
 
 def test_fmu_is_valid_with_units_and_dependencies(sunline_fmus):
