@@ -32,7 +32,7 @@ class RunInterrupted(_Stopped):
 
     signal: the signal number (exit code 128 + signal in the command line)."""
 
-    def __init__(self, message, signal):
+    def __init__(self, message: str, signal: int) -> None:
         super().__init__(message)
         self.signal = signal
 

@@ -2,6 +2,7 @@
 observers, the result; the instances are freed whatever happens. A run that fails or is
 interrupted raises with the rows recorded so far (`err.result`)."""
 import signal
+from typing import List, Optional, Sequence
 
 from ..errors import RunInterrupted, RunTimedOut, SimulationError
 from .algorithms import Algorithm, FixedStepAlgorithm, ScheduledAlgorithm
@@ -32,15 +33,15 @@ def execute(system, plan, progress=False, timeout=None, observers=()):
             raise
         except TimedOut:
             run.record_last()
-            err = RunTimedOut(f"wall-clock limit of {timeout:g} s reached at t = {run.info.t:g} s")
-            err.result = run.partial(f"timed out at t={run.info.t:g} s")
-            raise err from None
+            timed_out = RunTimedOut(f"wall-clock limit of {timeout:g} s reached at t = {run.info.t:g} s")
+            timed_out.result = run.partial(f"timed out at t={run.info.t:g} s")
+            raise timed_out from None
         except Interrupted as stop:
             name = signal.Signals(stop.signum).name
             run.record_last()
-            err = RunInterrupted(f"interrupted ({name}) at t = {run.info.t:g} s", stop.signum)
-            err.result = run.partial(f"interrupted ({name}) at t={run.info.t:g} s")
-            raise err from None
+            interrupted = RunInterrupted(f"interrupted ({name}) at t = {run.info.t:g} s", stop.signum)
+            interrupted.result = run.partial(f"interrupted ({name}) at t={run.info.t:g} s")
+            raise interrupted from None
         finally:
             table.free()
 
@@ -53,12 +54,13 @@ class _Run:
         self.system, self.plan, self.table = system, plan, table
         self.recorder = self.info = None
 
-    def loop(self, progress, watch, timeout=None, callers=()):
+    def loop(self, progress: bool, watch: SignalWatch, timeout: Optional[float] = None,
+             callers: Sequence[Observer] = ()) -> Result:
         system, plan, table = self.system, self.plan, self.table
         algorithm: Algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
-        observers = [recorder]
+        observers: List[Observer] = [recorder]
         if plan.stops:  # first: the recorder records a row where a stop condition fires
             observers.insert(0, StopConditions(table, plan.stops))
         bar = ProgressBar(plan) if progress else None

@@ -52,7 +52,7 @@ class Result:
 
     @property
     def names(self) -> list:
-        return list(self.data.dtype.names[1:])
+        return list(self.data.dtype.names or ())[1:]
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.data[name]
@@ -123,7 +123,7 @@ def write_csv_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> No
     folder = path.parent if str(path.parent) else Path(".")
     if not folder.is_dir():
         raise SSPError(f"output file {path}: folder {folder} does not exist")
-    names = data.dtype.names
+    names = data.dtype.names or ()
     cols = [data[n].astype(np.int64) if data.dtype[n].kind == "b" else data[n] for n in names]
     with atomic_write(path, "w", newline="") as f:
         w = csv.writer(f)  # the default dialect is RFC 4180's: minimal quoting, CRLF
@@ -146,7 +146,7 @@ def write_parquet_atomic(data: np.ndarray, path, units: Optional[dict] = None) -
         raise SSPError(f"output file {path}: writing Parquet needs pyarrow (pip install pyarrow)") from None
     path = Path(path)
     units = units or {}
-    names = data.dtype.names
+    names = data.dtype.names or ()
     fields = [pa.field(n, pa.from_numpy_dtype(data.dtype[n]),
                        metadata={b"unit": units[n].encode()} if units.get(n) else None) for n in names]
     meta = {b"neighbor-cosim.units": json.dumps({n: units.get(n) for n in names}).encode()}

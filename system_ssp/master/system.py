@@ -6,7 +6,7 @@ from pathlib import Path
 import shutil
 import tempfile
 import time
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 import zipfile
 
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
@@ -38,14 +38,15 @@ class System:
     extracted files."""
 
     def __init__(self, path: PathLike, validate: bool = True):
-        self._tmp = Path(tempfile.mkdtemp(prefix="system_ssp_"))
+        tmp = Path(tempfile.mkdtemp(prefix="system_ssp_"))
+        self._tmp: Optional[Path] = tmp
         try:
-            self._load(Path(path), validate)
+            self._load(Path(path), validate, tmp)
         except BaseException:
             self.close()
             raise
 
-    def _load(self, path, validate):
+    def _load(self, path: Path, validate: bool, tmp: Path) -> None:
         self.path = path
         self.validate = validate
         self.archive_root = None
@@ -55,7 +56,7 @@ class System:
             ssd_path = path / "SystemStructure.ssd"
             self.namer = reader.FileNamer()
         elif path.suffix.lower() == ".ssp":
-            root = self._tmp / "ssp"
+            root = tmp / "ssp"
             try:
                 with zipfile.ZipFile(path) as z:
                     for n in z.namelist():
@@ -76,7 +77,7 @@ class System:
         self.desc = reader.parse_ssd(ssd_path, self.namer, validate)
         if not self.desc.components:
             raise SSPError(f"{self.desc.display}: the system has no components")
-        self.comps = load_components(self.desc, self._tmp / "fmu", self.namer, validate)
+        self.comps = load_components(self.desc, tmp / "fmu", self.namer, validate)
         self.by_name = {c.name: c for c in self.comps}
         self.units = UnitTable(self.desc, self.comps)
         check_connector_units(self.comps, self.units)
@@ -85,26 +86,31 @@ class System:
         self.graph = FeedthroughGraph(self.comps, self.links)
 
     # ---- queries ------------------------------------------------------------------------
-    def default_order(self) -> list:
+    def default_order(self) -> List[str]:
         """Component names in dependency order (feedthrough edges), ties by SSD order.
 
         Raises SSPError naming the components of an algebraic loop."""
         return [self.comps[i].name for i in self.graph.order()]
 
-    def split_name(self, name: str, what: str = "variable"):
+    def split_name(self, name: str, what: str = "variable") -> Tuple[Any, str]:
         """'component.variable' -> (ComponentInfo, variable name); SSPError with suggestions."""
-        return split_name(self.comps, name, what)
+        comp, var = split_name(self.comps, name, what)
+        return comp, var
 
-    def var_unit(self, comp, var) -> Optional[str]:
-        return self.units.var_unit(comp, var)
+    def var_unit(self, comp: Any, var: str) -> Optional[str]:
+        unit: Optional[str] = self.units.var_unit(comp, var)
+        return unit
 
-    def collect_parameters(self, parameter_sets=None, parameters=None) -> dict:
+    def collect_parameters(self, parameter_sets: Optional[Sequence[PathLike]] = None,
+                           parameters: Optional[Mapping[str, Any]] = None) -> Dict[Tuple[int, str], Any]:
         """All start values for a run: {(comp index, var): value}, later sources overriding earlier."""
-        return collect_parameters(self, parameter_sets, parameters)
+        values: Dict[Tuple[int, str], Any] = collect_parameters(self, parameter_sets, parameters)
+        return values
 
     def info(self) -> str:
         """Human-readable description (components, connectors with units, bindings, experiment)."""
-        return describe_system(self)
+        text: str = describe_system(self)
+        return text
 
     # ---- running ------------------------------------------------------------------------
     def run(self, options: Optional[RunOptions] = None, *, observers: Sequence[Observer] = (),
@@ -128,7 +134,7 @@ class System:
                  plan.start, plan.stop, f", {plan.n_steps} steps of {plan.step_size:g} s" if plan.schedule is None
                  else ", nc:Schedule")
         try:
-            result = execute(self, plan, progress, timeout, observers)
+            result: Result = execute(self, plan, progress, timeout, observers)
         except (SimulationError, RunInterrupted, RunTimedOut) as err:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
@@ -145,17 +151,18 @@ class System:
 
     # ---- cleanup ------------------------------------------------------------------------
     def close(self) -> None:
-        if getattr(self, "_tmp", None) is not None:
-            shutil.rmtree(self._tmp, ignore_errors=True)
+        tmp = getattr(self, "_tmp", None)
+        if tmp is not None:
+            shutil.rmtree(tmp, ignore_errors=True)
             self._tmp = None
 
     def __enter__(self) -> "System":
         return self
 
-    def __exit__(self, *exc) -> None:
+    def __exit__(self, *exc: object) -> None:
         self.close()
 
-    def __del__(self):
+    def __del__(self) -> None:
         try:
             self.close()
         except Exception:

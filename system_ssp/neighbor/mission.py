@@ -28,6 +28,7 @@ import argparse
 import json
 from pathlib import Path
 import sys
+from typing import Dict
 
 import numpy as np
 
@@ -54,7 +55,7 @@ WH = 3600.0
 # tracking, propellant sizing, power and data budgets (sections 3.3.9, 3.5, 3.6).
 # Each published value is taken from where its case is defined: the attitude cases (thesis
 # runner), the burn and lifetime (de-orbit study), the sizing (propulsion report).
-_ATTITUDE = {"detumble_time_s": thesis.THESIS["detumble_case1"]["duration"],
+_ATTITUDE: Dict[str, float] = {"detumble_time_s": thesis.THESIS["detumble_case1"]["duration"],
              "slew_time_s": thesis.THESIS["slew_case1"]["duration"],
              "detumble_propellant_g": thesis.THESIS["detumble_case1"]["propellant"],
              "slew_propellant_g": thesis.THESIS["slew_case1"]["propellant"]}

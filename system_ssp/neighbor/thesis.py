@@ -19,6 +19,7 @@ time.
 import argparse
 import math
 from dataclasses import dataclass, field
+from typing import Any, Dict, Optional
 from pathlib import Path
 
 from components.core import rotations
@@ -30,7 +31,7 @@ from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_sett
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
 # omega in deg/s as printed, the printed "Euler angles" (Eq. 31: rates integrated, deg),
 # durations in s, propellant in g.
-THESIS = {
+THESIS: Dict[str, Dict[str, Any]] = {
     "detumble_case1": dict(duration=9.97, propellant=2.36, q=(0.1460, 0.4400, 0.2256, 0.8573),
                            omega=(0.0019, 0.0013, -0.0003), euler=(22.32, 53.52, 21.71),
                            source="Eq. 34, section 3.3.9"),
@@ -65,9 +66,9 @@ class CaseResult:
     converged: bool
     duration: float  # s
     propellant: float  # g
-    q: tuple = None
-    omega_deg: tuple = None
-    euler_deg: tuple = None  # Eq. 31's integrated angles at the end (deg), as the thesis prints them
+    q: Optional[tuple] = None
+    omega_deg: Optional[tuple] = None
+    euler_deg: Optional[tuple] = None  # Eq. 31's integrated angles at the end (deg), as the thesis prints them
     steps: int = 0
     wall_time: float = 0.0
     parts: list = field(default_factory=list)

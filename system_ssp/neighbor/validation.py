@@ -18,6 +18,7 @@ import os
 from pathlib import Path
 import re
 import sys
+from typing import Any, Dict
 
 from components.mission.neighbor import DEFAULT_SCENARIO
 
@@ -205,7 +206,7 @@ if len(BY_KEY) != len(NUMBERS):
     raise RuntimeError("duplicate keys in the validation table")
 
 # key -> test node ids that checked it in this process (read by the suite's coverage check)
-CHECKED = {}
+CHECKED: Dict[str, Any] = {}
 
 
 def assert_reproduces(key, ours):

@@ -11,6 +11,7 @@ that component, for a binding on the root system they are `component.variable`.
 from collections import namedtuple
 from dataclasses import dataclass, field
 import math
+from typing import Any, Dict, Optional
 from pathlib import Path
 import urllib.parse
 
@@ -44,7 +45,7 @@ ROOT_TAGS = {
 }
 TYPE_TAGS = ("Real", "Integer", "Boolean", "String", "Enumeration", "Binary")
 
-_schemas = {}
+_schemas: Dict[str, Any] = {}
 
 
 def _schema(kind):
@@ -72,8 +73,8 @@ ParamValue = namedtuple("ParamValue", "name type value unit units origin")
 class Connector:
     name: str
     kind: str
-    type: str = None  # declared type (ssc:Real, ...) or None
-    unit: str = None
+    type: Optional[str] = None  # declared type (ssc:Real, ...) or None
+    unit: Optional[str] = None
     origin: str = ""
 
 
@@ -94,7 +95,7 @@ class Connection:
     start_connector: str
     end_element: str
     end_connector: str
-    transform: tuple = None  # ("linear", factor, offset) | ("boolmap", {..}) | ("intmap", {..})
+    transform: Optional[tuple] = None  # ("linear", factor, offset) | ("boolmap", {..}) | ("intmap", {..})
     suppress_unit_conversion: bool = False
     origin: str = ""
 
@@ -107,13 +108,13 @@ class Connection:
 @dataclass
 class MasterSettings:
     """Contents of the `org.neighbor-cosim.master` annotation(s)."""
-    step_size: float = None
-    algorithm: str = None
-    order: list = None
+    step_size: Optional[float] = None
+    algorithm: Optional[str] = None
+    order: Optional[list] = None
     order_origin: str = ""  # file:line of nc:Order
     step_multiples: dict = field(default_factory=dict)
     stop_conditions: list = field(default_factory=list)
-    schedule: "Schedule" = None
+    schedule: Optional["Schedule"] = None
     origin: str = ""
 
 
@@ -123,7 +124,7 @@ class ScheduleMode:
     the `active` components (None = all)."""
     name: str
     step_size: float
-    active: list = None
+    active: Optional[list] = None
     record_every: int = 1
     every: dict = field(default_factory=dict)  # component -> k: stepped every k-th step of the mode
     conditions: list = field(default_factory=list)  # [(component, connector, frozenset of ints)]
@@ -148,8 +149,8 @@ class SystemDescription:
     system_connectors: dict = field(default_factory=dict)
     connections: list = field(default_factory=list)
     units: dict = field(default_factory=dict)  # name -> Unit (ssd:Units)
-    start_time: float = None
-    stop_time: float = None
+    start_time: Optional[float] = None
+    stop_time: Optional[float] = None
     parameters: list = field(default_factory=list)  # root-system bindings, names comp.var
     master: MasterSettings = field(default_factory=MasterSettings)
 

@@ -48,11 +48,11 @@ import math
 from components.orbit import circular
 from components.attitude import rigid_body
 from components.environment import sun
-from components.mission.neighbor import SPACECRAFT
+from components.mission.neighbor import SPACECRAFT as BASELINE
 
 from ...ssp.writer import vec
 
-MASS, EDGES = SPACECRAFT.mass, {"edge_a": SPACECRAFT.edge_a, "edge_b": SPACECRAFT.edge_b, "edge_c": SPACECRAFT.edge_c}
+MASS, EDGES = BASELINE.mass, {"edge_a": BASELINE.edge_a, "edge_b": BASELINE.edge_b, "edge_c": BASELINE.edge_c}
 J = rigid_body.box_inertia(MASS, EDGES["edge_a"], EDGES["edge_b"], EDGES["edge_c"])
 IX, IY, IZ = float(J[0][0]), float(J[1][1]), float(J[2][2])
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0}

@@ -5,6 +5,7 @@ import math
 import os
 import tempfile
 import time
+from typing import Dict
 
 import numpy as np
 
@@ -13,7 +14,7 @@ from components.environment import space_weather
 from ...errors import RunTimedOut, SSPError
 from ...master import System
 
-_SYSTEMS = {}  # system path -> System, for the life of this process
+_SYSTEMS: Dict[str, System] = {}  # system path -> System, for the life of this process
 
 
 def _system(path):
