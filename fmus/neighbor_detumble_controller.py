@@ -10,9 +10,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import detumble, thruster_control
 
-RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-ACCEL_INPUTS = [f"omega_dot_BN_B[{i}]" for i in (1, 2, 3)]
-
 
 class DetumbleController(NeighborSlave):
     description = ("Detumble controller: PD on body rates quantized to RCS thruster-pair torques (NEIGHBOR thesis "
@@ -32,7 +29,7 @@ class DetumbleController(NeighborSlave):
                        "test omega - omega_d <= tol (the thesis cases)",
                        bool)
         self.thruster_controller_interface(
-            self._command, self._done, RATE_INPUTS + ACCEL_INPUTS, RATE_INPUTS,
+            self._command, self._done, lambda s: s.omega_BN_B + s.omega_dot_BN_B, lambda s: s.omega_BN_B,
             "Detumble complete: rates within tolerance (Appendix D stop test), for settle_time when it is > 0")
         self.parameter("settle_time", 0.0, "s",
                        "Settle criterion: done once the rates have stayed within omega_tol for this long (>= 0); "

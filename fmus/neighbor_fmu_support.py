@@ -17,7 +17,7 @@ are when it is read (true direct feedthrough, as FMI co-simulation masters expec
 """
 import copy
 from collections import OrderedDict
-from typing import Any, Callable, Iterable, Optional, Sequence, Union
+from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Tuple, Union
 
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.fmi2slave import Fmi2Slave
@@ -27,6 +27,34 @@ from components.mission.neighbor import SPACECRAFT
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
 Scalar = Union[float, int, bool, str]
+Names = Tuple[str, ...]  # what a declaration returns: the FMI names it declared, in order
+
+
+def element_names(name: str, n: int) -> Names:
+    """The FMI structured names of a vector variable: name[1] .. name[n]."""
+    return tuple(f"{name}[{i}]" for i in range(1, n + 1))
+
+
+def matrix_names(name: str, rows: int, cols: int) -> Tuple[Names, ...]:
+    """The FMI structured names of a matrix variable, by row: ((name[1,1], name[1,2], ..), ..)."""
+    return tuple(tuple(f"{name}[{i},{j}]" for j in range(1, cols + 1)) for i in range(1, rows + 1))
+
+
+# The moving-target inputs of the RCS controller family (declared by `target_inputs`), named here
+# once because a controller's outputs depend on them before they are declared.
+TARGET_ATTITUDE = element_names("q_target_BN", 4)
+TARGET_RATE = element_names("omega_target_B", 3)
+
+
+class ControllerSignals(NamedTuple):
+    """What `thruster_controller_interface` declares, by connector."""
+    q_BN: Names
+    omega_BN_B: Names
+    omega_dot_BN_B: Names
+    enabled: str
+    torque_cmd_B: Names
+    thrust_flag: Names
+    done: str
 
 
 class ParameterError(ValueError):
@@ -80,7 +108,7 @@ class NeighborSlave(Fmi2Slave):
         }
         return var
 
-    def parameter(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> None:
+    def parameter(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> str:
         self.values[name] = kind(start)
 
         def setter(value, name=name):
@@ -89,13 +117,16 @@ class NeighborSlave(Fmi2Slave):
 
         self._register(name, kind, Fmi2Causality.parameter, Fmi2Variability.fixed, unit, description,
                        setter=setter, initial=Fmi2Initial.exact)
+        return name
 
     def parameter_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
-                        kind: type = float) -> None:
-        for i, start in enumerate(starts, 1):
-            self.parameter(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
+                        kind: type = float) -> Names:
+        names = element_names(name, len(starts))
+        for i, (element, start) in enumerate(zip(names, starts), 1):
+            self.parameter(element, start, unit, f"{description} (component {i})", kind)
+        return names
 
-    def input(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> None:
+    def input(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> str:
         self.values[name] = kind(start)
 
         def setter(value, name=name):
@@ -104,28 +135,37 @@ class NeighborSlave(Fmi2Slave):
 
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
+        return name
 
     def input_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
-                    kind: type = float) -> None:
-        for i, start in enumerate(starts, 1):
-            self.input(f"{name}[{i}]", start, unit, f"{description} (component {i})", kind)
+                    kind: type = float) -> Names:
+        names = element_names(name, len(starts))
+        for i, (element, start) in enumerate(zip(names, starts), 1):
+            self.input(element, start, unit, f"{description} (component {i})", kind)
+        return names
 
     def output(self, name: str, getter: Callable[[], Scalar], unit: Optional[str], description: str,
-               kind: type = float, depends_on: Iterable[str] = ()) -> None:
+               kind: type = float, depends_on: Iterable[str] = ()) -> str:
         """`depends_on`: input names this output depends on directly (feedthrough)."""
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         self._register(name, kind, Fmi2Causality.output, variability, unit, description,
                        getter=lambda: kind(getter()), initial=Fmi2Initial.calculated,
                        depends_on=depends_on)
+        return name
 
     def output_array(self, name: str, n: int, getter: Callable[[], Sequence[Scalar]], unit: Optional[str],
-                     description: str, kind: type = float, depends_on: Iterable[str] = ()) -> None:
+                     description: str, kind: type = float, depends_on: Iterable[str] = ()) -> Names:
         """`getter()` returns the whole vector; element i is output as `name[i+1]`."""
-        for i in range(n):
-            self.output(f"{name}[{i + 1}]", lambda i=i: getter()[i], unit,
-                        f"{description} (component {i + 1})", kind, depends_on)
+        names = element_names(name, n)
+        for i, element in enumerate(names):
+            self.output(element, lambda i=i: getter()[i], unit, f"{description} (component {i + 1})", kind,
+                        depends_on)
+        return names
 
-    def thruster_controller_interface(self, command, done, inputs, done_inputs, done_description):
+    def thruster_controller_interface(self, command: Callable[[], Any], done: Callable[[], bool],
+                                      reads: Callable[[ControllerSignals], Iterable[str]],
+                                      done_reads: Callable[[ControllerSignals], Iterable[str]],
+                                      done_description: str) -> ControllerSignals:
         """The connectors every RCS attitude controller shares (the controller interface family:
         detumble, slew, tracking), so that a system swaps one controller for another by
         replacing a component: the attitude knowledge `q_BN[4]`, `omega_BN_B[3]`,
@@ -134,33 +174,39 @@ class NeighborSlave(Fmi2Slave):
         and `done`.
 
         `command()` returns (torque, flags) from the current inputs, `done()` the stop test;
-        `inputs` / `done_inputs` are the input names they read (their output dependencies)."""
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
-        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
-        self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2",
-                         "Angular acceleration of the last step (read by laws with a derivative term)")
-        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
+        `reads` / `done_reads` give, from the declared connectors, the input names they read
+        (their output dependencies). Returns every connector's names."""
+        q = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
+        w = self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
+        w_dot = self.input_array("omega_dot_BN_B", [0.0] * 3, "rad/s2",
+                                 "Angular acceleration of the last step (read by laws with a derivative term)")
+        enabled = self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
+        declared = ControllerSignals(q, w, w_dot, enabled, (), (), "")
 
         def gated():
-            return command() if self.values["enabled"] else ([0.0, 0.0, 0.0], [0, 0, 0])
+            return command() if self.values[enabled] else ([0.0, 0.0, 0.0], [0, 0, 0])
 
-        deps = list(inputs) + ["enabled"]
-        self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(gated)[0], "N.m",
-                          "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
-        self.output_array("thrust_flag", 3, lambda: self.feedthrough(gated)[1], None,
-                          "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
-                          depends_on=deps)
-        self.output("done", lambda: self.feedthrough(done), None, done_description, bool, depends_on=done_inputs)
+        deps = list(reads(declared)) + [enabled]
+        torque = self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(gated)[0], "N.m",
+                                   "Commanded body torque, quantized to +-torque_level or 0", depends_on=deps)
+        flags = self.output_array("thrust_flag", 3, lambda: self.feedthrough(gated)[1], None,
+                                  "Thruster pair signal per axis: 1 positive torque, -1 negative, 0 off", int,
+                                  depends_on=deps)
+        finished = self.output("done", lambda: self.feedthrough(done), None, done_description, bool,
+                               depends_on=list(done_reads(declared)))
+        return declared._replace(torque_cmd_B=torque, thrust_flag=flags, done=finished)
 
-    def target_inputs(self, used_when):
+    def target_inputs(self, used_when: str) -> Names:
         """The moving-target inputs of the RCS controller family, `q_target_BN[4]` and
         `omega_target_B[3]` (the burn guidance's attitude and rate), declared after a controller's
         other variables so that their value references stay as they were. `used_when` says when
-        this law reads them."""
-        self.input_array("q_target_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         f"Target attitude quaternion q_BN, scalar last, from the guidance; {used_when}")
-        self.input_array("omega_target_B", [0.0] * 3, "rad/s",
-                         f"Target angular velocity in B, from the guidance; {used_when}")
+        this law reads them. Their names are TARGET_ATTITUDE and TARGET_RATE."""
+        q = self.input_array("q_target_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                             f"Target attitude quaternion q_BN, scalar last, from the guidance; {used_when}")
+        w = self.input_array("omega_target_B", [0.0] * 3, "rad/s",
+                             f"Target angular velocity in B, from the guidance; {used_when}")
+        assert (q, w) == (TARGET_ATTITUDE, TARGET_RATE)  # the names outputs declared earlier depend on
+        return q + w
 
     def attitude_measurement_inputs(self):
         """The inputs of the attitude-knowledge family (AttitudeDetermination, AttitudeEstimator):
@@ -183,9 +229,9 @@ class NeighborSlave(Fmi2Slave):
         self.parameter("edge_c", SPACECRAFT.edge_c, "m", "Box edge c along body x (Appendix A c = 0.3 m)")
         self.parameter("inertia_from_box", True, None,
                        "True: inertia of a uniform box from mass and edges (Eq. 4); false: use inertia_B", bool)
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.parameter(f"inertia_B[{i},{j}]", 0.0, "kg.m2",
+        for i, row in enumerate(matrix_names("inertia_B", 3, 3), 1):
+            for j, element in enumerate(row, 1):
+                self.parameter(element, 0.0, "kg.m2",
                                f"Inertia tensor element ({i},{j}) in B, used when inertia_from_box is false")
 
     def inertia(self, box_inertia):
@@ -193,7 +239,7 @@ class NeighborSlave(Fmi2Slave):
         v = self.values
         if v["inertia_from_box"]:
             return box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"])
-        return [[v[f"inertia_B[{i},{j}]"] for j in range(1, 4)] for i in range(1, 4)]
+        return [[v[element] for element in row] for row in matrix_names("inertia_B", 3, 3)]
 
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute: Callable[[], Any]) -> Any:
@@ -214,7 +260,7 @@ class NeighborSlave(Fmi2Slave):
         """[values of name[1] .. name[n]] (the element names are built once, not per call)."""
         keys = self._vector_keys.get((name, n))
         if keys is None:
-            keys = self._vector_keys[(name, n)] = [f"{name}[{i}]" for i in range(1, n + 1)]
+            keys = self._vector_keys[(name, n)] = list(element_names(name, n))
         values = self.values
         return [values[k] for k in keys]
 

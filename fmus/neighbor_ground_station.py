@@ -11,8 +11,6 @@ from neighbor_fmu_support import NeighborSlave
 from components.mission import ground_station as gs
 from components.core import time_utils
 
-R = ["r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]"]
-
 
 class GroundStation(NeighborSlave):
     description = ("Ground station at UIUC (40.1020 N, 88.2272 W): elevation, azimuth, range and visibility of "
@@ -33,20 +31,21 @@ class GroundStation(NeighborSlave):
         self.parameter("approach_margin", gs.APPROACH_MARGIN, "rad",
                        "near_contact is true above elevation_mask - approach_margin, in [0, pi]; default 20 deg "
                        "(a 300-420 km orbit needs at least 448 s from there to the mask)")
-        self.input_array("r_BN_N", [gs.geodesy.WGS84_A + 420e3, 0.0, 0.0], "m",
-                         "Spacecraft position relative to Earth's centre in N")
+        position = self.input_array("r_BN_N", [gs.geodesy.WGS84_A + 420e3, 0.0, 0.0], "m",
+                                    "Spacecraft position relative to Earth's centre in N")
         look = lambda: self.model.look(self.vector("r_BN_N", 3))  # noqa: E731
         self.output("visible", lambda: look()[0] >= self.model.elevation_mask, None,
-                    "Spacecraft in contact: elevation >= elevation_mask", bool, depends_on=R)
+                    "Spacecraft in contact: elevation >= elevation_mask", bool, depends_on=position)
         self.output("elevation", lambda: look()[0], "rad", "Elevation of the spacecraft above the station's "
-                    "horizon (ellipsoid normal)", depends_on=R)
+                    "horizon (ellipsoid normal)", depends_on=position)
         self.output("azimuth", lambda: look()[1], "rad", "Azimuth of the spacecraft from north toward east, "
-                    "in [0, 2 pi)", depends_on=R)
-        self.output("range", lambda: look()[2], "m", "Distance from the station to the spacecraft", depends_on=R)
+                    "in [0, 2 pi)", depends_on=position)
+        self.output("range", lambda: look()[2], "m", "Distance from the station to the spacecraft", depends_on=position)
         self.output("near_contact", lambda: self.model.near_contact(self.vector("r_BN_N", 3)), None,
-                    "A contact may begin soon: elevation > elevation_mask - approach_margin", bool, depends_on=R)
+                    "A contact may begin soon: elevation > elevation_mask - approach_margin", bool, depends_on=position)
         self.output("ground_command", lambda: self.model.ground_command(self.vector("r_BN_N", 3)), None,
-                    "Ground's final de-orbit confirmation: visible and time >= confirm_after", bool, depends_on=R)
+                    "Ground's final de-orbit confirmation: visible and time >= confirm_after", bool,
+                    depends_on=position)
 
     def build_model(self):
         v = self.values

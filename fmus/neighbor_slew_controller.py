@@ -11,13 +11,11 @@ and the rates within omega_tol for that long. State: the time the stop test has 
 """
 import math
 
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import TARGET_ATTITUDE, TARGET_RATE, NeighborSlave
 
 from components.attitude import slew, thruster_control
 
-Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-TARGET_INPUTS = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
+TARGET_INPUTS = TARGET_ATTITUDE + TARGET_RATE
 
 
 class SlewController(NeighborSlave):
@@ -37,14 +35,14 @@ class SlewController(NeighborSlave):
         self.parameter("accept_antipodal", False, None,
                        "True: done also when each element matches -q_d (Appendix G); false: q_d only (Appendix E)",
                        bool)
-        deps = Q_INPUTS + RATE_INPUTS + TARGET_INPUTS
-        self.thruster_controller_interface(
-            self._command, self._done, deps, deps,
+        reads = lambda s: s.q_BN + s.omega_BN_B + TARGET_INPUTS  # noqa: E731
+        ctl = self.thruster_controller_interface(
+            self._command, self._done, reads, reads,
             "Slew complete: quaternion and rates within tolerance (Appendix E/G stop test; with settle_time, "
             "error angle and rates held within tolerance for settle_time)")
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
                     "Rotation angle from the current to the target attitude, 2 acos|dq4|",
-                    depends_on=Q_INPUTS + TARGET_INPUTS)
+                    depends_on=ctl.q_BN + TARGET_INPUTS)
         self.parameter("target_from_input", False, None,
                        "True: target from the inputs q_target_BN and omega_target_B (burn guidance); false: the "
                        "fixed parameters q_d and omega_d (the thesis cases)", bool)

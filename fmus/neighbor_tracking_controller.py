@@ -14,13 +14,11 @@ q_target_BN and omega_target_B instead: the burn attitude the guidance computes 
 orbit, in place of the Eq. 67 rate at Re + 400 km; each new target re-anchors q_d, which is
 propagated in between (DeorbitTrackingController.follow).
 """
-from neighbor_fmu_support import NeighborSlave
+from neighbor_fmu_support import TARGET_ATTITUDE, TARGET_RATE, NeighborSlave
 
 from components.attitude import deorbit_tracking, rigid_body, thruster_control
 
-Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-TARGET_INPUTS = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
+TARGET_INPUTS = TARGET_ATTITUDE + TARGET_RATE
 
 
 class TrackingController(NeighborSlave):
@@ -44,23 +42,23 @@ class TrackingController(NeighborSlave):
         self.inertia_parameters("Spacecraft mass for the box inertia the law uses (Eq. 4)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
-        deps = Q_INPUTS + RATE_INPUTS + TARGET_INPUTS
-        self.thruster_controller_interface(
-            self._command, self._done, deps, deps,
+        reads = lambda s: s.q_BN + s.omega_BN_B + TARGET_INPUTS  # noqa: E731
+        ctl = self.thruster_controller_interface(
+            self._command, self._done, reads, reads,
             "Tracking converged: every sliding-vector component within its threshold e (the burn itself "
             "ends on the propellant budget, not on this signal)")
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
                     "Rotation angle from the desired to the current attitude, 2 acos|dq4|",
-                    depends_on=Q_INPUTS + TARGET_INPUTS)
+                    depends_on=ctl.q_BN + TARGET_INPUTS)
         self.output("pointing_error", lambda: self.feedthrough(self._pointing), "rad",
                     "Angle between the body x axis (de-orbit thrust axis) and the desired x axis",
-                    depends_on=Q_INPUTS + TARGET_INPUTS)
+                    depends_on=ctl.q_BN + TARGET_INPUTS)
         self.output_array("q_d", 4, lambda: self.feedthrough(self._target), "1",
                           "Desired quaternion q_BN, scalar last (equals q_BN while the latch is pending)",
-                          depends_on=Q_INPUTS + TARGET_INPUTS)
+                          depends_on=ctl.q_BN + TARGET_INPUTS)
         self.output_array("sliding_vector", 3, lambda: self.feedthrough(self._evaluate)[2], "rad/s",
                           "Sliding vector s = omega - omega_d + k sign(dq4) dq_1:3 (Eq. 70)",
-                          depends_on=deps)
+                          depends_on=reads(ctl))
         self.parameter("target_from_input", False, None,
                        "True: q_d and omega_d are the inputs q_target_BN and omega_target_B (burn guidance from the "
                        "actual orbit); false: the thesis' q_d propagated at the parameter omega_d", bool)

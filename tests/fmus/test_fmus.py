@@ -1,5 +1,6 @@
 """Each FMU on its own through FMPy: a valid model description, standalone simulation,
 get/set of the full state, and the incremental build."""
+import ast
 import math
 import re
 import zipfile
@@ -7,6 +8,7 @@ import zipfile
 import fmpy
 import pytest
 
+import build_fmus
 from build_fmus import wrapper_scripts
 from fmu_helpers import check_declarations, instantiate
 
@@ -181,3 +183,43 @@ def test_feedthrough_cache_follows_parameters_and_restored_state():
     assert d.get_real([out])[0] > 0
     d._set_fmu_state(saved)
     assert d.get_real([out])[0] < 0
+
+
+def _retyped_element_names(script):
+    """Lines where a wrapper spells FMI element names itself (f"x[{i}]" or "x[1]") instead of
+    taking them from the declaration that made them (input_array etc. return their names)."""
+    tree = ast.parse(script.read_text(), str(script))
+    lines = set()
+    for node in ast.walk(tree):
+        if isinstance(node, ast.JoinedStr):
+            parts = node.values
+            if any(isinstance(a, ast.Constant) and str(a.value).endswith("[") and isinstance(b, ast.FormattedValue)
+                   for a, b in zip(parts, parts[1:])):
+                lines.add(node.lineno)
+        elif isinstance(node, ast.Constant) and isinstance(node.value, str) and re.fullmatch(
+                r"\w+\[\d+(,\d+)?\]", node.value):
+            lines.add(node.lineno)
+    return sorted(lines)
+
+
+# Wrappers that still build their own lists of element names (issue 23: converted so far are the
+# RCS controller family and the support module; each conversion removes its name here).
+RETYPING = {"neighbor_acs_control", "neighbor_acs_signals", "neighbor_air_bearing_kinematics", "neighbor_atmosphere",
+            "neighbor_attitude_determination", "neighbor_attitude_to_dcm", "neighbor_burn_guidance",
+            "neighbor_earth_shadow", "neighbor_gps_receiver", "neighbor_gyro", "neighbor_horizon_sensor",
+            "neighbor_magnetic_field", "neighbor_rcs_thruster_set", "neighbor_rcs_thrusters",
+            "neighbor_reference_tracking_controller", "neighbor_sun_sensor", "neighbor_sunline_ephemeris",
+            "neighbor_torque_coils", "neighbor_torque_selector"}
+
+
+def test_wrappers_take_declared_names_from_their_declarations():
+    found = {s.stem: _retyped_element_names(s) for s in wrapper_scripts()}
+    support = build_fmus.FMU_SOURCES / "neighbor_fmu_support.py"
+    helpers = [f for f in ast.walk(ast.parse(support.read_text())) if isinstance(f, ast.FunctionDef)
+               and f.name in ("element_names", "matrix_names")]
+    spelled = {n for f in helpers for n in range(f.lineno, f.end_lineno + 1)}
+    assert len(helpers) == 2 and set(_retyped_element_names(support)) <= spelled, \
+        "the support module spells element names in its two naming helpers only"
+    offenders = {name: lines for name, lines in found.items() if lines}
+    assert set(offenders) - RETYPING == set(), f"wrappers that retype declared names: {offenders}"
+    assert RETYPING - set(offenders) == set(), "converted wrappers: take them out of RETYPING"
