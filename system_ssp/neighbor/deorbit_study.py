@@ -39,7 +39,8 @@ KM = 1000.0
 SYSTEMS = DEORBIT_SYSTEMS
 # Section 3.2 per scenario, from the mission definition: initial altitude and target perigee (km),
 # delta-V (m/s), propellant (kg), burn (min), lifetime without / with NEIGHBOR (years), figure
-THESIS = {name: dict(h0=s.altitude_km, target=s.target_perigee_km, **s.thesis) for name, s in SCENARIOS.items()}
+THESIS = {name: dict(h0=s.altitude_km, target=s.target_perigee_km, **s.thesis) for name, s in SCENARIOS.items()
+          if s.thesis}  # the study compares with the thesis: the scenarios it published
 # `--space-weather thesis`: a stand-in for the thesis' space-weather file (docs/models/orbit.md,
 # "Lifetimes"): the bundled history to the scenarios' start, then the solar-cycle-25 maximum at the
 # level the predictions of the time gave (130 sfu, ap 9) and, from 2030, the solar-minimum entry a

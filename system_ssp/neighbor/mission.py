@@ -198,7 +198,7 @@ def summarize(r, scenario, orbit):
     i_clear = _first(after & (store <= 0.5))
     s["contacts_to_downlink"] = None if i_clear is None else int(np.sum(rises <= i_clear))
     s["lifetime_with_burn_years"] = (r.stop_time - starts[DeorbitPhase.BURN][1]) / YEAR if s["reentered"] else None
-    s["thesis"] = THESIS[scenario]
+    s["thesis"] = THESIS.get(scenario, {})  # a scenario the thesis did not publish: no column
     s["propulsion"] = propulsion_report.of_mission(s)
     return s
 
