@@ -17,33 +17,20 @@ are when it is read (true direct feedthrough, as FMI co-simulation masters expec
 """
 import copy
 from collections import OrderedDict
-from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Tuple, Union
+from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
 
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.fmi2slave import Fmi2Slave
 from pythonfmu.variables import Boolean, Integer, Real, String
 
+from components.core.names import Names, element_names, matrix_names
 from components.mission.neighbor import SPACECRAFT
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
 Scalar = Union[float, int, bool, str]
-Names = Tuple[str, ...]  # what a declaration returns: the FMI names it declared, in order
-
-
-def element_names(name: str, n: int) -> Names:
-    """The FMI structured names of a vector variable: name[1] .. name[n]."""
-    return tuple(f"{name}[{i}]" for i in range(1, n + 1))
-
-
-def matrix_names(name: str, rows: int, cols: int) -> Tuple[Names, ...]:
-    """The FMI structured names of a matrix variable, by row: ((name[1,1], name[1,2], ..), ..)."""
-    return tuple(tuple(f"{name}[{i},{j}]" for j in range(1, cols + 1)) for i in range(1, rows + 1))
-
-
 # The moving-target inputs of the RCS controller family (declared by `target_inputs`), named here
 # once because a controller's outputs depend on them before they are declared.
-TARGET_ATTITUDE = element_names("q_target_BN", 4)
-TARGET_RATE = element_names("omega_target_B", 3)
+TARGET_INPUTS = element_names("q_target_BN", 4) + element_names("omega_target_B", 3)
 
 
 class ControllerSignals(NamedTuple):
@@ -200,12 +187,12 @@ class NeighborSlave(Fmi2Slave):
         """The moving-target inputs of the RCS controller family, `q_target_BN[4]` and
         `omega_target_B[3]` (the burn guidance's attitude and rate), declared after a controller's
         other variables so that their value references stay as they were. `used_when` says when
-        this law reads them. Their names are TARGET_ATTITUDE and TARGET_RATE."""
+        this law reads them. Their names are TARGET_INPUTS."""
         q = self.input_array("q_target_BN", [0.0, 0.0, 0.0, 1.0], "1",
                              f"Target attitude quaternion q_BN, scalar last, from the guidance; {used_when}")
         w = self.input_array("omega_target_B", [0.0] * 3, "rad/s",
                              f"Target angular velocity in B, from the guidance; {used_when}")
-        assert (q, w) == (TARGET_ATTITUDE, TARGET_RATE)  # the names outputs declared earlier depend on
+        assert q + w == TARGET_INPUTS  # the names outputs declared earlier depend on
         return q + w
 
     def attitude_measurement_inputs(self):

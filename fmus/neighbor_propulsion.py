@@ -12,12 +12,9 @@ communication point. The orbit FMUs take `mass` and `F_thrust_B` as inputs.
 """
 from neighbor_fmu_support import NeighborSlave
 
-from components.mission.neighbor import DEFAULT_SCENARIO, SCENARIOS
 from components.orbit import propulsion
 
-_KM = 1000.0
-_DEFAULT_BUDGET = propulsion.deorbit_scenario(SCENARIOS[DEFAULT_SCENARIO].altitude_km * _KM,
-                                              SCENARIOS[DEFAULT_SCENARIO].target_perigee_km * _KM)["propellant"]
+_DEFAULT_BUDGET = propulsion.mission_scenario()["propellant"]
 
 
 class Propulsion(NeighborSlave):

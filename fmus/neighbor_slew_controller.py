@@ -11,11 +11,9 @@ and the rates within omega_tol for that long. State: the time the stop test has 
 """
 import math
 
-from neighbor_fmu_support import TARGET_ATTITUDE, TARGET_RATE, NeighborSlave
+from neighbor_fmu_support import TARGET_INPUTS, NeighborSlave
 
 from components.attitude import slew, thruster_control
-
-TARGET_INPUTS = TARGET_ATTITUDE + TARGET_RATE
 
 
 class SlewController(NeighborSlave):

@@ -14,11 +14,9 @@ q_target_BN and omega_target_B instead: the burn attitude the guidance computes 
 orbit, in place of the Eq. 67 rate at Re + 400 km; each new target re-anchors q_d, which is
 propagated in between (DeorbitTrackingController.follow).
 """
-from neighbor_fmu_support import TARGET_ATTITUDE, TARGET_RATE, NeighborSlave
+from neighbor_fmu_support import TARGET_INPUTS, NeighborSlave
 
 from components.attitude import deorbit_tracking, rigid_body, thruster_control
-
-TARGET_INPUTS = TARGET_ATTITUDE + TARGET_RATE
 
 
 class TrackingController(NeighborSlave):

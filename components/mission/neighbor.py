@@ -18,6 +18,7 @@ import math
 from types import MappingProxyType
 from typing import Mapping, Optional, Tuple
 
+from ..core.names import element_names as elements
 from ..core.time_utils import DEFAULT_EPOCH
 
 
@@ -89,7 +90,7 @@ DEFAULT_SCENARIO = "420km"  # the thesis sizes the tank, power and data budgets 
 
 # The systems (system_ssp/systems/<name>.ssd, packed as build/ssp/<name>.ssp) by orbit fidelity:
 # the Cowell orbit (Orbit FMU) or the orbit-averaged one (OrbitAveraged, the default: years in seconds).
-ORBIT_MODELS = ("averaged", "cowell")
+ORBIT_FMUS: Mapping[str, str] = MappingProxyType({"averaged": "OrbitAveraged", "cowell": "Orbit"})
 MISSION_SYSTEMS: Mapping[str, str] = MappingProxyType({"averaged": "neighbor_mission_lifetime",
                                                        "cowell": "neighbor_mission"})
 DEORBIT_SYSTEMS: Mapping[str, str] = MappingProxyType({"averaged": "deorbit_lifetime", "cowell": "deorbit"})
@@ -109,11 +110,6 @@ GNC_SETS: Mapping[str, Optional[str]] = MappingProxyType({
     "thesis": "mission_gnc_thesis",  # the thesis' guidance and control: its published numbers
 })
 DEFAULT_GNC = "closed-loop"
-
-
-def elements(name: str, n: int) -> Tuple[str, ...]:
-    """The FMI structured names of a vector variable: name[1] .. name[n]."""
-    return tuple(f"{name}[{i}]" for i in range(1, n + 1))
 
 
 # What the mission records (rows per nc:Schedule mode) for its summary and figures.

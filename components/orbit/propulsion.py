@@ -37,7 +37,7 @@ import math
 from ..core import checks
 from ..core.constants import MU_EARTH, R_EQ
 from ..core.checks import positive
-from ..mission.neighbor import SPACECRAFT
+from ..mission.neighbor import DEFAULT_SCENARIO, SCENARIOS, SPACECRAFT
 
 # The spacecraft's values, from the mission definition (components.mission.neighbor)
 G0 = SPACECRAFT.g0  # m/s^2, thesis Eq. 3
@@ -131,6 +131,13 @@ def deorbit_scenario(altitude_initial, altitude_target, mass0=MASS0, thrust=N_TH
     return {"delta_v": dv, "propellant": mp, "burn_time": burn_time(mp, thrust, isp, g0)}
 
 
+def mission_scenario(name=DEFAULT_SCENARIO, **spacecraft):
+    """`deorbit_scenario` of a scenario of the mission definition (components.mission.neighbor),
+    by name; `spacecraft`: deorbit_scenario's keywords (mass0, thrust, isp, g0) when not the baseline."""
+    s = SCENARIOS[name]
+    return deorbit_scenario(s.altitude_km * 1e3, s.target_perigee_km * 1e3, **spacecraft)
+
+
 # ---- tank and feed lines (Appendix H) -------------------------------------------------------
 def tank_sizing(propellant, molar_mass=MOLAR_MASS_R236FA, pressure=STORAGE_PRESSURE,
                 temperature=STORAGE_TEMPERATURE, yield_strength=AL6061_YIELD, safety_factor=SAFETY_FACTOR,
@@ -218,8 +225,8 @@ class MainThrusters:
         self.isp, self.g0 = positive("isp", isp), positive("g0", g0)
         self.mass0 = positive("mass0", mass0)
         if propellant_budget is None:
-            propellant_budget = deorbit_scenario(420e3, 350e3, self.mass0, self.thrust, self.isp,
-                                                 self.g0)["propellant"]
+            propellant_budget = mission_scenario(mass0=self.mass0, thrust=self.thrust, isp=self.isp,
+                                                 g0=self.g0)["propellant"]
         self.budget = positive("propellant_budget", propellant_budget)
         if self.budget >= self.mass0:
             raise ValueError(f"propellant_budget = {self.budget!r} kg must be below mass0 = {self.mass0!r} kg")

@@ -6,7 +6,7 @@ recorder knows whether the run stops here), and at the end (`finish`). They shar
 that the algorithm fills in."""
 import sys
 import time
-from typing import Dict, List, Sequence, Union
+from typing import Dict, Sequence, Union
 
 import numpy as np
 
@@ -41,10 +41,6 @@ class RunView:
     def __init__(self, table, refresh):
         self._table, self._refresh = table, refresh
         self._ops = {}
-
-    @property
-    def component_names(self) -> List[str]:
-        return [c.name for c in self._table.system.comps]
 
     def read(self, names: Sequence[str]) -> Dict[str, Union[float, int, bool]]:
         """{name: current value} of the named Real, Integer or Boolean variables; SSPError names

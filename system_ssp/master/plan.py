@@ -62,7 +62,7 @@ class ScheduleMode:
 @dataclass(frozen=True, slots=True)
 class SchedulePlan:
     """nc:Schedule: the first mode whose conditions hold decides each macro step."""
-    modes: Tuple[ScheduleMode, ...]  #; the last may be unconditional
+    modes: Tuple[ScheduleMode, ...]  # the last may be unconditional
     events: Tuple[Tuple[int, str], ...]  # ((component, Real output announcing the next event time), ...)
     origin: str  # file:line of the nc:Schedule element, for messages
 

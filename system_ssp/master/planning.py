@@ -98,12 +98,10 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
     """The RunPlan of `options` on `system` (a loaded `System`; a field left at None: the SSD's
     own setting)."""
     o = options if options is not None else RunOptions()
-    stop_time, step_size, start_time, algorithm, order = o.stop_time, o.step_size, o.start_time, o.algorithm, o.order
-    record_every, schedule, profile = o.record_every, o.schedule, o.profile
     d, m = system.desc, system.desc.master
-    start = start_time if start_time is not None else (d.start_time if d.start_time is not None else 0.0)
-    stop = stop_time if stop_time is not None else d.stop_time
-    h = step_size if step_size is not None else m.step_size
+    start = o.start_time if o.start_time is not None else (d.start_time if d.start_time is not None else 0.0)
+    stop = o.stop_time if o.stop_time is not None else d.stop_time
+    h = o.step_size if o.step_size is not None else m.step_size
     if stop is None:
         raise SSPError(f"{d.display}: no stop time: pass stop_time (CLI --stop-time) or set "
                        "ssd:DefaultExperiment stopTime")
@@ -118,22 +116,22 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
         raise SSPError(f"step size must be positive, got {h}")
     if stop < start:
         raise SSPError(f"stop time {stop} is before start time {start}")
-    algo = algorithm or m.algorithm or "gauss-seidel"
+    algo = o.algorithm or m.algorithm or "gauss-seidel"
     if algo not in ALGORITHMS:
         raise SSPError(f"unknown algorithm {algo!r} (expected one of: {', '.join(ALGORITHMS)})")
-    order_idx = _order(system, order, algo)
+    order_idx = _order(system, o.order, algo)
     mult = _multiples(system, o.step_multiples)
     stops = _stops(system, o.stop_when)
     rec = _recorded(system, o.outputs)
-    if isinstance(record_every, bool) or not isinstance(record_every, numbers.Integral) or record_every < 1:
-        raise SSPError(f"record_every must be an integer >= 1, got {record_every!r}")
+    if isinstance(o.record_every, bool) or not isinstance(o.record_every, numbers.Integral) or o.record_every < 1:
+        raise SSPError(f"record_every must be an integer >= 1, got {o.record_every!r}")
     n_float = (stop - start) / h
     n_steps = int(round(n_float))
     if abs(n_float - n_steps) > 1e-9 * max(1.0, n_float):
         n_steps = int(math.ceil(n_float))
     params = collect_parameters(system, o.parameter_sets, o.parameters)
     sched = None
-    if schedule and m.schedule:
+    if o.schedule and m.schedule:
         sched = _schedule(system, algo, mult)
     if sched is None and n_steps > MAX_STEPS:
         raise SSPError(f"{stop - start:g} s in steps of {h:g} s are {n_steps:,} communication steps, more than the "
@@ -141,7 +139,7 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
                        "step): use a larger step size or a shorter run")
     return RunPlan(start=start, stop=stop, step_size=h, n_steps=n_steps, algorithm=algo, order=tuple(order_idx),
                    multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
-                   record_every=int(record_every), profile=bool(profile), schedule=sched)
+                   record_every=int(o.record_every), profile=bool(o.profile), schedule=sched)
 
 
 def _schedule(system, algorithm, multiples):

@@ -105,7 +105,7 @@ def _run_all(ssp, scenarios, model, density, overrides, max_years, progress, out
                      "propellant_used_kg": r.final["propulsion.propellant_used"],
                      "burn_time_min": r.final["propulsion.burn_time"] / 60.0}
                 if burn:
-                    lib = propulsion.deorbit_scenario(ref["h0"] * KM, ref["target"] * KM)
+                    lib = propulsion.mission_scenario(name)
                     s.update(delta_v_m_s=lib["delta_v"], propellant_kg=lib["propellant"],
                              burn_time_library_min=lib["burn_time"] / 60.0,
                              thesis_delta_v_m_s=ref["delta_v"], thesis_propellant_kg=ref["propellant"],

@@ -43,6 +43,7 @@ def test_every_scenario_has_its_systems_parameter_sets():
         for system in (*neighbor.DEORBIT_SYSTEMS.values(), *neighbor.MISSION_SYSTEMS.values()):
             assert (PARAMETERS_DIR / f"{scenario_set(system, name)}.ssv").is_file()
         budget = propulsion.deorbit_scenario(s.altitude_km * KM, s.target_perigee_km * KM)["propellant"]
+        assert propulsion.mission_scenario(name)["propellant"] == budget
         for system in neighbor.DEORBIT_SYSTEMS.values():
             burn = ssv(scenario_set(system, name))
             assert burn["orbit.sma0"] == pytest.approx(R_EQ + s.altitude_km * KM, abs=1e-6)

@@ -29,8 +29,8 @@ Scenario files (names component.variable), one per thesis case, with and without
   scenario's target perigee (350, 350, 300 km). Without the burn, burn_enable stays false
   (the host alone, 12 kg).
 """
-from components.mission.neighbor import DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS, SPACECRAFT, \
-    scenario_set
+from components.mission.neighbor import (DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBIT as HOST_ORBIT, ORBIT_FMUS, SCENARIOS,
+                                         SPACECRAFT, scenario_set)
 from components.orbit import propulsion
 from components.core.constants import DAY, R_EQ, YEAR
 
@@ -42,14 +42,13 @@ ORBIT = {"epoch": HOST_ORBIT.deorbit_epoch, "sma0": R_EQ + BASE.altitude_km * KM
          "density_model": HOST_ORBIT.density_model, "space_weather_file": "", "use_constant_space_weather": False}
 BURN_STEP = 0.5  # s, thesis Section 3.2
 COAST_STEP = {"cowell": 3600.0, "averaged": DAY}
-FMU = {"cowell": "Orbit", "averaged": "OrbitAveraged"}
 STOP_TIME = 150.0 * YEAR  # longer than the 97-year case
 
 
-def scenario(h0_km, target_km, burn):
-    params = {"orbit.sma0": R_EQ + h0_km * KM, "propulsion.burn_enable": burn}
+def scenario(name, burn):
+    params = {"orbit.sma0": R_EQ + SCENARIOS[name].altitude_km * KM, "propulsion.burn_enable": burn}
     if burn:
-        params["propulsion.propellant_budget"] = propulsion.deorbit_scenario(h0_km * KM, target_km * KM)["propellant"]
+        params["propulsion.propellant_budget"] = propulsion.mission_scenario(name)["propellant"]
     return params
 
 
@@ -75,7 +74,7 @@ def generate(writer):
     writer.ssv("deorbit_orbit",
                "Host orbit and drag (thesis Tables 2-3, start 2023-01-01; Jacchia-Roberts with the bundled CSSI "
                "space weather); retrograde thrust since no attitude is simulated", orbit)
-    dv = propulsion.deorbit_scenario(BASE.altitude_km * KM, BASE.target_perigee_km * KM)
+    dv = propulsion.mission_scenario(BASE.name)
     writer.ssv("deorbit_propulsion",
                f"Main de-orbit thrusters ({propulsion.N_THRUSTERS} x {propulsion.THRUST_PER_THRUSTER * 1e3:g} mN, "
                f"Isp {propulsion.ISP:g} s, g0 {propulsion.G0:g}; thesis Section 3.2, Appendix A), "
@@ -89,13 +88,13 @@ def generate(writer):
         h0, target = s.altitude_km, s.target_perigee_km
         writer.ssv(scenario_set(cowell, s.name),
                    f"Thesis scenario {h0:g} km -> {target:g} km perigee, with the NEIGHBOR burn",
-                   scenario(h0, target, True))
+                   scenario(s.name, True))
         writer.ssv(scenario_set(cowell, s.name, burn=False),
                    f"Thesis scenario {h0:g} km without NEIGHBOR (host alone, {SPACECRAFT.mass:g} kg)",
-                   scenario(h0, target, False))
+                   scenario(s.name, False))
     # the lifetime system's scenario files are the same files under its name
     for name in SCENARIOS:
         for burn in (True, False):
             writer.ssv_copy(scenario_set(cowell, name, burn), scenario_set(averaged, name, burn))
     for orbit, name in DEORBIT_SYSTEMS.items():
-        writer.ssd(name, system(FMU[orbit], COAST_STEP[orbit]))
+        writer.ssd(name, system(ORBIT_FMUS[orbit], COAST_STEP[orbit]))

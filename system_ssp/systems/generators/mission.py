@@ -71,8 +71,8 @@ from components.orbit import averaged, propulsion
 from components.core import time_utils
 from components.core.constants import DAY, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase as Phase, MissionMode as Mode
-from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS,
-                                         SPACECRAFT, scenario_set)
+from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, ORBIT_FMUS,
+                                         SCENARIOS, SPACECRAFT, scenario_set)
 from components.mission.power_bus import LOAD_NAMES
 
 from ...ssp.writer import vec
@@ -404,8 +404,7 @@ def generate(writer):
     writer.ssv("mission_ground",
                "UIUC ground station (40.1020 N, 88.2272 W), horizon mask (Appendix I sets none)",
                {"epoch": MISSION_EPOCH})
-    budget = {name: propulsion.deorbit_scenario(s.altitude_km * KM, s.target_perigee_km * KM)["propellant"]
-              for name, s in SCENARIOS.items()}
+    budget = {name: propulsion.mission_scenario(name)["propellant"] for name in SCENARIOS}
     writer.ssv("mission_propulsion",
                f"Main de-orbit thrusters, {SPACECRAFT.mass:g} kg, the {base.altitude_km:g} km -> "
                f"{base.target_perigee_km:g} km budget (Eq. 2-3: {base.thesis['propellant']:g} kg)",
@@ -465,7 +464,7 @@ def generate(writer):
                    f"{MISSION_EPOCH}, at {h0:g} km when the de-orbit starts ({DEORBIT_EPOCH})",
                    {"orbit.sma0": R_EQ + takeover_altitudes[name] * KM,
                    "propulsion.propellant_budget": budget[name]})
-    writer.ssd(cowell, system("Orbit"))
-    writer.ssd(averaged, system("OrbitAveraged"))
+    for orbit, name in MISSION_SYSTEMS.items():
+        writer.ssd(name, system(ORBIT_FMUS[orbit]))
     for name in SCENARIOS:
         writer.ssv_copy(scenario_set(cowell, name), scenario_set(averaged, name))
