@@ -29,9 +29,6 @@ PARAMETERS = (
     ("reorient_hold_elevation", "1", "Sine of the Sun elevation Reorient holds until reorient_duration, [0, 1)"),
     ("reorient_duration", "s", "Time in Reorient before the elevation is driven to zero (set to RMD), >= 0"),
 )
-OMEGA = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-B_IN = [f"B_B[{i}]" for i in (1, 2, 3)]
-SUN = [f"sun_heading_B[{i}]" for i in (1, 2, 3)]
 
 
 class AcsControl(NeighborSlave):
@@ -44,20 +41,21 @@ class AcsControl(NeighborSlave):
         for name, unit, text in PARAMETERS:
             default = control.PARAMETER_DEFAULTS[name]
             self.parameter(name, default, unit, f"{text}; default {default:.6g}")
-        self.input("mode", 0, None, f"ACS mode ({modes.MODE_TABLE})", int)
-        self.input("coils_enabled", False, None, "Coils permitted (false: zero dipole command)", bool)
-        self.input("wheel_enabled", False, None, "Wheel permitted (false: zero torque command)", bool)
-        self.input("time_in_mode", 0.0, "s", "Time since the current mode was entered (Reorient schedule)")
-        self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "Body angular velocity in B")
-        self.input_array("B_B", [0.0, 0.0, 0.0], "T", "Geomagnetic field in B")
-        self.input_array("sun_heading_B", [0.0, 0.0, 1.0], "1", "Unit vector to the Sun in B")
-        self.input("wheel_rate", 0.0, "rad/s", "Momentum-wheel rate about +Y relative to the body")
-        deps = ["mode", "coils_enabled", "wheel_enabled", "time_in_mode", "wheel_rate"] + OMEGA + B_IN + SUN
+        mode = self.input("mode", 0, None, f"ACS mode ({modes.MODE_TABLE})", int)
+        coils_enabled = self.input("coils_enabled", False, None, "Coils permitted (false: zero dipole command)", bool)
+        wheel_enabled = self.input("wheel_enabled", False, None, "Wheel permitted (false: zero torque command)", bool)
+        time_in_mode = self.input("time_in_mode", 0.0, "s",
+                                  "Time since the current mode was entered (Reorient schedule)")
+        omega = self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "Body angular velocity in B")
+        field = self.input_array("B_B", [0.0, 0.0, 0.0], "T", "Geomagnetic field in B")
+        sun = self.input_array("sun_heading_B", [0.0, 0.0, 1.0], "1", "Unit vector to the Sun in B")
+        wheel_rate = self.input("wheel_rate", 0.0, "rad/s", "Momentum-wheel rate about +Y relative to the body")
+        deps = (mode, coils_enabled, wheel_enabled, time_in_mode, wheel_rate) + omega + field + sun
         self.output_array("dipole_cmd_B", 3, lambda: self.feedthrough(self._command)[0], "A.m2",
                           "Commanded magnetic dipole in B (0 when coils_enabled is false)", depends_on=deps)
         self.output("wheel_torque_cmd", lambda: self.feedthrough(self._command)[1], "N.m",
                     "Commanded wheel motor torque about +Y (0 when wheel_enabled is false)",
-                    depends_on=["mode", "wheel_enabled", "omega_BN_B[2]"] + SUN)
+                    depends_on=(mode, wheel_enabled, omega[1]) + sun)
 
     def _command(self):
         v = self.values

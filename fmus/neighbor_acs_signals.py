@@ -9,11 +9,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.acs import signals
 
-H_IN = [f"H_B[{i}]" for i in (1, 2, 3)]
-HW_IN = [f"wheel_momentum_B[{i}]" for i in (1, 2, 3)]
-W_IN = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-S_IN = [f"sun_heading_B[{i}]" for i in (1, 2, 3)]
-
 
 class AcsSignals(NeighborSlave):
     description = ("State values of the ACS mode manager (ACS mode specification) from the truth (momentum "
@@ -29,20 +24,22 @@ class AcsSignals(NeighborSlave):
         self.parameter("command_start", d["command_start"], "s", "Ground command true from this time")
         self.parameter("command_end", d["command_end"], "s",
                        "Ground command true until this time (exclusive; <= command_start: never)")
-        self.input_array("H_B", [0.0, 0.0, 0.0], "N.m.s", "Body angular momentum J omega in B")
-        self.input_array("wheel_momentum_B", [0.0, 0.0, 0.0], "N.m.s", "Wheel momentum relative to the body in B")
-        self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "Body angular velocity in B")
-        self.input_array("sun_heading_B", [0.0, 0.0, 1.0], "1", "Unit vector to the Sun in B")
+        momentum = self.input_array("H_B", [0.0, 0.0, 0.0], "N.m.s", "Body angular momentum J omega in B")
+        wheel_momentum = self.input_array("wheel_momentum_B", [0.0, 0.0, 0.0], "N.m.s",
+                                          "Wheel momentum relative to the body in B")
+        omega = self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "Body angular velocity in B")
+        sun = self.input_array("sun_heading_B", [0.0, 0.0, 1.0], "1", "Unit vector to the Sun in B")
         f = lambda: self.feedthrough(self._values)  # noqa: E731
         self.output("xz_momentum_error", lambda: f()["xz_momentum_error"], "N.m.s",
-                    "|(H_x, H_z)| of the total momentum H = H_B + wheel_momentum_B", depends_on=H_IN + HW_IN)
+                    "|(H_x, H_z)| of the total momentum H = H_B + wheel_momentum_B",
+                    depends_on=momentum + wheel_momentum)
         self.output("momentum_error", lambda: f()["momentum_error"], "N.m.s",
-                    "|H - Iy spin_rate y_hat| of the total momentum", depends_on=H_IN + HW_IN)
+                    "|H - Iy spin_rate y_hat| of the total momentum", depends_on=momentum + wheel_momentum)
         self.output("sin_sun_elevation", lambda: f()["sin_sun_elevation"], "1",
-                    "Sine of the Sun elevation from the body X-Z plane (+ towards +Y)", depends_on=S_IN)
+                    "Sine of the Sun elevation from the body X-Z plane (+ towards +Y)", depends_on=sun)
         self.output("sin_sun_azimuth", lambda: f()["sin_sun_azimuth"], "1",
-                    "Sine of the Sun azimuth about Y from +Z towards +X", depends_on=S_IN)
-        self.output("body_rate", lambda: f()["body_rate"], "rad/s", "|omega_BN_B|", depends_on=W_IN)
+                    "Sine of the Sun azimuth about Y from +Z towards +X", depends_on=sun)
+        self.output("body_rate", lambda: f()["body_rate"], "rad/s", "|omega_BN_B|", depends_on=omega)
         self.output("ground_command", lambda: self.model.ground_command, None,
                     "Ground command received: command_start <= t < command_end", bool)
 

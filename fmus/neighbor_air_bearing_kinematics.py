@@ -17,9 +17,8 @@ import math
 
 from neighbor_fmu_support import NeighborSlave
 
+from components.core.names import matrix_names
 from components.sensing import air_bearing
-
-DCM_INPUTS = [f"dcm_BN[{i},{j}]" for i in (1, 2, 3) for j in (1, 2, 3)]
 
 
 class AirBearingKinematics(NeighborSlave):
@@ -40,28 +39,29 @@ class AirBearingKinematics(NeighborSlave):
         self.parameter("rate_from_thresholded", True, None,
                        "True (seed): omega is the rate of the thresholded DCM stream (the thresholded DCM is "
                        "the previous DCM of the next estimate); false: rate of the raw input DCMs", bool)
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.input(f"dcm_BN[{i},{j}]", 1.0 if i == j else 0.0, "1",
-                           f"Input DCM [BN] element ({i},{j}): maps N components to B components "
-                           "(transpose of the description's R^N_B)")
+        self._dcm_inputs = tuple(
+            self.input(element, 1.0 if i == j else 0.0, "1",
+                       f"Input DCM [BN] element ({i},{j}): maps N components to B components "
+                       "(transpose of the description's R^N_B)")
+            for i, row in enumerate(matrix_names("dcm_BN", 3, 3), 1) for j, element in enumerate(row, 1))
+        dcm = self._dcm_inputs
 
         self.output_array("q_BN", 4, lambda: self._out()["q_BN"], "1",
                           "Thresholded attitude quaternion of B relative to N, scalar last (sign continuous)",
-                          depends_on=DCM_INPUTS)
+                          depends_on=dcm)
         self.output_array("omega_BN_B", 3, lambda: self._out()["omega_BN_B"], "rad/s",
                           "Angular velocity of B relative to N in B, estimated from consecutive DCMs "
-                          "(zero before the first step)", depends_on=DCM_INPUTS)
+                          "(zero before the first step)", depends_on=dcm)
         self.output_array("euler321", 3, lambda: self._out()["euler321"], "rad",
                           "3-2-1 Euler angles after limiting, in the order yaw psi, pitch theta, roll phi; "
-                          "[BN] = R1(phi) R2(theta) R3(psi)", depends_on=DCM_INPUTS)
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.output(f"dcm_out_BN[{i},{j}]", lambda i=i, j=j: self._out()["dcm_out_BN"][i - 1][j - 1], "1",
+                          "[BN] = R1(phi) R2(theta) R3(psi)", depends_on=dcm)
+        for i, row in enumerate(matrix_names("dcm_out_BN", 3, 3), 1):
+            for j, element in enumerate(row, 1):
+                self.output(element, lambda i=i, j=j: self._out()["dcm_out_BN"][i - 1][j - 1], "1",
                             f"Thresholded DCM [BN] element ({i},{j}), rebuilt from the limited 3-2-1 angles",
-                            depends_on=DCM_INPUTS)
+                            depends_on=dcm)
         self.output("limited", lambda: self._out()["limited"], None,
-                    "True when pitch or roll exceeded tau and was clamped", bool, depends_on=DCM_INPUTS)
+                    "True when pitch or roll exceeded tau and was clamped", bool, depends_on=dcm)
 
     def build_model(self):
         return air_bearing.AirBearingKinematics(self.values["tau"], self.values["dcm_tol"],
@@ -69,7 +69,7 @@ class AirBearingKinematics(NeighborSlave):
 
     def _dcm(self):
         values = self.values
-        return [values[k] for k in DCM_INPUTS]
+        return [values[k] for k in self._dcm_inputs]
 
     def _evaluate(self):
         return self.model.evaluate(self._dcm())

@@ -27,16 +27,12 @@ class Atmosphere(NeighborSlave):
         self.parameter("epoch", time_utils.DEFAULT_EPOCH, None,
                        "Scenario epoch (simulation time 0), ISO 8601 UTC 'YYYY-MM-DDThh:mm:ss[.fff]Z'", str)
         atmosphere_parameters(self)
-        self.input_array("r_BN_N", [R_EQ + 420e3, 0.0, 0.0], "m",
-                         "Spacecraft position relative to Earth's centre in N")
+        position = self.input_array("r_BN_N", [R_EQ + 420e3, 0.0, 0.0], "m",
+                                    "Spacecraft position relative to Earth's centre in N")
         self.output("density", lambda: self.feedthrough(self._density), "kg/m3",
-                    "Atmospheric mass density at r_BN_N at the current time", depends_on=self._r_names())
+                    "Atmospheric mass density at r_BN_N at the current time", depends_on=position)
         self.output("altitude", lambda: self.feedthrough(self._altitude), "m",
-                    "Geodetic altitude of r_BN_N above the WGS-84 ellipsoid", depends_on=self._r_names())
-
-    @staticmethod
-    def _r_names():
-        return [f"r_BN_N[{i}]" for i in (1, 2, 3)]
+                    "Geodetic altitude of r_BN_N above the WGS-84 ellipsoid", depends_on=position)
 
     def _density(self):
         return self.model.density(self.vector("r_BN_N", 3))

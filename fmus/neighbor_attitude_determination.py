@@ -13,10 +13,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import triad
 
-VECTORS = ([f"nadir_B[{i}]" for i in (1, 2, 3)] + ["nadir_valid"] + [f"sun_B[{i}]" for i in (1, 2, 3)]
-           + ["sun_valid"] + [f"r_BN_N[{i}]" for i in (1, 2, 3)] + [f"r_SN_N[{i}]" for i in (1, 2, 3)])
-RATE = [f"omega_meas_B[{i}]" for i in (1, 2, 3)]
-
 
 class AttitudeDetermination(NeighborSlave):
     description = ("Attitude determination: TRIAD from the nadir (horizon sensor) and Sun vectors when both are "
@@ -32,16 +28,16 @@ class AttitudeDetermination(NeighborSlave):
                        "Smallest angle between nadir and Sun for a TRIAD fix, [0, pi/2)")
         self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
                              "Initial estimate q_BN (used until the first fix; normalized, non-zero)")
-        self.attitude_measurement_inputs()
+        measured = self.attitude_measurement_inputs()
         self.output_array("q_est_BN", 4, lambda: self.feedthrough(self._estimate)[0], "1",
-                          "Estimated attitude quaternion q_BN, scalar last", depends_on=VECTORS)
+                          "Estimated attitude quaternion q_BN, scalar last", depends_on=measured.vectors)
         self.output_array("omega_est_B", 3, lambda: self.feedthrough(self._rate), "rad/s",
                           "Estimated angular velocity in B (the gyro measurement; no bias estimation)",
-                          depends_on=RATE)
+                          depends_on=measured.rate)
         self.output("fix", lambda: self.feedthrough(self._estimate)[1], None,
-                    "The estimate at this communication point is a TRIAD fix", bool, depends_on=VECTORS)
+                    "The estimate at this communication point is a TRIAD fix", bool, depends_on=measured.vectors)
         self.output("time_since_fix", lambda: self.feedthrough(self._estimate)[2], "s",
-                    "Time since the last TRIAD fix (since the start before the first fix)", depends_on=VECTORS)
+                    "Time since the last TRIAD fix (since the start before the first fix)", depends_on=measured.vectors)
 
     def build_model(self):
         return triad.AttitudeDetermination(self.values["nadir_sigma"], self.values["sun_sigma"],

@@ -6,9 +6,8 @@ system drive the DCM-input kinematics FMU from the RigidBody FMU.
 """
 from neighbor_fmu_support import NeighborSlave
 
+from components.core.names import matrix_names
 from components.sensing import air_bearing
-
-Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 
 
 class AttitudeToDcm(NeighborSlave):
@@ -17,13 +16,14 @@ class AttitudeToDcm(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         "Attitude quaternion of B relative to N, scalar last (normalized; zero is an error)")
-        for i in range(1, 4):
-            for j in range(1, 4):
-                self.output(f"dcm_BN[{i},{j}]", lambda i=i, j=j: self.feedthrough(self._dcm)[i - 1][j - 1], "1",
+        quaternion = self.input_array(
+            "q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+            "Attitude quaternion of B relative to N, scalar last (normalized; zero is an error)")
+        for i, row in enumerate(matrix_names("dcm_BN", 3, 3), 1):
+            for j, element in enumerate(row, 1):
+                self.output(element, lambda i=i, j=j: self.feedthrough(self._dcm)[i - 1][j - 1], "1",
                             f"DCM [BN] = A(q) element ({i},{j}): maps N components to B components",
-                            depends_on=Q_INPUTS)
+                            depends_on=quaternion)
 
     def build_model(self):
         return air_bearing.AttitudeToDcm()

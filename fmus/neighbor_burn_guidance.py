@@ -10,8 +10,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import burn_guidance
 
-ORBIT_INPUTS = [f"r_BN_N[{i}]" for i in (1, 2, 3)] + [f"v_BN_N[{i}]" for i in (1, 2, 3)]
-
 
 class BurnGuidance(NeighborSlave):
     description = ("De-orbit burn guidance: anti-velocity burn attitude (thrust axis +x_B along -v, y_B along the "
@@ -19,15 +17,16 @@ class BurnGuidance(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.input_array("r_BN_N", [6798136.3, 0.0, 0.0], "m", "Spacecraft position relative to Earth's centre in N")
-        self.input_array("v_BN_N", [0.0, 4750.0, 6000.0], "m/s",
-                         "Spacecraft velocity relative to N, in N (not parallel to r_BN_N)")
+        position = self.input_array("r_BN_N", [6798136.3, 0.0, 0.0], "m",
+                                    "Spacecraft position relative to Earth's centre in N")
+        velocity = self.input_array("v_BN_N", [0.0, 4750.0, 6000.0], "m/s",
+                                    "Spacecraft velocity relative to N, in N (not parallel to r_BN_N)")
         self.output_array("q_target_BN", 4, lambda: self.feedthrough(self._frame)[0], "1",
                           "Burn attitude quaternion q_BN, scalar last (q4 >= 0): +x_B along -v, +y_B along r x v",
-                          depends_on=ORBIT_INPUTS)
+                          depends_on=position + velocity)
         self.output_array("omega_target_B", 3, lambda: self.feedthrough(self._frame)[1], "rad/s",
                           "Angular velocity of the burn frame in B: |r x v| / |r|^2 about y_B (the mean motion on a "
-                          "circular orbit, thesis Eq. 67-68 at the actual radius)", depends_on=ORBIT_INPUTS)
+                          "circular orbit, thesis Eq. 67-68 at the actual radius)", depends_on=position + velocity)
 
     def build_model(self):
         return burn_guidance.BurnGuidance()

@@ -44,6 +44,13 @@ class ControllerSignals(NamedTuple):
     done: str
 
 
+class AttitudeMeasurementSignals(NamedTuple):
+    """What `attitude_measurement_inputs` declares: the vector measurements with their validity
+    and reference positions (what a TRIAD fix reads), and the gyro rate."""
+    vectors: Names
+    rate: Names
+
+
 class ParameterError(ValueError):
     """A parameter or input value outside its allowed range (message names the variable)."""
 
@@ -195,17 +202,19 @@ class NeighborSlave(Fmi2Slave):
         assert q + w == TARGET_INPUTS  # the names outputs declared earlier depend on
         return q + w
 
-    def attitude_measurement_inputs(self):
+    def attitude_measurement_inputs(self) -> AttitudeMeasurementSignals:
         """The inputs of the attitude-knowledge family (AttitudeDetermination, AttitudeEstimator):
         the nadir and Sun vectors with their validity, the gyro rate, and the positions that give
         the vectors' reference directions, in this order."""
-        self.input_array("nadir_B", [0.0, 0.0, 0.0], "1", "Measured nadir unit vector in B")
-        self.input("nadir_valid", False, None, "Nadir measurement valid", bool)
-        self.input_array("sun_B", [0.0, 0.0, 0.0], "1", "Measured Sun unit vector in B")
-        self.input("sun_valid", False, None, "Sun measurement valid", bool)
-        self.input_array("omega_meas_B", [0.0, 0.0, 0.0], "rad/s", "Measured angular velocity in B (gyro)")
-        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N (e.g. GPS)")
-        self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N (ephemeris)")
+        nadir = self.input_array("nadir_B", [0.0, 0.0, 0.0], "1", "Measured nadir unit vector in B")
+        nadir_valid = self.input("nadir_valid", False, None, "Nadir measurement valid", bool)
+        sun = self.input_array("sun_B", [0.0, 0.0, 0.0], "1", "Measured Sun unit vector in B")
+        sun_valid = self.input("sun_valid", False, None, "Sun measurement valid", bool)
+        rate = self.input_array("omega_meas_B", [0.0, 0.0, 0.0], "rad/s", "Measured angular velocity in B (gyro)")
+        position = self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N (e.g. GPS)")
+        sun_position = self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N (ephemeris)")
+        return AttitudeMeasurementSignals(nadir + (nadir_valid,) + sun + (sun_valid,) + position + sun_position,
+                                          rate)
 
     def inertia_parameters(self, mass_description):
         """The spacecraft inertia parameters shared by RigidBody and the controllers that use

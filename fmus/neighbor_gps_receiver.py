@@ -7,9 +7,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import sensors
 
-POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-
-
 class GpsReceiver(NeighborSlave):
     description = ("GPS receiver: position in N plus N(0, sigma^2) noise per axis and communication step, and the "
                    "time (NEIGHBOR thesis 3.3.1)")
@@ -19,9 +16,9 @@ class GpsReceiver(NeighborSlave):
         self.parameter("sigma", 1.5, "m", "Position noise standard deviation per axis, >= 0 (OEM7700: 1.5 m RMS)")
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
         self.parameter("available", True, None, "Receiver has a fix; false models an outage (valid false)", bool)
-        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "True spacecraft position in N")
+        position = self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "True spacecraft position in N")
         self.output_array("r_meas_N", 3, lambda: self.feedthrough(self._measure)[0], "m",
-                          "Measured position in N (zeros when invalid)", depends_on=POS)
+                          "Measured position in N (zeros when invalid)", depends_on=position)
         # not named `time`: FMPy's result arrays (and CSV files) already have a `time` column
         self.output("gps_time", lambda: self.model.time, "s",
                     "Time of the measurement (the simulation time): seconds since the scenario epoch")

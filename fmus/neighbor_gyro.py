@@ -7,9 +7,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import sensors
 
-RATE = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-
-
 class Gyro(NeighborSlave):
     description = ("3-axis rate gyro: omega_meas = omega_BN_B + bias + N(0, sigma^2) white noise per "
                    "communication step (NEIGHBOR thesis 3.3.1)")
@@ -21,9 +18,10 @@ class Gyro(NeighborSlave):
                        "White-noise standard deviation per sample per axis, >= 0 (BMG160 0.014 deg/s/sqrt(Hz) "
                        "over a 5 Hz bandwidth, i.e. 10 Hz sampling)")
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
-        self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "True angular velocity of B relative to N, in B")
+        rate = self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s",
+                                "True angular velocity of B relative to N, in B")
         self.output_array("omega_meas_B", 3, lambda: self.feedthrough(self._measure), "rad/s",
-                          "Measured angular velocity in B", depends_on=RATE)
+                          "Measured angular velocity in B", depends_on=rate)
         # appended after the first release's variables (their value references stay)
         self.parameter("sigma_sample_time", 0.0, "s",
                        "Sampling step at which sigma holds, >= 0; 0: every sample has sigma. Otherwise a sample at the "

@@ -11,9 +11,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import sensors
 
-POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-QUAT = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-
 
 class HorizonSensor(NeighborSlave):
     description = ("Horizon sensor: unit nadir vector in the body frame, perturbed by a random rotation of "
@@ -24,13 +21,13 @@ class HorizonSensor(NeighborSlave):
         self.parameter("sigma", math.radians(0.25), "rad",
                        "RMS error angle of the nadir vector (>= 0; 0.25 deg default, CubeSat IR horizon sensor class)")
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
-        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
+        position = self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N")
+        quaternion = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
         self.output_array("nadir_B", 3, lambda: self.feedthrough(self._measure)[0], "1",
                           "Measured unit vector toward Earth's centre in B (zeros when invalid)",
-                          depends_on=POS + QUAT)
+                          depends_on=position + quaternion)
         self.output("valid", lambda: self.feedthrough(self._measure)[1], None,
-                    "Nadir measurement valid (false only for a zero position)", bool, depends_on=POS)
+                    "Nadir measurement valid (false only for a zero position)", bool, depends_on=position)
 
     def build_model(self):
         return sensors.HorizonSensor(self.values["sigma"], self.values["seed"])

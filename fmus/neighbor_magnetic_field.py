@@ -11,9 +11,6 @@ from neighbor_fmu_support import NeighborSlave
 from components.environment import magnetic_field
 from components.core import time_utils
 
-R_IN = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-Q_IN = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-
 
 class MagneticField(NeighborSlave):
     description = ("Geomagnetic field as a tilted dipole (IGRF-13 2020.0 first-degree Gauss coefficients, "
@@ -27,14 +24,14 @@ class MagneticField(NeighborSlave):
         self.parameter("secular_variation", False, None,
                        "True: apply the IGRF-13 secular variation (dg10 = 5.7, dg11 = 7.4, dh11 = -25.9 nT/yr) "
                        "from 2020.0 to the current date; false: the 2020.0 coefficients", bool)
-        self.input_array("r_BN_N", [magnetic_field.R_REF + 500e3, 0.0, 0.0], "m",
-                         "Spacecraft position relative to Earth's centre in N (must be non-zero)")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         "Attitude quaternion of B relative to N, scalar last (normalized before use)")
+        position = self.input_array("r_BN_N", [magnetic_field.R_REF + 500e3, 0.0, 0.0], "m",
+                                    "Spacecraft position relative to Earth's centre in N (must be non-zero)")
+        quaternion = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                                      "Attitude quaternion of B relative to N, scalar last (normalized before use)")
         self.output_array("B_N", 3, self._field_N, "T",
-                          "Geomagnetic field at the spacecraft in N", depends_on=R_IN)
+                          "Geomagnetic field at the spacecraft in N", depends_on=position)
         self.output_array("B_B", 3, self._field_B, "T",
-                          "Geomagnetic field at the spacecraft in B, A(q_BN) B_N", depends_on=R_IN + Q_IN)
+                          "Geomagnetic field at the spacecraft in B, A(q_BN) B_N", depends_on=position + quaternion)
 
     def _field_N(self):
         return self.model.field_N(self.vector("r_BN_N", 3))

@@ -14,7 +14,8 @@ from neighbor_fmu_support import NeighborSlave
 from components.attitude import thruster_set
 from components.mission.neighbor import SPACECRAFT
 
-CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
+# declared after the outputs that depend on it (appended in a later release)
+AXIAL_FIRING = "axial_firing"
 N = 16
 
 
@@ -32,12 +33,12 @@ class RcsThrusterSet(NeighborSlave):
                        "Edge c of the host along x: the y/z pairs' arms c/2, c/2 - c/3 (Eq. 16)")
         self.parameter("Isp", SPACECRAFT.isp, "s", "Specific impulse of the thrusters")
         self.parameter("g0", SPACECRAFT.g0, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
-        self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
+        command = self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
         self.output_array("torque_B", 3, lambda: self.feedthrough(self._force_torque)[1], "N.m",
                           "Torque of the firing thrusters, sum of l x F (Eq. 13)",
-                          depends_on=CMD_INPUTS + ["axial_firing"])
+                          depends_on=command + (AXIAL_FIRING,))
         self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._flags), None,
-                          "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=CMD_INPUTS)
+                          "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=command)
         self.output_array("torque_level", 3, lambda: self.model.levels, "N.m",
                           "Nominal torque of one thruster pair per axis (Eq. 16)")
         self.output_array("fire_time", 3, lambda: self.model.axis_fire_time(), "s",
@@ -56,12 +57,12 @@ class RcsThrusterSet(NeighborSlave):
         self.parameter_array("misalignment_2", [0.0] * N, "rad",
                              "Misalignment of each thruster's direction: rotation about its second perpendicular axis "
                              "(|angle| <= 0.2)")
-        self.input("axial_firing", False, None, "The axial de-orbit thrusters are firing (the burn): their torque "
+        self.input(AXIAL_FIRING, False, None, "The axial de-orbit thrusters are firing (the burn): their torque "
                    "is added (their force is the propulsion's)", bool)
         self.output_array("force_B", 3, lambda: self.feedthrough(self._force_torque)[0], "N",
                           "Net force of the firing RCS thrusters in B (zero for aligned pairs; the axial thrusters' "
                           "force is the propulsion's)",
-                          depends_on=CMD_INPUTS + ["axial_firing"])
+                          depends_on=command + (AXIAL_FIRING,))
 
     def build_model(self):
         v = self.values

@@ -9,8 +9,6 @@ from neighbor_fmu_support import NeighborSlave
 from components.attitude import thrusters
 from components.mission.neighbor import SPACECRAFT
 
-CMD_INPUTS = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
-
 
 class RcsThrusters(NeighborSlave):
     description = ("RCS thruster pairs (NEIGHBOR thesis Eq. 13-16, 74): commanded torque rounded to the pair "
@@ -23,13 +21,13 @@ class RcsThrusters(NeighborSlave):
         self.parameter("edge_c", SPACECRAFT.edge_c, "m", "Edge c of the host (y/z-axis pair lever arms, Eq. 16)")
         self.parameter("Isp", SPACECRAFT.isp, "s", "Specific impulse of the thrusters")
         self.parameter("g0", SPACECRAFT.g0, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
-        self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
+        command = self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
 
         self.output_array("torque_B", 3, lambda: self.feedthrough(self._applied), "N.m",
                           "Torque applied by the firing pairs (nearest level in {-L, 0, +L})",
-                          depends_on=CMD_INPUTS)
+                          depends_on=command)
         self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._flags), None,
-                          "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=CMD_INPUTS)
+                          "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=command)
         self.output_array("torque_level", 3, lambda: self.model.levels, "N.m",
                           "Torque of one thruster pair per axis from the geometry (Eq. 16)")
         self.output_array("fire_time", 3, lambda: self.model.fire_time, "s",

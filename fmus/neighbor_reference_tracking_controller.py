@@ -12,12 +12,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import reference_tracking as rt
 
-Q_INPUTS = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-RATE_INPUTS = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
-QREF_INPUTS = [f"q_ref_BN[{i}]" for i in (1, 2, 3, 4)]
-WREF_INPUTS = [f"omega_ref_BN_B[{i}]" for i in (1, 2, 3)]
-FF_INPUTS = [f"torque_ff_B[{i}]" for i in (1, 2, 3)]
-
 
 class ReferenceTrackingController(NeighborSlave):
     description = ("Reference-tracking attitude controller: feed-forward torque plus quaternion-error PD to a moving "
@@ -34,15 +28,16 @@ class ReferenceTrackingController(NeighborSlave):
                        "+-max_torque", bool)
         self.parameter("angle_tol", math.radians(0.1), "rad", "Attitude error angle tolerance for done, in (0, pi)")
         self.parameter("rate_tol", math.radians(0.01), "rad/s", "Rate error tolerance per axis for done (> 0)")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
-        self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
-        self.input_array("q_ref_BN", [0.0, 0.0, 0.0, 1.0], "1", "Reference attitude quaternion q_BN, scalar last")
-        self.input_array("omega_ref_BN_B", [0.0] * 3, "rad/s", "Reference angular velocity, in B")
-        self.input_array("torque_ff_B", [0.0] * 3, "N.m", "Feed-forward torque from the guidance, in B")
-        self.input("guidance_done", False, None, "The guidance profile has ended", bool)
-        self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
+        q = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "Measured attitude quaternion q_BN, scalar last")
+        omega = self.input_array("omega_BN_B", [0.0] * 3, "rad/s", "Measured angular velocity of B relative to N, in B")
+        q_ref = self.input_array("q_ref_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                                 "Reference attitude quaternion q_BN, scalar last")
+        omega_ref = self.input_array("omega_ref_BN_B", [0.0] * 3, "rad/s", "Reference angular velocity, in B")
+        torque_ff = self.input_array("torque_ff_B", [0.0] * 3, "N.m", "Feed-forward torque from the guidance, in B")
+        guidance_done = self.input("guidance_done", False, None, "The guidance profile has ended", bool)
+        enabled = self.input("enabled", True, None, "Controller enabled; when false it commands zero torque", bool)
 
-        deps = Q_INPUTS + RATE_INPUTS + QREF_INPUTS + WREF_INPUTS + FF_INPUTS + ["enabled"]
+        deps = q + omega + q_ref + omega_ref + torque_ff + (enabled,)
         cmd = lambda: self.feedthrough(self._command)  # noqa: E731
         self.output_array("torque_cmd_B", 3, lambda: cmd()[0], "N.m",
                           "Commanded body torque: continuous, clipped to +-max_torque (quantize false), or "
@@ -50,13 +45,13 @@ class ReferenceTrackingController(NeighborSlave):
         self.output_array("thrust_flag", 3, lambda: cmd()[1], None,
                           "Sign of the commanded torque per axis: 1 positive, -1 negative, 0 none", int,
                           depends_on=deps)
-        done_deps = Q_INPUTS + RATE_INPUTS + QREF_INPUTS + WREF_INPUTS + ["guidance_done"]
+        done_deps = q + omega + q_ref + omega_ref + (guidance_done,)
         self.output("done", lambda: self.feedthrough(self._done), None,
                     "Guidance done and attitude error <= angle_tol and every rate error <= rate_tol", bool,
                     depends_on=done_deps)
         self.output("attitude_error", lambda: self.feedthrough(self._angle), "rad",
                     "Rotation angle from the reference to the measured attitude, 2 acos|dq4|",
-                    depends_on=Q_INPUTS + QREF_INPUTS)
+                    depends_on=q + q_ref)
 
     def build_model(self):
         v = self.values

@@ -11,10 +11,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import sensors
 
-SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
-POS = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-QUAT = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
-
 
 class SunSensor(NeighborSlave):
     description = ("Digital sun sensor: unit Sun vector in the body frame with a random error rotation of angle "
@@ -28,11 +24,12 @@ class SunSensor(NeighborSlave):
         self.parameter("sigma", math.radians(0.5) / 3.0, "rad",
                        "RMS error angle of the Sun vector, >= 0 (nanoSSOC-D60: 0.5 deg 3 sigma)")
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
-        self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N")
-        self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
-        self.input("sunlit", True, None, "Spacecraft in sunlight (false in eclipse, from an eclipse model)", bool)
-        deps = SUN + POS + QUAT + ["sunlit"]
+        sun = self.input_array("r_SN_N", [0.0, -1.496e11, 0.0], "m", "Sun position in N")
+        position = self.input_array("r_BN_N", [6798137.0, 0.0, 0.0], "m", "Spacecraft position in N")
+        quaternion = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
+        sunlit = self.input("sunlit", True, None, "Spacecraft in sunlight (false in eclipse, from an eclipse model)",
+                            bool)
+        deps = sun + position + quaternion + (sunlit,)
         self.output_array("sun_B", 3, lambda: self.feedthrough(self._measure)[0], "1",
                           "Measured unit vector toward the Sun in B (zeros when invalid)", depends_on=deps)
         self.output("valid", lambda: self.feedthrough(self._measure)[1], None,

@@ -8,10 +8,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.sensing import sunline
 
-R_SUN = [f"r_SN_N[{i}]" for i in (1, 2, 3)]
-R_SC = [f"r_BN_N[{i}]" for i in (1, 2, 3)]
-SIGMA = [f"sigma_BN[{i}]" for i in (1, 2, 3)]
-Q = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
 AU = 149597870700.0  # m (IAU 2012)
 
 
@@ -23,16 +19,17 @@ class SunlineEphemeris(NeighborSlave):
         super().__init__(**kwargs)
         self.parameter("attitude_input", "mrp", None,
                        "Attitude input used: 'mrp' (sigma_BN, the default) or 'quaternion' (q_BN)", str)
-        self.input_array("r_SN_N", [AU, 0.0, 0.0], "m", "Sun position in N")
-        self.input_array("r_BN_N", [0.0, 0.0, 0.0], "m", "Spacecraft position in N")
-        self.input_array("sigma_BN", [0.0, 0.0, 0.0], "1",
-                         "Attitude MRP sigma_BN (Schaub and Junkins), used when attitude_input = 'mrp'")
-        self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
-                         "Attitude quaternion q_BN, scalar last, used when attitude_input = 'quaternion'")
+        sun = self.input_array("r_SN_N", [AU, 0.0, 0.0], "m", "Sun position in N")
+        position = self.input_array("r_BN_N", [0.0, 0.0, 0.0], "m", "Spacecraft position in N")
+        sigma = self.input_array("sigma_BN", [0.0, 0.0, 0.0], "1",
+                                 "Attitude MRP sigma_BN (Schaub and Junkins), used when attitude_input = 'mrp'")
+        quaternion = self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1",
+                                      "Attitude quaternion q_BN, scalar last, used when attitude_input = 'quaternion'")
         self.output_array("sun_heading_B", 3, lambda: self.feedthrough(self._heading)[0], "1",
-                          "Unit vector from the spacecraft to the Sun in B", depends_on=R_SUN + R_SC + SIGMA + Q)
+                          "Unit vector from the spacecraft to the Sun in B",
+                          depends_on=sun + position + sigma + quaternion)
         self.output("sun_distance", lambda: self.feedthrough(self._heading)[1], "m",
-                    "Distance from the spacecraft to the Sun, |r_SN_N - r_BN_N|", depends_on=R_SUN + R_SC)
+                    "Distance from the spacecraft to the Sun, |r_SN_N - r_BN_N|", depends_on=sun + position)
 
     def build_model(self):
         return sunline.SunlineEphemeris(self.values["attitude_input"])

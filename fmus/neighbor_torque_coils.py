@@ -7,10 +7,6 @@ from neighbor_fmu_support import NeighborSlave
 
 from components.acs import magnetorquer
 
-CMD_IN = [f"dipole_cmd_B[{i}]" for i in (1, 2, 3)] + ["enabled"]
-B_IN = [f"B_B[{i}]" for i in (1, 2, 3)]
-
-
 class TorqueCoils(NeighborSlave):
     description = ("Magnetic torque coils on the body axes: commanded dipole saturated per axis, torque = "
                    "dipole x field")
@@ -20,14 +16,15 @@ class TorqueCoils(NeighborSlave):
         self.parameter_array("max_dipole", [0.2, 0.2, 0.2], "A.m2",
                              "Largest dipole magnitude of the coil on each body axis, >= 0 (CubeSat torque "
                              "rod/coil class)")
-        self.input_array("dipole_cmd_B", [0.0, 0.0, 0.0], "A.m2", "Commanded magnetic dipole in B")
-        self.input_array("B_B", [0.0, 0.0, 0.0], "T", "Geomagnetic field at the spacecraft in B")
-        self.input("enabled", True, None, "Coils enabled; when false the dipole and torque are zero", bool)
+        dipole_cmd = self.input_array("dipole_cmd_B", [0.0, 0.0, 0.0], "A.m2", "Commanded magnetic dipole in B")
+        field = self.input_array("B_B", [0.0, 0.0, 0.0], "T", "Geomagnetic field at the spacecraft in B")
+        enabled = self.input("enabled", True, None, "Coils enabled; when false the dipole and torque are zero", bool)
         self.output_array("dipole_B", 3, self._dipole, "A.m2",
                           "Dipole produced: the command saturated per axis to +-max_dipole, 0 when disabled",
-                          depends_on=CMD_IN)
+                          depends_on=dipole_cmd + (enabled,))
         self.output_array("torque_B", 3, lambda: self._torque()[1], "N.m",
-                          "Magnetic torque on the body in B, dipole_B x B_B", depends_on=CMD_IN + B_IN)
+                          "Magnetic torque on the body in B, dipole_B x B_B",
+                          depends_on=dipole_cmd + (enabled,) + field)
 
     def _dipole(self):
         return self.model.dipole(self.vector("dipole_cmd_B", 3), self.values["enabled"])

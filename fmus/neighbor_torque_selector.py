@@ -22,11 +22,12 @@ class TorqueSelector(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        deps = []
+        deps: tuple = ()
         for name in command_selector.CONTROLLERS:
-            self.input_array(f"torque_cmd_{name}_B", [0.0] * 3, "N.m", f"Torque command of the {name} controller")
-            self.input(f"{name}_enable", False, None, f"The {name} controller is the active one", bool)
-            deps += [f"torque_cmd_{name}_B[{i}]" for i in (1, 2, 3)] + [f"{name}_enable"]
+            command = self.input_array(f"torque_cmd_{name}_B", [0.0] * 3, "N.m",
+                                       f"Torque command of the {name} controller")
+            enable = self.input(f"{name}_enable", False, None, f"The {name} controller is the active one", bool)
+            deps += command + (enable,)
         self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(self._select), "N.m",
                           "Torque command of the enabled controller (zero when none is enabled)", depends_on=deps)
 

@@ -202,20 +202,9 @@ def _retyped_element_names(script):
     return sorted(lines)
 
 
-# Wrappers that still build their own lists of element names (issue 23: converted so far are the
-# RCS controller family, the ground station and the support module; each conversion removes its name here).
-RETYPING = {"neighbor_acs_control", "neighbor_acs_signals", "neighbor_air_bearing_kinematics", "neighbor_atmosphere",
-            "neighbor_attitude_determination", "neighbor_attitude_to_dcm", "neighbor_burn_guidance",
-            "neighbor_earth_shadow", "neighbor_gps_receiver", "neighbor_gyro", "neighbor_horizon_sensor",
-            "neighbor_magnetic_field", "neighbor_rcs_thruster_set", "neighbor_rcs_thrusters",
-            "neighbor_reference_tracking_controller", "neighbor_sun_sensor", "neighbor_sunline_ephemeris",
-            "neighbor_torque_coils", "neighbor_torque_selector"}
-
-
 def test_wrappers_take_declared_names_from_their_declarations():
     found = {s.stem: _retyped_element_names(s) for s in wrapper_scripts()}
     support = build_fmus.FMU_SOURCES / "neighbor_fmu_support.py"
     assert _retyped_element_names(support) == [], "the support module takes element names from components.core.names"
     offenders = {name: lines for name, lines in found.items() if lines}
-    assert set(offenders) - RETYPING == set(), f"wrappers that retype declared names: {offenders}"
-    assert RETYPING - set(offenders) == set(), "converted wrappers: take them out of RETYPING"
+    assert offenders == {}, f"wrappers that retype declared names (file: lines): {offenders}"
