@@ -215,7 +215,7 @@ class ScheduledAlgorithm:
         for m in sch.modes:
             conds = [(_Signal(table, ci, var, KIND[comps[ci].vars[var].type]), vals) for ci, var, vals in m.conditions]
             order = [ci for ci in plan.order if m.active[ci]]
-            self.modes.append(_Mode(m.name, m.step_size, order, m.record_every, conds, list(m.multiples),
+            self.modes.append(_Mode(m.mode.name, m.mode.step_size, order, m.mode.record_every, conds, list(m.multiples),
                                     refreshed(order)))
         self.events = [_Signal(table, ci, var, "Real") for ci, var in sch.events]
         self.cond_comps = sorted({sig.ci for m in self.modes for sig, _ in m.conditions})

@@ -8,6 +8,8 @@ from os import PathLike
 from types import MappingProxyType
 from typing import Any, FrozenSet, Mapping, Optional, Sequence, Tuple, Union
 
+from ..ssp.schedule import ScheduleMode
+
 ALGORITHMS = ("gauss-seidel", "jacobi")
 
 Path_ = Union[str, "PathLike[str]"]
@@ -49,12 +51,10 @@ class RunOptions:
 
 
 @dataclass(frozen=True, slots=True)
-class ScheduleMode:
-    """One nc:Mode of an nc:Schedule: when every condition holds, step with `step_size`."""
-    name: str
-    step_size: float
+class PlannedMode:
+    """A mode of the nc:Schedule, as the file declares it, resolved against the components."""
+    mode: ScheduleMode  # what the file says (name, step size, record interval, by name)
     active: Tuple[bool, ...]  # per component: stepped in this mode (else suspended)
-    record_every: int  # record a row every this many macro steps of the mode
     conditions: Tuple[Tuple[int, str, FrozenSet[int]], ...]  # (component, connector, values): all must hold
     multiples: Tuple[int, ...]  # per component: stepped every k-th macro step of the mode (1: every step)
 
@@ -62,7 +62,7 @@ class ScheduleMode:
 @dataclass(frozen=True, slots=True)
 class SchedulePlan:
     """nc:Schedule: the first mode whose conditions hold decides each macro step."""
-    modes: Tuple[ScheduleMode, ...]  # the last may be unconditional
+    modes: Tuple[PlannedMode, ...]  # the last may be unconditional
     events: Tuple[Tuple[int, str], ...]  # ((component, Real output announcing the next event time), ...)
     origin: str  # file:line of the nc:Schedule element, for messages
 

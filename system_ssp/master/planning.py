@@ -9,7 +9,7 @@ from .connections import KIND, NUMERIC
 from .graph import toposort
 from .names import near, split_name
 from .parameters import collect_parameters
-from .plan import ALGORITHMS, RunOptions, RunPlan, ScheduleMode, SchedulePlan
+from .plan import ALGORITHMS, PlannedMode, RunOptions, RunPlan, SchedulePlan
 
 
 # The most communication steps a fixed-step run may take: a day of wall time at the master's
@@ -175,7 +175,7 @@ def _schedule(system, algorithm, multiples):
                                + ", ".join(f"{u!r}{near(u, names)}" for u in unknown))
             active = [c.name in m.active for c in system.comps]
         conds = tuple(signal(c, v, ("Integer", "Enumeration", "Boolean"), f"nc:When of mode {m.name!r}",
-                             m.origin, CONDITION_CAUSALITIES)[:2] + (vals,) for c, v, vals in m.conditions)
+                             m.origin, CONDITION_CAUSALITIES)[:2] + (frozenset(vals),) for c, v, vals in m.conditions)
         mult = [1] * len(system.comps)
         for comp, k in m.every.items():
             if comp not in system.by_name:
@@ -185,7 +185,6 @@ def _schedule(system, algorithm, multiples):
                 raise SSPError(f"{m.origin}: nc:Mode {m.name!r} every names {comp!r}, which is not active "
                                "in that mode")
             mult[system.by_name[comp].index] = k
-        modes.append(ScheduleMode(name=m.name, step_size=m.step_size, active=tuple(active),
-                                  record_every=m.record_every, conditions=conds, multiples=tuple(mult)))
+        modes.append(PlannedMode(mode=m, active=tuple(active), conditions=conds, multiples=tuple(mult)))
     events = tuple(signal(c, v, ("Real",), "nc:NextEvent", sched.origin)[:2] for c, v in sched.events)
     return SchedulePlan(modes=tuple(modes), events=events, origin=sched.origin)

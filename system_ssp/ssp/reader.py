@@ -19,6 +19,7 @@ import fmpy
 from lxml import etree
 
 from ..errors import SSPError
+from .schedule import Schedule, ScheduleMode, When
 from .units import SI_BASE_UNITS, Unit
 
 NS_SSD = "http://ssp-standard.org/SSP1/SystemStructureDescription"
@@ -114,28 +115,7 @@ class MasterSettings:
     order_origin: str = ""  # file:line of nc:Order
     step_multiples: dict = field(default_factory=dict)
     stop_conditions: list = field(default_factory=list)
-    schedule: Optional["Schedule"] = None
-    origin: str = ""
-
-
-@dataclass
-class ScheduleMode:
-    """One entry of nc:Schedule: when its conditions hold, step with `step_size` and step only
-    the `active` components (None = all)."""
-    name: str
-    step_size: float
-    active: Optional[list] = None
-    record_every: int = 1
-    every: dict = field(default_factory=dict)  # component -> k: stepped every k-th step of the mode
-    conditions: list = field(default_factory=list)  # [(component, connector, frozenset of ints)]
-    origin: str = ""
-
-
-@dataclass
-class Schedule:
-    """nc:Schedule: mode-dependent communication steps (see system_ssp/__init__.py)."""
-    modes: list = field(default_factory=list)
-    events: list = field(default_factory=list)  # [(component, connector)] of Real outputs
+    schedule: Optional[Schedule] = None
     origin: str = ""
 
 
@@ -480,8 +460,8 @@ def _where(e, namer):
 
 def _parse_schedule(el, namer):
     """nc:Schedule: nc:Mode entries (each with nc:When conditions) and nc:NextEvent signals."""
-    sched = Schedule(origin=_where(el, namer))
-    names = set()
+    origin = _where(el, namer)
+    modes, events, names = [], [], set()
     for child in el:
         if not isinstance(child.tag, str):
             continue
@@ -490,18 +470,18 @@ def _parse_schedule(el, namer):
             comp, conn = child.get("component"), child.get("connector")
             if not comp or not conn:
                 raise SSPError(f"{o}: nc:NextEvent needs component=\"name\" and connector=\"name\"")
-            sched.events.append((comp, conn))
+            events.append((comp, conn))
             continue
         if child.tag != _q("nc", "Mode"):
             raise SSPError(f"{o}: unknown element {child.tag} in nc:Schedule (expected nc:Mode, nc:NextEvent)")
-        sched.modes.append(_parse_mode(child, o, namer, names))
-    if not sched.modes:
-        raise SSPError(f"{sched.origin}: nc:Schedule needs at least one nc:Mode")
-    for m in sched.modes[:-1]:
+        modes.append(_parse_mode(child, o, namer, names))
+    if not modes:
+        raise SSPError(f"{origin}: nc:Schedule needs at least one nc:Mode")
+    for m in modes[:-1]:
         if not m.conditions:
             raise SSPError(f"{m.origin}: nc:Mode {m.name!r} has no nc:When, so it always matches; only the "
                            "last mode may be unconditional (modes are tried in order)")
-    return sched
+    return Schedule(modes=tuple(modes), events=tuple(events), origin=origin)
 
 
 def _parse_mode(child, o, namer, names):
@@ -536,8 +516,7 @@ def _parse_mode(child, o, namer, names):
             raise SSPError(f"{o}: nc:Mode {name!r} every=\"{child.get('every')}\": expected "
                            "\"component:k ...\" with integers k >= 1")
         multiples[comp] = k
-    mode = ScheduleMode(name=name, step_size=h, active=None if active is None else active.split(),
-                        record_every=every, every=multiples, origin=o)
+    conditions = []
     for w in child:
         if not isinstance(w.tag, str):
             continue
@@ -546,14 +525,15 @@ def _parse_mode(child, o, namer, names):
             raise SSPError(f"{wo}: unknown element {w.tag} in nc:Mode (expected nc:When)")
         comp, conn, values = w.get("component"), w.get("connector"), w.get("values")
         try:
-            vals = frozenset(int(v) for v in (values or "").split())
+            vals = tuple(int(v) for v in (values or "").split())
         except ValueError:
-            vals = frozenset()
+            vals = ()
         if not comp or not conn or not vals:
             raise SSPError(f"{wo}: nc:When needs component=\"name\", connector=\"name\" and "
                            "values=\"integers\" (Booleans: 0 or 1)")
-        mode.conditions.append((comp, conn, vals))
-    return mode
+        conditions.append(When(comp, conn, vals))
+    return ScheduleMode(name=name, step_size=h, active=None if active is None else tuple(active.split()),
+                        record_every=every, conditions=tuple(conditions), every=multiples, origin=o)
 
 
 def parse_ssd(ssd_path, namer, validate=True):

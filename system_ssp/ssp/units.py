@@ -11,19 +11,19 @@ the one place the product spells it.
 that only name their units (e.g. "m" and "km") still converts correctly.
 """
 import math
-from typing import NamedTuple
+from typing import Dict, NamedTuple, Optional, Tuple
 
 SI_BASE_UNITS = ("kg", "m", "s", "A", "K", "mol", "cd", "rad")
 
 
 class Unit(NamedTuple):
     name: str
-    exponents: tuple  # of SI_BASE_UNITS
+    exponents: Tuple[int, ...]  # of SI_BASE_UNITS
     factor: float
     offset: float
 
 
-def make_unit(name, factor=1.0, offset=0.0, **exps):
+def make_unit(name: str, factor: float = 1.0, offset: float = 0.0, **exps: int) -> Unit:
     unknown = set(exps) - set(SI_BASE_UNITS)
     if unknown:
         raise ValueError(f"unit {name!r}: unknown base unit(s) {sorted(unknown)}")
@@ -56,13 +56,13 @@ BUILTIN = {u.name: u for u in [
 ]}
 
 
-def base_unit_attributes(unit):
+def base_unit_attributes(unit: Unit) -> Dict[str, int]:
     """{base unit: exponent} of the non-zero exponents, in SI_BASE_UNITS order (the attributes of
     an FMI BaseUnit / ssc:BaseUnit element)."""
     return {b: e for b, e in zip(SI_BASE_UNITS, unit.exponents) if e}
 
 
-def conversion(src, dst):
+def conversion(src: Unit, dst: Unit) -> Optional[Tuple[float, float]]:
     """(factor, offset) mapping a value in unit `src` to unit `dst`; None if dimensions differ."""
     if src.exponents != dst.exponents:
         return None
@@ -71,6 +71,6 @@ def conversion(src, dst):
     return factor, offset
 
 
-def describe(unit):
+def describe(unit: Unit) -> str:
     parts = [f"{b}^{e}" if e != 1 else b for b, e in zip(SI_BASE_UNITS, unit.exponents) if e]
     return "*".join(parts) or "1"

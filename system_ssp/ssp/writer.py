@@ -99,11 +99,9 @@ class SystemWriter:
         files in parameters/, without .ssv]), connections as (source, output, destination, input,
         n) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar, optional
         "parameters" (system parameters, see _system_parameters_xml) and "parameter_bindings", "stop"
-        Boolean outputs, "order", "stop_time", "step_size", and "schedule": {"modes": [(name,
-        step, active components or None, recordEvery, [(component, connector, [values])][,
-        {component: k}])], "events": [(component, connector)]} for an nc:Schedule (the optional
-        dict: components stepped every k-th step of the mode). libcosim applies only a
-        component's first ParameterBinding: put the one that matters first."""
+        Boolean outputs, "order", "stop_time", "step_size", and "schedule": a schedule.Schedule
+        for an nc:Schedule (the type the reader returns). libcosim applies only a component's
+        first ParameterBinding: put the one that matters first."""
         self._write(self.directory / f"{name}.ssd", self.ssd_text(name, spec))
 
     def ssd_text(self, name, spec):
@@ -220,28 +218,27 @@ def _schedule_xml(name, schedule, comp_vars):
                                  f"{' or '.join(types)}")
 
     out = ["          <nc:Schedule>"]
-    for mode, step, active, every, when, *multiples in schedule["modes"]:
-        multiples = multiples[0] if multiples else {}
-        for comp in list(active or []) + list(multiples):
+    for mode in schedule.modes:
+        for comp in list(mode.active or []) + list(mode.every):
             if comp not in comp_vars:
-                raise GeneratorError(f"{name}: schedule mode {mode} lists unknown component {comp}")
-        attrs = f'name="{mode}" stepSize="{step!r}"'
-        if active is not None:
-            attrs += f' active="{" ".join(active)}"'
-        if every != 1:
-            attrs += f' recordEvery="{every}"'
-        if multiples:
-            attrs += f' every="{" ".join(f"{c}:{k}" for c, k in multiples.items())}"'
-        if not when:
+                raise GeneratorError(f"{name}: schedule mode {mode.name} lists unknown component {comp}")
+        attrs = f'name="{mode.name}" stepSize="{mode.step_size!r}"'
+        if mode.active is not None:
+            attrs += f' active="{" ".join(mode.active)}"'
+        if mode.record_every != 1:
+            attrs += f' recordEvery="{mode.record_every}"'
+        if mode.every:
+            attrs += f' every="{" ".join(f"{c}:{k}" for c, k in mode.every.items())}"'
+        if not mode.conditions:
             out.append(f"            <nc:Mode {attrs}/>")
             continue
         out.append(f"            <nc:Mode {attrs}>")
-        for comp, var, values in when:
+        for comp, var, values in mode.conditions:
             check(comp, var, ("Integer", "Enumeration", "Boolean"), CONDITION_CAUSALITIES)
             out.append(f'              <nc:When component="{comp}" connector="{var}" '
                        f'values="{" ".join(str(int(v)) for v in values)}"/>')
         out.append("            </nc:Mode>")
-    for comp, var in schedule.get("events", []):
+    for comp, var in schedule.events:
         check(comp, var, ("Real",))
         out.append(f'            <nc:NextEvent component="{comp}" connector="{var}"/>')
     out.append("          </nc:Schedule>")

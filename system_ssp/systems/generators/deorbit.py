@@ -34,6 +34,8 @@ from components.mission.neighbor import (DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBI
 from components.orbit import propulsion
 from components.core.constants import DAY, R_EQ, YEAR
 
+from ...ssp.schedule import Schedule, ScheduleMode, When
+
 KM = 1000.0
 BASE = SCENARIOS[DEFAULT_SCENARIO]  # the component-level files start from it
 ORBIT = {"epoch": HOST_ORBIT.deorbit_epoch, "sma0": R_EQ + BASE.altitude_km * KM, "ecc0": 0.0,
@@ -64,8 +66,9 @@ def system(orbit_fmu, coast_step):
         "stop": [("orbit", "reentered")],
         "stop_time": STOP_TIME,
         "step_size": coast_step,
-        "schedule": {"modes": [("burn", BURN_STEP, None, 60, [("propulsion", "burning", [1])]),
-                               ("coast", coast_step, None, 1, [])]},
+        "schedule": Schedule(modes=(
+            ScheduleMode("burn", BURN_STEP, record_every=60, conditions=(When("propulsion", "burning", (1,)),)),
+            ScheduleMode("coast", coast_step))),
     }
 
 

@@ -75,6 +75,7 @@ from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYS
                                          SCENARIOS, SPACECRAFT, scenario_set)
 from components.mission.power_bus import LOAD_NAMES
 
+from ...ssp.schedule import Schedule, ScheduleMode, When
 from ...ssp.writer import vec
 from . import attitude_determination as ad
 
@@ -204,7 +205,7 @@ SPACECRAFT_PARAMETERS = {
 
 def having(role):
     """The components with a schedule role, in SSD order."""
-    return [c for c, (_, _, roles) in COMPONENTS.items() if role in roles]
+    return tuple(c for c, (_, _, roles) in COMPONENTS.items() if role in roles)
 
 
 def maneuver_active(phase, truth=False):
@@ -213,11 +214,11 @@ def maneuver_active(phase, truth=False):
     others = {c for c, (_, _, roles) in COMPONENTS.items() if roles & set(MANEUVERS) - {phase}}
     if truth:
         others |= set(having("sense")) - set(having("truth"))
-    return [c for c in ORDER if c not in others]
+    return tuple(c for c in ORDER if c not in others)
 
 
 def maneuver_every(phase, truth=False):
-    slow = having("slow") + (having("slow_burn") if phase == "burn" else [])
+    slow = having("slow") + (having("slow_burn") if phase == "burn" else ())
     every = {c: SLOW_EVERY for c in slow}
     if not truth:
         every.update({c: SLOW_EVERY for c in having("sense_slow")})
@@ -227,7 +228,7 @@ def maneuver_every(phase, truth=False):
 
 def determination_active():
     """Estimation: the bus, the tumbling rigid body, the sensors and the estimator."""
-    return [c for c in ORDER if c in set(having("bus")) | set(having("sense")) | {"dynamics"}]
+    return tuple(c for c in ORDER if c in set(having("bus")) | set(having("sense")) | {"dynamics"})
 
 
 def determination_every():
@@ -260,17 +261,22 @@ def deployment_altitude(target_km, density=HOST_ORBIT.density_model):
     return 0.5 * (lo + hi)
 
 
-TRUTH = ("estimator", "truth_feedback", [1])
+TRUTH = When("estimator", "truth_feedback", (1,))
+
+
+def in_mode(mode, **also):
+    """Conditions: the mission in `mode` and each further output of the manager at its value."""
+    return (When("mission", "mode", (mode,)),) + tuple(When("mission", k, (v,)) for k, v in also.items())
 
 
 def maneuver_modes():
     """The 15 ms attitude phases, each twice: with truth feedback (no sensors) and with estimation."""
     modes = []
     for name, phase in (("detumble", Phase.DETUMBLE), ("slew", Phase.SLEW), ("burn", Phase.BURN)):
-        when = [("mission", "mode", [Mode.DEORBIT]), ("mission", "phase", [phase])]
-        modes.append((f"{name}_truth", 0.015, maneuver_active(name, truth=True), 20, when + [TRUTH],
-                      maneuver_every(name, truth=True)))
-        modes.append((name, 0.015, maneuver_active(name), 20, when, maneuver_every(name)))
+        when = in_mode(Mode.DEORBIT, phase=phase)
+        modes.append(ScheduleMode(f"{name}_truth", 0.015, maneuver_active(name, truth=True), 20, when + (TRUTH,),
+                                  maneuver_every(name, truth=True)))
+        modes.append(ScheduleMode(name, 0.015, maneuver_active(name), 20, when, maneuver_every(name)))
     return modes
 
 
@@ -362,21 +368,21 @@ def system(orbit_fmu):
         # The fixed step a master without our nc:Schedule runs at (and `--no-schedule`): the 15 ms of
         # the attitude loop, which every phase is correct at. The schedule only saves the steps.
         "step_size": 0.015,
-        "schedule": {"modes": [
+        "schedule": Schedule(modes=(
             *maneuver_modes(),
-            ("determination_truth", 1.0, having("bus"), 10, [("mission", "mode", [Mode.DEORBIT]), TRUTH]),
-            ("determination", DETERMINATION_STEP, determination_active(), 10, [("mission", "mode", [Mode.DEORBIT])],
-             determination_every()),
-            ("contact", 1.0, having("bus"), 10, [("mission", "mode", [Mode.CONTACT])]),
-            ("awaiting_near", 5.0, having("bus"), 12,
-             [("mission", "mode", [Mode.AWAITING]), ("ground", "near_contact", [1])]),
-            ("awaiting", FAR_STEP, having("bus"), 1, [("mission", "mode", [Mode.AWAITING])]),
-            ("monitoring_near", 10.0, having("monitor"), 6,
-             [("mission", "mode", [Mode.MONITORING]), ("ground", "near_contact", [1])]),
-            ("monitoring", FAR_STEP, having("monitor"), 1, [("mission", "mode", [Mode.MONITORING])]),
-            ("decay", DAY, having("decay"), 1, [("mission", "mode", [Mode.END])]),
-            ("idle", 6 * 3600.0, having("idle"), 4, [])],
-            "events": [("mission", "next_event_time"), ("host", "next_event_time")]},
+            ScheduleMode("determination_truth", 1.0, having("bus"), 10, in_mode(Mode.DEORBIT) + (TRUTH,)),
+            ScheduleMode("determination", DETERMINATION_STEP, determination_active(), 10, in_mode(Mode.DEORBIT),
+                         determination_every()),
+            ScheduleMode("contact", 1.0, having("bus"), 10, in_mode(Mode.CONTACT)),
+            ScheduleMode("awaiting_near", 5.0, having("bus"), 12,
+                         in_mode(Mode.AWAITING) + (When("ground", "near_contact", (1,)),)),
+            ScheduleMode("awaiting", FAR_STEP, having("bus"), 1, in_mode(Mode.AWAITING)),
+            ScheduleMode("monitoring_near", 10.0, having("monitor"), 6,
+                         in_mode(Mode.MONITORING) + (When("ground", "near_contact", (1,)),)),
+            ScheduleMode("monitoring", FAR_STEP, having("monitor"), 1, in_mode(Mode.MONITORING)),
+            ScheduleMode("decay", DAY, having("decay"), 1, in_mode(Mode.END)),
+            ScheduleMode("idle", 6 * 3600.0, having("idle"), 4)),
+            events=(("mission", "next_event_time"), ("host", "next_event_time"))),
     }
 
 
