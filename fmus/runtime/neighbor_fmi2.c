@@ -4,10 +4,14 @@
  * bridge any FMI host loads, with or without a Python of its own:
  *
  * - The Python C API is resolved at run time (dlsym), never linked: in a host that already runs
- *   Python (FMPy) its interpreter is used; otherwise the CPython shared library is loaded
- *   (NEIGHBOR_FMU_LIBPYTHON, the library the FMU was built with, then the system's soname) and
- *   an interpreter is started. Only functions of the stable ABI are called, through pointers,
- *   so the binary depends on no Python version at link time.
+ *   Python (FMPy) its interpreter is used; otherwise a CPython 3.9+ shared library is found on the
+ *   target (see find_python: NEIGHBOR_FMU_LIBPYTHON, the python3 on PATH, the linker's
+ *   libpython3.X newest first, the build's library last) with its own standard library, and an
+ *   interpreter is started. Only functions of the stable ABI are called, through pointers, so one
+ *   binary serves every CPython 3.9 to 3.13.
+ * - Nothing here exits the host: a Python that could not start (Python's initialization would
+ *   exit the process) is refused before it starts, and fmi2Instantiate returns NULL with the
+ *   reason in the host's logger; every later fmi2Instantiate gives the same answer.
  * - An interpreter this library started is never finalized (extension modules such as numpy or
  *   numba cannot be re-initialized, and a host may load other FMUs later); Python holds no
  *   pointer into this library, so the host may unload it at any time.
@@ -22,6 +26,9 @@
  * its path into a module private to the FMU build, never imported) and one private package with
  * the model's code (see build_fmus.py).
  */
+#ifndef _WIN32
+#define _GNU_SOURCE  /* dladdr */
+#endif
 #include <stdarg.h>
 #include <stddef.h>
 #include <stdio.h>
@@ -33,7 +40,6 @@
 #ifdef _WIN32
 #include <windows.h>
 typedef HMODULE lib_handle;
-static lib_handle lib_open(const char *path) { return LoadLibraryA(path); }
 static void *lib_sym(lib_handle h, const char *name) { return (void *)GetProcAddress(h, name); }
 static void *process_sym(const char *name) {
     /* a Python already in the host: look in the modules the process has loaded */
@@ -51,7 +57,6 @@ static void *process_sym(const char *name) {
 #else
 #include <dlfcn.h>
 typedef void *lib_handle;
-static lib_handle lib_open(const char *path) { return dlopen(path, RTLD_NOW | RTLD_GLOBAL); }
 static void *lib_sym(lib_handle h, const char *name) { return dlsym(h, name); }
 static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
 #define PATH_SEP '/'
@@ -159,60 +164,247 @@ static void config_value(const char *resources, const char *key, char *out, size
     fclose(f);
 }
 
+/* ---- finding a Python on the target -------------------------------------------------------------
+ * In order: NEIGHBOR_FMU_LIBPYTHON (an explicit choice: its failure is the answer); the python3 on
+ * the host's PATH (asked for its shared library); libpython3.X through the system's linker for
+ * every supported minor version, newest first; the build machine's library last, and only when its
+ * prefix exists. A library is taken only with its standard library: the Python home is PYTHONHOME
+ * when the user set it, else the folder above the library that holds lib/python3.X/encodings (so
+ * the build machine's paths are never used for another Python). Python's own initialization
+ * exits the process when it finds no standard library; checking first keeps the host alive. */
+#define MIN_MINOR 9
+#define MAX_MINOR 13
+
+static void note(char *tried, size_t size, const char *fmt, ...) {
+    size_t used = strlen(tried);
+    if (used + 3 >= size) return;
+    if (used) {
+        memcpy(tried + used, "; ", 3);
+        used += 2;
+    }
+    va_list ap;
+    va_start(ap, fmt);
+    vsnprintf(tried + used, size - used, fmt, ap);
+    va_end(ap);
+}
+
+static int file_exists(const char *path) {
+    FILE *f = fopen(path, "rb");
+    if (!f) return 0;
+    fclose(f);
+    return 1;
+}
+
+/* The standard library of Python `version` (3.X) below `home`: its landmark's path in `landmark`. */
+static int stdlib_at(const char *home, const char *version, char *landmark, size_t size) {
+#ifdef _WIN32
+    (void)version;
+    snprintf(landmark, size, "%s\\Lib\\encodings\\__init__.py", home);
+#else
+    snprintf(landmark, size, "%s/lib/python%s/encodings/__init__.py", home, version);
+#endif
+    return file_exists(landmark);
+}
+
+/* The home of the library at `libpath`: it or one of the 3 folders above it holding the standard
+   library (pyenv and python.org: <home>/lib/libpython3.X.so; Debian: /usr/lib/<arch>/; Windows:
+   <home>/python3X.dll). */
+static int home_of_library(const char *libpath, const char *version, char *home, size_t size) {
+    char dir[4096], landmark[4200];
+    snprintf(dir, sizeof dir, "%s", libpath);
+    for (int up = 0; up < 4; up++) {
+        char *sep = strrchr(dir, PATH_SEP);
+#ifdef _WIN32
+        char *alt = strrchr(dir, '/');
+        if (alt > sep) sep = alt;
+#endif
+        if (!sep || sep == dir) return 0;
+        *sep = '\0';
+        if (stdlib_at(dir, version, landmark, sizeof landmark)) {
+            snprintf(home, size, "%s", dir);
+            return 1;
+        }
+    }
+    return 0;
+}
+
+static lib_handle lib_probe(const char *path) {
+#ifdef _WIN32
+    return LoadLibraryA(path);
+#else
+    return dlopen(path, RTLD_NOW | RTLD_LOCAL);  /* made global only once it is chosen */
+#endif
+}
+
+static void lib_close(lib_handle h) {
+#ifdef _WIN32
+    FreeLibrary(h);
+#else
+    dlclose(h);
+#endif
+}
+
+/* Where the library that holds `symbol` (in `h`) was loaded from. */
+static int library_file(lib_handle h, void *symbol, char *out, size_t size) {
+#ifdef _WIN32
+    (void)symbol;
+    DWORD n = GetModuleFileNameA(h, out, (DWORD)size);
+    return n > 0 && n < size;
+#else
+    (void)h;
+    Dl_info info;
+    if (!dladdr(symbol, &info) || !info.dli_fname) return 0;
+    char *real = realpath(info.dli_fname, NULL);  /* Debian: /lib/<arch>/ is /usr/lib/<arch>/ */
+    snprintf(out, size, "%s", real ? real : info.dli_fname);
+    free(real);
+    return 1;
+#endif
+}
+
+/* Try the CPython library `spec` (a path or a name for the linker), found as `how`. On success
+   the handle (made global), its version "3.X" and its home. */
+static lib_handle try_library(const char *spec, const char *how, char *version, size_t vsize, char *home,
+                              size_t hsize, char *tried, size_t tsize) {
+    lib_handle h = lib_probe(spec);
+    if (!h) {
+        note(tried, tsize, "%s (%s): not found", spec, how);
+        return NULL;
+    }
+    void *sym = lib_sym(h, "Py_GetVersion");
+    if (!sym) {
+        note(tried, tsize, "%s (%s): not a CPython library", spec, how);
+        lib_close(h);
+        return NULL;
+    }
+    const char *(*get_version)(void) = (const char *(*)(void))sym;
+    int major = 0, minor = 0;
+    if (sscanf(get_version(), "%d.%d", &major, &minor) != 2 || major != 3 || minor < MIN_MINOR) {
+        note(tried, tsize, "%s (%s): Python %.12s is not supported (3.%d or newer)", spec, how, get_version(),
+             MIN_MINOR);
+        lib_close(h);
+        return NULL;
+    }
+    snprintf(version, vsize, "%d.%d", major, minor);
+    char file[4096], landmark[4200];
+    if (!library_file(h, sym, file, sizeof file)) snprintf(file, sizeof file, "%s", spec);
+    const char *user_home = getenv("PYTHONHOME");
+    if (user_home && user_home[0]) {
+        if (!stdlib_at(user_home, version, landmark, sizeof landmark)) {
+            note(tried, tsize, "%s (%s, Python %s): PYTHONHOME=%s has no standard library for it (no %s)", file,
+                 how, version, user_home, landmark);
+            lib_close(h);
+            return NULL;
+        }
+        snprintf(home, hsize, "%s", user_home);
+    } else if (!home_of_library(file, version, home, hsize)) {
+        note(tried, tsize, "%s (%s, Python %s): no standard library beside it (no lib/python%s/encodings in the "
+             "folders above it; set PYTHONHOME to its prefix)", file, how, version, version);
+        lib_close(h);
+        return NULL;
+    }
+#ifndef _WIN32
+    /* global from now on: extension modules (numpy) find the C API in the process */
+    lib_handle global = dlopen(file, RTLD_NOW | RTLD_GLOBAL);
+    if (global) {
+        dlclose(h);
+        h = global;
+    }
+#endif
+    return h;
+}
+
+/* The shared library of the python3 on the host's PATH, asked from that Python ("" if none). */
+static void python_on_path(char *out, size_t size) {
+    out[0] = '\0';
+#ifdef _WIN32
+    FILE *p = _popen("python -E -S -c \"import sys, os; print(os.path.join(sys.base_prefix, "
+                     "'python%d%d.dll' % sys.version_info[:2]))\" 2>NUL", "r");
+#else
+    FILE *p = popen("python3 -E -S -c \"import os, sysconfig as s; "
+                    "print(os.path.join(s.get_config_var('LIBDIR') or '', s.get_config_var('INSTSONAME') or ''))\" "
+                    "2>/dev/null", "r");
+#endif
+    if (!p) return;
+    if (fgets(out, (int)size, p)) out[strcspn(out, "\r\n")] = '\0';
+    else out[0] = '\0';
+#ifdef _WIN32
+    _pclose(p);
+#else
+    pclose(p);
+#endif
+}
+
+static void library_name(int minor, char *out, size_t size) {
+#ifdef _WIN32
+    snprintf(out, size, "python3%d.dll", minor);
+#else
+    snprintf(out, size, "libpython3.%d.so.1.0", minor);
+#endif
+}
+
+static lib_handle find_python(const char *resources, char *version, size_t vsize, char *home, size_t hsize) {
+    char tried[3000] = "", spec[4096];
+    lib_handle h = NULL;
+    const char *env = getenv("NEIGHBOR_FMU_LIBPYTHON");
+    if (env && env[0]) {
+        h = try_library(env, "NEIGHBOR_FMU_LIBPYTHON", version, vsize, home, hsize, tried, sizeof tried);
+        if (!h) snprintf(runtime_error, sizeof runtime_error, "no usable Python for this FMU: %s", tried);
+        return h;
+    }
+    python_on_path(spec, sizeof spec);
+    if (spec[0] && file_exists(spec)) {
+        h = try_library(spec, "the python3 on PATH", version, vsize, home, hsize, tried, sizeof tried);
+    } else {
+        note(tried, sizeof tried, spec[0] ? "the python3 on PATH has no shared library (%s)" : "no python3 on PATH",
+             spec);
+    }
+    for (int minor = MAX_MINOR; minor >= MIN_MINOR && !h; minor--) {
+        library_name(minor, spec, sizeof spec);
+        h = try_library(spec, "system linker", version, vsize, home, hsize, tried, sizeof tried);
+    }
+    if (!h) {
+        char built[4096], built_home[4096], landmark[4200];
+        config_value(resources, "libpython", built, sizeof built);
+        config_value(resources, "python_home", built_home, sizeof built_home);
+        config_value(resources, "python_version", version, vsize);
+        if (built[0] && built_home[0] && stdlib_at(built_home, version, landmark, sizeof landmark))
+            h = try_library(built, "the build's Python", version, vsize, home, hsize, tried, sizeof tried);
+    }
+    if (!h)
+        snprintf(runtime_error, sizeof runtime_error,
+                 "this FMU runs its model in CPython 3.%d to 3.%d with numpy and found none it can use (%s). Install "
+                 "CPython 3 with its shared library (e.g. Debian's libpython3.11) and numpy, put its python3 on "
+                 "PATH, or set NEIGHBOR_FMU_LIBPYTHON to the library's path", MIN_MINOR, MAX_MINOR, tried);
+    return h;
+}
+
 static int start_runtime(const char *resources) {
     if (runtime_ready) return 1;
-    runtime_error[0] = '\0';
+    if (runtime_error[0]) return 0;  /* tried in this process before: the same answer, no retry */
     if (process_sym("Py_IsInitialized") && resolve_all(NULL) && py.IsInitialized()) {
         runtime_ready = 1;  /* the host runs Python: use its interpreter */
-    } else {
-        char built[4096], version[64], tried[3072] = "";
-        config_value(resources, "libpython", built, sizeof built);
-        config_value(resources, "python_version", version, sizeof version);
-        char soname[128];
-#ifdef _WIN32
-        char nodot[64];
-        size_t k = 0;
-        for (const char *c = version; *c && k + 1 < sizeof nodot; c++)
-            if (*c != '.') nodot[k++] = *c;
-        nodot[k] = '\0';
-        snprintf(soname, sizeof soname, "python%s.dll", nodot);
-#else
-        snprintf(soname, sizeof soname, "libpython%s.so.1.0", version);
-#endif
-        const char *env = getenv("NEIGHBOR_FMU_LIBPYTHON");
-        const char *candidates[] = {env, built, soname};
-        lib_handle handle = NULL;
-        for (size_t i = 0; i < 3 && !handle; i++) {
-            if (!candidates[i] || !candidates[i][0]) continue;
-            handle = lib_open(candidates[i]);
-            size_t used = strlen(tried);
-            snprintf(tried + used, sizeof tried - used, "%s%s", used ? ", " : "", candidates[i]);
-        }
-        if (!handle) {
-            snprintf(runtime_error, sizeof runtime_error,
-                     "this FMU runs its model in Python %s and needs the CPython %s shared library; none found "
-                     "(tried %s). Install Python %s with its shared library (e.g. the libpython%s package) or set "
-                     "NEIGHBOR_FMU_LIBPYTHON to the library's path", version, version, tried, version, version);
+        return 1;
+    }
+    runtime_error[0] = '\0';
+    char version[64], home[4096];
+    lib_handle handle = find_python(resources, version, sizeof version, home, sizeof home);
+    if (!handle) return 0;
+    if (!resolve_all(handle)) return 0;
+    if (!py.IsInitialized()) {
+        void *(*decode)(const char *, size_t *) = (void *(*)(const char *, size_t *))lib_sym(handle, "Py_DecodeLocale");
+        void (*set_home)(const void *) = (void (*)(const void *))lib_sym(handle, "Py_SetPythonHome");
+        if (!decode || !set_home) {
+            snprintf(runtime_error, sizeof runtime_error, "the Python %s library lacks Py_SetPythonHome", version);
             return 0;
         }
-        if (!resolve_all(handle)) return 0;
-        if (!py.IsInitialized()) {
-            /* The standard library of the Python the library belongs to (its prefix at build
-               time), unless the user chose one with PYTHONHOME. */
-            char home[4096];
-            config_value(resources, "python_home", home, sizeof home);
-            void *(*decode)(const char *, size_t *) = (void *(*)(const char *, size_t *))lib_sym(handle, "Py_DecodeLocale");
-            void (*set_home)(const void *) = (void (*)(const void *))lib_sym(handle, "Py_SetPythonHome");
-            if (!getenv("PYTHONHOME") && home[0] && decode && set_home) {
-                void *whome = decode(home, NULL);  /* kept: Python reads it during initialization */
-                if (whome) set_home(whome);
-            }
-            py.InitializeEx(0);  /* no signal handlers: the host owns the signals */
-            runtime_embedded = 1;
-            py.EvalSaveThread();  /* release the GIL: every call takes it with PyGILState_Ensure */
-        }
-        runtime_ready = 1;
+        static void *whome = NULL;  /* kept: Python reads it during initialization and after */
+        whome = decode(home, NULL);
+        if (whome) set_home(whome);
+        py.InitializeEx(0);  /* no signal handlers: the host owns the signals */
+        runtime_embedded = 1;
+        py.EvalSaveThread();  /* release the GIL: every call takes it with PyGILState_Ensure */
     }
+    runtime_ready = 1;
     return 1;
 }
 

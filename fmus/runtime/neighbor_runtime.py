@@ -34,9 +34,12 @@ def _config(resources):
 
 def _make_packages_importable(cfg):
     """In an interpreter the binary started: the folders of NEIGHBOR_FMU_PYTHONPATH, then the
-    site-packages of the environment the FMU was built in (where they exist)."""
+    site-packages of the environment the FMU was built in (where they exist, and only for the
+    Python version it was built with: another version cannot load their compiled modules)."""
     extra = [p for p in os.environ.get("NEIGHBOR_FMU_PYTHONPATH", "").split(os.pathsep) if p]
-    for folder in extra + cfg.get("site_packages", []):
+    here = f"{sys.version_info[0]}.{sys.version_info[1]}"
+    built = cfg.get("site_packages", []) if cfg.get("python_version", [""])[0] == here else []
+    for folder in extra + built:
         if os.path.isdir(folder) and folder not in sys.path:
             site.addsitedir(folder)
 

@@ -1,9 +1,9 @@
 """Every FMU in hosts other than our master: a C program with no Python in it (dlopen, the FMI
-calls, unload, load again), FMPy in a fresh virtual environment that has only fmpy and numpy, and
-a plain Python process that runs several systems one after another and exits normally."""
+calls, unload, load again; on a user's machine: test_target_machines.py), FMPy in a fresh virtual
+environment that has only fmpy and numpy, and a plain Python process that runs several systems
+one after another and exits normally."""
 import json
 import os
-from pathlib import Path
 import subprocess
 import sys
 import sysconfig
@@ -15,25 +15,10 @@ from fmpy.fmi2 import FMU2Slave
 import numpy as np
 import pytest
 
-from paths import TESTS
 
-HOST_SOURCE = TESTS / "fmus" / "c_host" / "fmu_host.c"
 STEP, STEPS = 0.015, 3
 # A C host's environment: nothing that points at a Python.
 CLEAN_ENV = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/tmp")}
-
-
-@pytest.fixture(scope="session")
-def c_host(tmp_path_factory):
-    out = tmp_path_factory.mktemp("c_host") / "fmu_host"
-    headers = Path(fmpy.__file__).parent / "c-code"
-    cmd = ["gcc", "-std=c99", "-O1", "-Wall", "-Werror", f"-I{headers}", str(HOST_SOURCE), "-o", str(out),
-           "-ldl", "-lpthread"]
-    proc = subprocess.run(cmd, capture_output=True, text=True)
-    assert proc.returncode == 0, proc.stderr
-    libs = subprocess.run(["ldd", str(out)], capture_output=True, text=True).stdout
-    assert "python" not in libs  # the host itself has no Python
-    return out
 
 
 def plan(path):
@@ -110,20 +95,6 @@ def test_c_host_threads_and_verbatim_messages(c_host, fmu_paths, tmp_path):
     assert "epoch = 'bad %s%n%x epoch %d'" in proc.stdout
     assert "STATUS fmi2ExitInitializationMode(c) 3" in proc.stdout  # fmi2Error
     assert "ROUND 2" in proc.stdout  # the host went on: a fresh instance after the failed one
-
-
-def test_missing_python_is_reported(c_host, fmu_paths, tmp_path):
-    """With no Python to be found, fmi2Instantiate fails with a message that says what to install."""
-    path = fmu_paths["Paddles"]
-    folder = extract(path, tmp_path / "paddles")
-    config = folder / "resources" / "neighbor_runtime.txt"
-    drop = ("libpython=", "python_home=", "python_version=")
-    lines = [line for line in config.read_text().splitlines() if not line.startswith(drop)]
-    config.write_text("\n".join(lines + ["python_version=0.0"]) + "\n")  # no such Python anywhere
-    guid, model, opts, _ = plan(path)
-    proc = run_host(c_host, folder, model, guid, opts, ["--rounds", "1"])
-    assert proc.returncode == 3
-    assert "needs the CPython" in proc.stdout and "NEIGHBOR_FMU_LIBPYTHON" in proc.stdout
 
 
 @pytest.fixture(scope="session")
