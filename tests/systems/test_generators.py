@@ -51,3 +51,16 @@ def test_unknown_generator_is_refused():
     with pytest.raises(ValueError, match="unknown generator"):
         generate_all(None, only=["nope"])
     assert list(GENERATORS)[0] == "maneuvers"
+
+
+def test_a_spacecraft_the_thesis_detumble_cannot_settle_is_refused(monkeypatch):
+    """The slew cases start from the detumble's end state: a spacecraft whose thesis detumble
+    limit-cycles (14 kg with the thesis gains) is a clear error, not a generator that never ends."""
+    import dataclasses
+
+    from system_ssp.ssp.writer import GeneratorError
+    from system_ssp.systems.generators import maneuvers
+
+    monkeypatch.setattr(maneuvers, "SPACECRAFT", dataclasses.replace(maneuvers.SPACECRAFT, mass=14.0))
+    with pytest.raises(GeneratorError, match=r"does not reach its rate tolerance within .* 20 s .*mass 14 kg"):
+        maneuvers.detumble_end_state([0.0, 0.0, 0.0, 1.0])

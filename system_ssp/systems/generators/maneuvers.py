@@ -11,6 +11,7 @@ Parameter files, one per concern (docs/conventions.md):
   case's gains. Names are `component.variable`; a case is applied on top of the SSD's own
   bindings with `simulate(..., parameter_sets=["parameters/detumble_case2.ssv"])` or `--ssv`.
 """
+import functools
 import math
 
 from components.attitude.detumble import DetumbleController
@@ -20,9 +21,10 @@ from components.attitude.thrusters import ThrusterPairs
 from components.core import rotations
 from components.mission.neighbor import SPACECRAFT
 
-from ...ssp.writer import vec
+from ...ssp.writer import GeneratorError, vec
 
 DT = 0.015  # thesis time step (s)
+DETUMBLE_LIMIT = 20.0  # s, the Appendix D loop limit
 
 BODY = {"mass": SPACECRAFT.mass, "edge_a": SPACECRAFT.edge_a, "edge_b": SPACECRAFT.edge_b, "edge_c": SPACECRAFT.edge_c,
         "inertia_from_box": True}
@@ -56,19 +58,23 @@ def detumble_end_state(q0):
     body = RigidBody(inertia, q0, W0_DETUMBLE, "euler")
     ctrl = DetumbleController(DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD, torque_level=LEVELS)
     pairs = ThrusterPairs()
-    while not ctrl.done(body.omega):
+    for _ in range(round(DETUMBLE_LIMIT / DT)):
+        if ctrl.done(body.omega):
+            return list(body.q), list(body.omega), list(body.euler_integrated)
         cmd, _ = ctrl.command(body.omega, body.omega_dot)
         pairs.step(cmd, DT)
         body.step(pairs.applied_torque(cmd), DT)
-    return list(body.q), list(body.omega), list(body.euler_integrated)
+    raise GeneratorError(
+        f"the thesis detumble (gains Kp {DETUMBLE_GAINS_KP[0]:g}, Kd {DETUMBLE_GAINS_KD[0]:g}) from q0 = {list(q0)} "
+        f"does not reach its rate tolerance within the Appendix D limit of {DETUMBLE_LIMIT:g} s for the "
+        f"spacecraft of components/mission/neighbor.py (mass {SPACECRAFT.mass:g} kg; it ends at omega = "
+        f"{[float(f'{w:.3g}') for w in body.omega]} rad/s): the slew cases start from that end state")
 
 
 DETUMBLE_GAINS_KP, DETUMBLE_GAINS_KD = [100.0] * 3, [1.0] * 3
 # Appendix D's stop test as printed (omega - omega_d <= tol, no absolute value): the thesis cases
 # use it; everything else the controller's default, |omega - omega_d| <= tol (same end here).
 THESIS_STOP_TEST = {"signed_stop_test": True}
-Q_END_1, W_END_1, E_END_1 = detumble_end_state([0.0, 0.0, 0.0, 1.0])
-Q_END_2, W_END_2, E_END_2 = detumble_end_state(Q0_CASE2)
 
 
 def continued_angles(euler):
@@ -76,41 +82,48 @@ def continued_angles(euler):
     return {"euler0_from_q0": False, **vec("euler0", euler)}
 
 
+@functools.lru_cache(maxsize=None)
+def thesis_cases():
+    """The thesis' validation cases as parameter sets (computed when first asked for: the slews
+    start from the detumbles' end states, which take a simulation)."""
+    q_end_1, w_end_1, e_end_1 = detumble_end_state([0.0, 0.0, 0.0, 1.0])
+    q_end_2, w_end_2, e_end_2 = detumble_end_state(Q0_CASE2)
+    cases = {
+        "detumble_case1": {"description": "Thesis detumble validation case 1 (Eq. 6-7, 32-34)",
+                           "dynamics": {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_DETUMBLE),
+                                        "integrator": "euler"},
+                           "detumble": THESIS_STOP_TEST},
+        "detumble_case2": {"description": "Thesis detumble validation case 2 (Eq. 35-38)",
+                           "dynamics": {**vec("q0", Q0_CASE2), **vec("omega0", W0_DETUMBLE), "integrator": "euler"},
+                           "detumble": THESIS_STOP_TEST},
+        "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47): from the end state of detumble "
+                                      "case 1 (full precision; Eq. 39 prints it to 4 decimals)",
+                       "dynamics": {**vec("q0", q_end_1), **vec("omega0", w_end_1), "integrator": "euler",
+                                    **continued_angles(e_end_1)},
+                       "slew": {**vec("Kd", [17.5] * 3)}},
+        "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50): from the end state of detumble "
+                                      "case 2 (full precision; Eq. 48 prints it to 4 decimals)",
+                       "dynamics": {**vec("q0", q_end_2), **vec("omega0", w_end_2), "integrator": "euler",
+                                    **continued_angles(e_end_2)},
+                       "slew": {**vec("Kd", [22.5] * 3)}},
+    }
+    # Slew case 3 (Eq. 51-66, Appendix G): three 180 deg rotations from the end state of
+    # detumble case 1, targets q_x (x) q0, q_y (x) q_d,x, q_z (x) q_d,y (Eq. 57-59), each with its
+    # own gains and the Appendix G stop test. The y and z rotations start where the previous one
+    # ended, so their files carry no initial state: system_ssp.thesis chains them.
+    target = tuple(q_end_1)
+    for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.items():
+        rot = rotations.from_axis_angle({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}[axis],
+                                       math.pi)
+        target = rotations.circle_cross(rot, target)
+        cases[f"slew_case3_{axis}"] = {
+            "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 57-66, Appendix G)",
+            "dynamics": ({**vec("q0", q_end_1), **vec("omega0", w_end_1), **continued_angles(e_end_1)}
+                         if axis == "x" else {}) | {"integrator": "euler"},
+            "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), **vec("q_d", list(target)),
+                     "accept_antipodal": True}}
+    return cases
 
-CASES = {
-    "detumble_case1": {"description": "Thesis detumble validation case 1 (Eq. 6-7, 32-34)",
-                       "dynamics": {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_DETUMBLE),
-                                    "integrator": "euler"},
-                       "detumble": THESIS_STOP_TEST},
-    "detumble_case2": {"description": "Thesis detumble validation case 2 (Eq. 35-38)",
-                       "dynamics": {**vec("q0", Q0_CASE2), **vec("omega0", W0_DETUMBLE), "integrator": "euler"},
-                       "detumble": THESIS_STOP_TEST},
-    "slew_case1": {"description": "Thesis slew validation case 1 (Eq. 39-47): from the end state of detumble "
-                                  "case 1 (full precision; Eq. 39 prints it to 4 decimals)",
-                   "dynamics": {**vec("q0", Q_END_1), **vec("omega0", W_END_1), "integrator": "euler",
-                                **continued_angles(E_END_1)},
-                   "slew": {**vec("Kd", [17.5] * 3)}},
-    "slew_case2": {"description": "Thesis slew validation case 2 (Eq. 48-50): from the end state of detumble "
-                                  "case 2 (full precision; Eq. 48 prints it to 4 decimals)",
-                   "dynamics": {**vec("q0", Q_END_2), **vec("omega0", W_END_2), "integrator": "euler",
-                                **continued_angles(E_END_2)},
-                   "slew": {**vec("Kd", [22.5] * 3)}},
-}
-# Slew case 3 (Eq. 51-66, Appendix G): three 180 deg rotations from the end state of
-# detumble case 1, targets q_x (x) q0, q_y (x) q_d,x, q_z (x) q_d,y (Eq. 57-59), each with its
-# own gains and the Appendix G stop test. The y and z rotations start where the previous one
-# ended, so their files carry no initial state: system_ssp.thesis chains them.
-_target = tuple(Q_END_1)
-for axis, (kp, kd) in {"x": (10.0, 20.0), "y": (1.0, 5.0), "z": (10.0, 30.0)}.items():
-    _rot = rotations.from_axis_angle({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}[axis],
-                                    math.pi)
-    _target = rotations.circle_cross(_rot, _target)
-    CASES[f"slew_case3_{axis}"] = {
-        "description": f"Thesis slew validation case 3, 180 deg about {axis} (Eq. 57-66, Appendix G)",
-        "dynamics": ({**vec("q0", Q_END_1), **vec("omega0", W_END_1), **continued_angles(E_END_1)}
-                     if axis == "x" else {}) | {"integrator": "euler"},
-        "slew": {**vec("Kp", [kp] * 3), **vec("Kd", [kd] * 3), **vec("q_d", list(_target)),
-                 "accept_antipodal": True}}
 
 SYSTEMS = {
     "detumble": {
@@ -125,7 +138,7 @@ SYSTEMS = {
         "default_case": "detumble_case1",
         "stop": [("detumble", "done")],
         "order": ["detumble", "thrusters", "dynamics"],
-        "stop_time": 20.0,  # the Appendix D loop limit
+        "stop_time": DETUMBLE_LIMIT,
         "step_size": DT,
     },
     "slew": {
@@ -152,17 +165,18 @@ CONCERNS = {"spacecraft": ("Host spacecraft mass and box edges (thesis Appendix 
 
 
 def case_parameters(case):
-    return {f"{comp}.{k}": v for comp, params in CASES[case].items() if comp != "description"
+    return {f"{comp}.{k}": v for comp, params in thesis_cases()[case].items() if comp != "description"
             for k, v in params.items()}
 
 
 def generate(writer):
     for concern, (description, values) in CONCERNS.items():
         writer.ssv(concern, description, values)
-    for case, spec in CASES.items():
+    cases = thesis_cases()
+    for case, spec in cases.items():
         writer.ssv(case, spec["description"], case_parameters(case))
     for name, spec in SYSTEMS.items():
-        initial = CASES[spec["default_case"]]["dynamics"]
+        initial = cases[spec["default_case"]]["dynamics"]
         writer.ssv(f"{name}_initial_state",
-                   f"Default initial state of {name}: {CASES[spec['default_case']]['description']}", initial)
+                   f"Default initial state of {name}: {cases[spec['default_case']]['description']}", initial)
         writer.ssd(name, spec)
