@@ -3,6 +3,7 @@
     python build_fmus.py            # rebuild what changed
     python build_fmus.py --clean    # rebuild everything
     python build_fmus.py --check    # also run fmpy's validation on every FMU
+    python build_fmus.py --compat   # also write the compatibility bundle (build/compat/<Model>/)
 
 FMUs: each `fmus/neighbor_*.py` wrapper becomes `build/fmus/<ClassName>.fmu`:
 - modelDescription.xml: pythonfmu's, from the wrapper's declarations, completed here from what
@@ -525,6 +526,9 @@ def main(argv=None):
     parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     parser.add_argument("--clean", action="store_true", help="rebuild every FMU and SSP")
     parser.add_argument("--check", action="store_true", help="run fmpy validation on every FMU after building")
+    parser.add_argument("--compat", action="store_true",
+                        help="write each FMU's compatibility information (the FMI cross-check's layout: the FMU, "
+                             "its reference result and options, a README) into build/compat/<Model>/")
     args = parser.parse_args(argv)
     try:
         fmus, ssps = build_all(clean=args.clean)
@@ -541,6 +545,12 @@ def main(argv=None):
         if bad:
             return 1
     print(f"{len(fmus)} FMUs in {BUILD / 'fmus'}, {len(ssps)} systems in {BUILD / 'ssp'}")
+    if args.compat:
+        from system_ssp.tools.compat import write_bundle
+
+        for fmu in fmus:
+            write_bundle(fmu, BUILD / "compat")
+        print(f"compatibility information for {len(fmus)} FMUs in {BUILD / 'compat'}")
     return 0
 
 

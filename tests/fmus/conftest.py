@@ -1,8 +1,11 @@
-"""Fixtures of the FMU tests: the C host with no Python in it."""
+"""Fixtures of the FMU tests: the C host with no Python in it, a Python with only numpy and fmpy."""
+import os
 from pathlib import Path
 import subprocess
+import venv
 
 import fmpy
+import numpy as np
 import pytest
 
 from paths import TESTS
@@ -21,3 +24,26 @@ def c_host(tmp_path_factory):
     libs = subprocess.run(["ldd", str(out)], capture_output=True, text=True).stdout
     assert "python" not in libs  # the host itself has no Python
     return out
+
+
+@pytest.fixture(scope="session")
+def numpy_only_python(tmp_path_factory):
+    """A fresh virtual environment with fmpy and numpy and nothing else of ours."""
+    env_dir = tmp_path_factory.mktemp("numpy_only") / "venv"
+    venv.EnvBuilder(with_pip=True).create(env_dir)
+    python = env_dir / ("Scripts" if os.name == "nt" else "bin") / "python"
+    numpy_version, fmpy_version = np.__version__, fmpy.__version__
+    proc = subprocess.run([str(python), "-m", "pip", "install", "--quiet", f"numpy=={numpy_version}",
+                           f"fmpy=={fmpy_version}"], capture_output=True, text=True, timeout=900)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return python
+
+
+@pytest.fixture(scope="session")
+def user_machine():
+    """Skips where a user's machine cannot be simulated (see user_machine.py)."""
+    from user_machine import can_unshare
+
+    reason = can_unshare()
+    if reason:
+        pytest.skip(reason)

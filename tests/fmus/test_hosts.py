@@ -7,13 +7,11 @@ import os
 import subprocess
 import sys
 import sysconfig
-import venv
 import zipfile
 
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 import numpy as np
-import pytest
 
 
 STEP, STEPS = 0.015, 3
@@ -95,19 +93,6 @@ def test_c_host_threads_and_verbatim_messages(c_host, fmu_paths, tmp_path):
     assert "epoch = 'bad %s%n%x epoch %d'" in proc.stdout
     assert "STATUS fmi2ExitInitializationMode(c) 3" in proc.stdout  # fmi2Error
     assert "ROUND 2" in proc.stdout  # the host went on: a fresh instance after the failed one
-
-
-@pytest.fixture(scope="session")
-def numpy_only_python(tmp_path_factory):
-    """A fresh virtual environment with fmpy and numpy and nothing else of ours."""
-    env_dir = tmp_path_factory.mktemp("numpy_only") / "venv"
-    venv.EnvBuilder(with_pip=True).create(env_dir)
-    python = env_dir / ("Scripts" if os.name == "nt" else "bin") / "python"
-    numpy_version, fmpy_version = np.__version__, fmpy.__version__
-    proc = subprocess.run([str(python), "-m", "pip", "install", "--quiet", f"numpy=={numpy_version}",
-                           f"fmpy=={fmpy_version}"], capture_output=True, text=True, timeout=900)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return python
 
 
 SIMULATE_ALL = r"""
