@@ -4,6 +4,9 @@ environment that has only fmpy and numpy, and a plain Python process that runs s
 one after another and exits normally."""
 import json
 import os
+from pathlib import Path
+import re
+import shutil
 import subprocess
 import sys
 import sysconfig
@@ -12,6 +15,7 @@ import zipfile
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 import numpy as np
+import pytest
 
 
 STEP, STEPS = 0.015, 3
@@ -154,3 +158,33 @@ def test_runtime_config_records_the_build_python(fmu_paths):
     assert f"python_version={sys.version_info[0]}.{sys.version_info[1]}" in text
     if sysconfig.get_config_var("Py_ENABLE_SHARED"):
         assert "libpython=" in text and "python_home=" in text
+
+
+def _fmi2_cosimulation_functions():
+    """The functions a co-simulation FMU must export: the common and co-simulation sections of
+    the FMI 2.0 header (FMPy ships the standard's headers), without the model-exchange ones."""
+    header = (Path(fmpy.__file__).parent / "c-code" / "fmi2Functions.h").read_text()
+    common, rest = header.rsplit("Functions for FMI2 for Model Exchange", 1)  # the declarations come last
+    cosimulation = rest.split("Functions for FMI2 for Co-Simulation", 1)[1]
+    return {m for part in (common, cosimulation) for m in re.findall(r"FMI2_Export\s+\w+TYPE\s+(fmi2\w+);", part)}
+
+
+def test_win64_binary_exports_fmi2_and_links_no_python(fmu_paths, tmp_path):
+    """The win64 binary (compiled with mingw-w64, not yet run on Windows): exactly the FMI 2.0
+    co-simulation functions exported, and imports from Windows' own DLLs only (the Python DLL is
+    loaded at run time, never linked)."""
+    objdump = shutil.which("x86_64-w64-mingw32-objdump")
+    with zipfile.ZipFile(fmu_paths["Gyro"]) as z:
+        dlls = [n for n in z.namelist() if n.startswith("binaries/win64/")]
+        if not dlls or objdump is None:
+            pytest.skip("no win64 binary or no mingw-w64 objdump (apt install gcc-mingw-w64-x86-64, as .ci/run does)")
+        dll = tmp_path / "Gyro.dll"
+        dll.write_bytes(z.read(dlls[0]))
+    text = subprocess.run([objdump, "-p", str(dll)], capture_output=True, text=True, check=True).stdout
+    exports = set(re.findall(r"^\s*\[\s*\d+\]\s+(\w+)\s*$", text.split("[Ordinal/Name Pointer] Table", 1)[1],
+                             re.M))
+    required = _fmi2_cosimulation_functions()
+    assert len(required) == 34
+    assert exports == required, (sorted(required - exports), sorted(exports - required))
+    imports = {name.lower() for name in re.findall(r"DLL Name: (\S+)", text)}
+    assert imports <= {"kernel32.dll", "msvcrt.dll"}, imports
