@@ -176,3 +176,16 @@ def test_docs_table_of_importing_tools_is_these_runs():
         text = DOCS.read_text()
     assert compat.docs_table(text) == table, f"docs/interoperability.md's table is not these runs':\n{table}\n" \
         "(NEIGHBOR_WRITE_DOCS=1 writes it)"
+
+
+def test_ecos_without_python_gets_the_error_and_lives(bundle, ecos, user_machine, tmp_path):
+    """No CPython on the machine: ecos gets fmi2Instantiate's fmi2Error with the message and the
+    process ends by itself. (ecos 0.7.2 then carries on: it logs the error at debug level only,
+    steps nothing and writes zeros; our calls after the failure return fmi2Error.)"""
+    binary, _ = ecos
+    shutil.copyfile(bundle["Gyro"] / "Gyro.fmu", tmp_path / "Gyro.fmu")
+    proc = on_user_machine(["sh", "-c", f'cd "{tmp_path}" && exec "$@"', "sh", str(binary), "simulate", "--path",
+                            "Gyro.fmu", "--stopTime", "1", "--stepSize", "0.1", "--noParallel", "-l", "debug"], [],
+                           hide_all_python=True)
+    assert proc.returncode >= 0, f"ecos died of signal {-proc.returncode}:\n{proc.stdout[-2000:]}"
+    assert "fmi2Error" in proc.stdout and "found none it can use" in proc.stdout, proc.stdout[-2000:]
