@@ -56,6 +56,7 @@ static void *process_sym(const char *name) {
 #define PATH_SEP '\\'
 #else
 #include <dlfcn.h>
+#include <sys/wait.h>
 typedef void *lib_handle;
 static void *lib_sym(lib_handle h, const char *name) { return dlsym(h, name); }
 static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
@@ -313,8 +314,9 @@ static lib_handle try_library(const char *spec, const char *how, char *version, 
     return h;
 }
 
-/* The shared library of the python3 on the host's PATH, asked from that Python ("" if none). */
-static void python_on_path(char *out, size_t size) {
+/* The shared library of the python3 on the host's PATH, asked from that Python ("" if none);
+   the command's exit status (127: no python3 on PATH). */
+static int python_on_path(char *out, size_t size) {
     out[0] = '\0';
 #ifdef _WIN32
     FILE *p = _popen("python -E -S -c \"import sys, os; print(os.path.join(sys.base_prefix, "
@@ -324,13 +326,14 @@ static void python_on_path(char *out, size_t size) {
                     "print(os.path.join(s.get_config_var('LIBDIR') or '', s.get_config_var('INSTSONAME') or ''))\" "
                     "2>/dev/null", "r");
 #endif
-    if (!p) return;
+    if (!p) return -1;
     if (fgets(out, (int)size, p)) out[strcspn(out, "\r\n")] = '\0';
     else out[0] = '\0';
 #ifdef _WIN32
-    _pclose(p);
+    return _pclose(p);
 #else
-    pclose(p);
+    int status = pclose(p);
+    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
 #endif
 }
 
@@ -351,13 +354,15 @@ static lib_handle find_python(const char *resources, char *version, size_t vsize
         if (!h) snprintf(runtime_error, sizeof runtime_error, "no usable Python for this FMU: %s", tried);
         return h;
     }
-    python_on_path(spec, sizeof spec);
-    if (spec[0] && file_exists(spec)) {
+    int status = python_on_path(spec, sizeof spec);
+    if (spec[0] && file_exists(spec))
         h = try_library(spec, "the python3 on PATH", version, vsize, home, hsize, tried, sizeof tried);
-    } else {
-        note(tried, sizeof tried, spec[0] ? "the python3 on PATH has no shared library (%s)" : "no python3 on PATH",
-             spec);
-    }
+    else if (spec[0])
+        note(tried, sizeof tried, "the python3 on PATH has no shared library (no %s)", spec);
+    else if (status == 127 || status == 9009)  /* sh / cmd.exe: no such command */
+        note(tried, sizeof tried, "no python3 on PATH");
+    else
+        note(tried, sizeof tried, "the python3 on PATH did not answer (exit status %d)", status);
     for (int minor = MAX_MINOR; minor >= MIN_MINOR && !h; minor--) {
         library_name(minor, spec, sizeof spec);
         h = try_library(spec, "system linker", version, vsize, home, hsize, tried, sizeof tried);
