@@ -9,18 +9,22 @@ import os
 from pathlib import Path
 import shutil
 import tempfile
+from typing import IO, Any, Iterator, Optional, Union
 
 from .errors import SSPError
 
 
-def _umask():
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _umask() -> int:
     mask = os.umask(0)
     os.umask(mask)
     return mask
 
 
 @contextmanager
-def atomic_write(path, mode="w", **open_kwargs):
+def atomic_write(path: PathLike, mode: str = "w", **open_kwargs: Any) -> Iterator[IO[Any]]:
     """`with atomic_write(path, "w") as f: f.write(...)`; `mode` "w" (text) or "wb". The file
     gets the permissions a plain open() would give it (0666 less the umask)."""
     path = Path(path)
@@ -38,7 +42,7 @@ def atomic_write(path, mode="w", **open_kwargs):
         raise
 
 
-def write_text_atomic(path, text, encoding="utf-8"):
+def write_text_atomic(path: PathLike, text: str, encoding: str = "utf-8") -> None:
     with atomic_write(path, "w", encoding=encoding, newline="") as f:
         f.write(text)
 
@@ -51,7 +55,7 @@ class StagedFolder:
     `commit_partial(reason)` puts it at <target>.partial with a PARTIAL.txt saying why;
     `discard()` deletes it. Folder and file modes follow the umask."""
 
-    def __init__(self, target, what="results folder"):
+    def __init__(self, target: PathLike, what: str = "results folder") -> None:
         self.target = Path(target)
         if self.target.exists() and not self.target.is_dir():
             raise SSPError(f"{what} {self.target}: exists and is not a folder")
@@ -64,9 +68,9 @@ class StagedFolder:
             raise SSPError(f"{what} {self.target}: cannot write in {self.target.parent} "
                            f"({exc.strerror or exc})") from None
 
-    def commit(self, target=None):
+    def commit(self, target: Optional[PathLike] = None) -> Path:
         target = Path(target) if target is not None else self.target
-        old = None
+        old: Optional[Path] = None
         if target.exists():
             old = Path(tempfile.mkdtemp(prefix=f".{target.name}.", suffix=".old", dir=target.parent))
             os.replace(target, old / "previous")
@@ -75,10 +79,10 @@ class StagedFolder:
             shutil.rmtree(old, ignore_errors=True)
         return target
 
-    def commit_partial(self, reason):
+    def commit_partial(self, reason: str) -> Path:
         with atomic_write(self.path / "PARTIAL.txt", "w") as f:
             f.write(f"partial results: {reason}\n")
         return self.commit(self.target.with_name(self.target.name + ".partial"))
 
-    def discard(self):
+    def discard(self) -> None:
         shutil.rmtree(self.path, ignore_errors=True)

@@ -5,12 +5,14 @@ import json
 import os
 from pathlib import Path
 import tempfile
-from typing import Optional
+from typing import Any, Dict, List, Optional
 
 import numpy as np
 
-from ..atomic import atomic_write
+from ..atomic import PathLike, atomic_write
 from ..errors import SSPError
+
+Units = Dict[str, Optional[str]]  # {column: unit or None}
 
 
 class Result:
@@ -30,10 +32,11 @@ class Result:
     partial:     True for the rows of a run that failed or was interrupted (err.result).
     """
 
-    def __init__(self, data: np.ndarray, stop_time: float, stop_reason: str, steps: int, final: dict,
-                 wall_time: float, start_time: float, step_size: Optional[float], algorithm: str, order: list,
-                 messages: dict, modes: Optional[dict] = None, profile: Optional[dict] = None,
-                 units: Optional[dict] = None, partial: bool = False):
+    def __init__(self, data: np.ndarray, stop_time: float, stop_reason: str, steps: int, final: Dict[str, Any],
+                 wall_time: float, start_time: float, step_size: Optional[float], algorithm: str, order: List[str],
+                 messages: Dict[str, List[str]], modes: Optional[Dict[str, Dict[str, float]]] = None,
+                 profile: Optional[Dict[str, Any]] = None, units: Optional[Units] = None,
+                 partial: bool = False) -> None:
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -51,20 +54,20 @@ class Result:
         self.partial = partial
 
     @property
-    def names(self) -> list:
+    def names(self) -> List[str]:
         return list(self.data.dtype.names or ())[1:]
 
     def __getitem__(self, name: str) -> np.ndarray:
         return self.data[name]
 
-    def __repr__(self):
+    def __repr__(self) -> str:
         return (f"Result(steps={self.steps}, stop_time={self.stop_time!r}, stop_reason={self.stop_reason!r}, "
-                f"signals={len(self.data.dtype.names) - 1}, wall_time={self.wall_time:.3f})")
+                f"signals={len(self.data.dtype.names or ()) - 1}, wall_time={self.wall_time:.3f})")
 
-    def write_csv(self, path) -> None:
+    def write_csv(self, path: PathLike) -> None:
         write_csv_atomic(self.data, path, self.units)
 
-    def write(self, path) -> None:
+    def write(self, path: PathLike) -> None:
         """Write the rows to `path`: Parquet for .parquet, otherwise CSV (see write_result)."""
         write_result(self.data, path, self.units)
 
@@ -72,7 +75,7 @@ class Result:
 FORMATS = (".csv", ".parquet")
 
 
-def check_output_file(path, what="output file") -> Path:
+def check_output_file(path: PathLike, what: str = "output file") -> Path:
     """Refuse, before a run starts, an output file the run could not write: its folder missing or
     not a folder, the path a folder, or no file creatable in the folder (tried)."""
     path = Path(path)
@@ -94,19 +97,19 @@ def check_output_file(path, what="output file") -> Path:
     return path
 
 
-def partial_path(path) -> Path:
+def partial_path(path: PathLike) -> Path:
     """Where the rows of a failed or interrupted run go: x.csv -> x.partial.csv."""
     path = Path(path)
     return path.with_name(f"{path.stem}.partial{path.suffix or '.csv'}")
 
 
-def units_path(path) -> Path:
+def units_path(path: PathLike) -> Path:
     """The units sidecar of a CSV file: x.csv -> x.units.json."""
     path = Path(path)
     return path.with_name(f"{path.stem}.units.json")
 
 
-def write_result(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+def write_result(data: np.ndarray, path: PathLike, units: Optional[Units] = None) -> None:
     """Write `data` to `path`: `.parquet` as Parquet, anything else as CSV (write_csv_atomic)."""
     if Path(path).suffix.lower() == ".parquet":
         write_parquet_atomic(data, path, units)
@@ -114,7 +117,7 @@ def write_result(data: np.ndarray, path, units: Optional[dict] = None) -> None:
         write_csv_atomic(data, path, units)
 
 
-def write_csv_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+def write_csv_atomic(data: np.ndarray, path: PathLike, units: Optional[Units] = None) -> None:
     """Write `data` as CSV, RFC 4180 (comma-separated, names such as `dcm_BN[1,1]` quoted, CRLF
     line ends): header `time,component.variable,...`, Booleans as 0/1, Reals as their shortest
     round-trip repr. With `units`, the sidecar x.units.json holds {column: unit or null}. Each
@@ -135,7 +138,7 @@ def write_csv_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> No
             f.write("\n")
 
 
-def write_parquet_atomic(data: np.ndarray, path, units: Optional[dict] = None) -> None:
+def write_parquet_atomic(data: np.ndarray, path: PathLike, units: Optional[Units] = None) -> None:
     """Write `data` as Parquet (pyarrow): one column per field, Booleans as bool; each field's
     unit in its metadata (b"unit") and all of them in the schema metadata
     (b"neighbor-cosim.units", JSON {column: unit or null})."""
@@ -148,7 +151,7 @@ def write_parquet_atomic(data: np.ndarray, path, units: Optional[dict] = None) -
     units = units or {}
     names = data.dtype.names or ()
     fields = [pa.field(n, pa.from_numpy_dtype(data.dtype[n]),
-                       metadata={b"unit": units[n].encode()} if units.get(n) else None) for n in names]
+                       metadata={b"unit": unit.encode()} if (unit := units.get(n)) else None) for n in names]
     meta = {b"neighbor-cosim.units": json.dumps({n: units.get(n) for n in names}).encode()}
     table = pa.table([pa.array(data[n]) for n in names], schema=pa.schema(fields, metadata=meta))
     with atomic_write(path, "wb") as f:
