@@ -110,3 +110,48 @@ def test_one_and_two_workers_give_the_same_rows_and_resume_skips(ssp_paths, tmp_
     other = _spec(tmp_path, DETUMBLE.format(system=ssp_paths["detumble"], runs=4), "other.toml")
     with pytest.raises(SSPError, match="holds the results of another campaign spec"):
         run_campaign(other, tmp_path / "two", workers=1)
+
+
+@pytest.mark.parametrize("change, pattern", [
+    (('"dynamics.integrator" = "rk4"', '"dynamics.integrater" = "rk4"'),
+     r"spec.toml: parameters.dynamics.integrater: parameter 'dynamics.integrater': component 'dynamics' has no "
+     r"variable 'integrater' \(did you mean 'integrator'"),
+    (('wz = "final:dynamics.omega_BN_B[3]"', 'wz = "final:dynamics.omega_BN[3]"'),
+     r"spec.toml: metrics.wz: output 'dynamics.omega_BN\[3\]': component 'dynamics' has no variable"),
+    (('[sweep."dynamics.omega0[2]"]', '[sweep."dynamic.omega0[2]"]'),
+     r"sweep.dynamic.omega0\[2\]: .*unknown component"),
+    (('parameter_sets = ["parameters/detumble_case1.ssv"]', 'parameter_sets = ["parameters/detumble_case9.ssv"]'),
+     r"spec.toml: parameter set 'parameters/detumble_case9.ssv': file not found"),
+])
+def test_names_are_checked_against_the_system_before_any_run(ssp_paths, tmp_path, change, pattern):
+    """A misspelled name in the spec stops the campaign before its folder is made or a run starts,
+    with the file, the key and the closest names (it used to run every run and exit 0)."""
+    spec = _spec(tmp_path, DETUMBLE.format(system=ssp_paths["detumble"], runs=2).replace(*change))
+    with pytest.raises(SSPError, match=pattern):
+        run_campaign(spec, tmp_path / "out", workers=1)
+    assert not (tmp_path / "out").exists()
+
+
+def test_cli_exit_codes_say_how_the_campaign_went(ssp_paths, tmp_path, capsys):
+    """exit 2 for a bad spec (before any run); exit 1 when no run succeeds, with the commonest
+    error; exit 1 below campaign.min_success; resuming says what it kept."""
+    from system_ssp.cli import main
+
+    bad = tmp_path / "bad.toml"
+    bad.write_text(DETUMBLE.format(system=ssp_paths["detumble"], runs=1).replace('"dynamics.integrator"',
+                                                                                 '"dynamics.integrater"'))
+    assert main(["campaign", str(bad), "--out", str(tmp_path / "bad"), "--workers", "1"]) == 2
+    assert "did you mean 'integrator'" in capsys.readouterr().err
+    failing = tmp_path / "failing.toml"
+    failing.write_text(DETUMBLE.format(system=ssp_paths["detumble"], runs=1).replace("values = [100.0, 80.0, -1.0]",
+                                                                                     "values = [-1.0]"))
+    assert main(["campaign", str(failing), "--out", str(tmp_path / "failing"), "--workers", "1"]) == 1
+    out = capsys.readouterr()
+    assert "campaign failed: no run succeeded" in out.err and "2 run(s) failed with:" in out.out
+    strict = tmp_path / "strict.toml"
+    strict.write_text(DETUMBLE.format(system=ssp_paths["detumble"], runs=3).replace(
+        "stop_time = 1.0", "stop_time = 1.0\nmin_success = 0.99"))
+    assert main(["campaign", str(strict), "--out", str(tmp_path / "strict"), "--workers", "1"]) == 1
+    assert "below campaign.min_success 0.99" in capsys.readouterr().err
+    assert main(["campaign", str(strict), "--out", str(tmp_path / "strict"), "--workers", "1"]) == 1
+    assert "6 of 6 runs already recorded there are kept, 0 to run" in capsys.readouterr().err

@@ -18,11 +18,13 @@ A run that fails or passes timeout_s is a row with its status and error; a worke
 dies (an FMU that crashes it) is restarted by its nanny and its run recorded as failed.
 """
 import argparse
+from collections import Counter
 import json
 import math
 import os
 from pathlib import Path
 import platform
+import re
 import sys
 import time
 
@@ -103,6 +105,41 @@ def _client(workers, scheduler):
     return Client(cluster), cluster
 
 
+def _spec_key(spec, name):
+    """Where the spec names `name`: parameters.x, dispersions.x, sweep.x or metrics.<metric>."""
+    if name in spec.parameters:
+        return f"parameters.{name}"
+    if any(d.name == name or name in d.also for d in spec.dispersions):
+        return f"dispersions.{next(d.name for d in spec.dispersions if d.name == name or name in d.also)}"
+    if any(n == name for n, _ in spec.sweeps):
+        return f"sweep.{name}"
+    metric = next((m.name for m in spec.metrics if m.variable == name), None)
+    return f"metrics.{metric}" if metric else None
+
+
+def check_against_system(spec):
+    """Every name and value of the spec checked against its system before the first run: the
+    master plans run 0 of every sweep point (parameters, parameter sets, the metrics' signals)
+    as it would run it. SSPError naming the spec file, the key and the closest names."""
+    from ...master import System
+    from ...master.plan import RunOptions
+    from ...master.planning import make_plan
+
+    record = tuple(sorted({m.variable for m in spec.metrics if m.variable}))
+    with System(spec.system) as system:
+        for point in range(len(spec.points)):
+            _, values = spec.inputs(point * spec.runs)
+            options = RunOptions(stop_time=spec.stop_time, step_size=spec.step_size,
+                                 parameter_sets=tuple(spec.parameter_sets), parameters=spec.overrides(values),
+                                 outputs=record)
+            try:
+                make_plan(system, options)
+            except SSPError as exc:
+                named = re.search(r"'([^']+)'", str(exc))
+                key = _spec_key(spec, named.group(1)) if named else None
+                raise SSPError(f"{spec.path}: {key + ': ' if key else ''}{exc}") from None
+
+
 def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=1):
     """Run (or resume) campaign `spec` (a CampaignSpec or a spec path) into folder `out`, `batch`
     runs per Dask task (more for short runs: each task costs a round trip of about 10 ms);
@@ -113,10 +150,14 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
 
     if not hasattr(spec, "inputs"):
         spec = load_spec(spec)
+    check_against_system(spec)  # before the folder is touched and before any run
     out = _prepare_folder(spec, out)
     columns = _columns(spec)
     done = {r["run"] for r in _read_rows(out)}
     todo = [i for i in range(spec.total_runs) if i not in done]
+    if done:
+        print(f"resuming {out}: {len(done)} of {spec.total_runs} runs already recorded there are kept, "
+              f"{len(todo)} to run", file=sys.stderr)
     if todo:
         client, cluster = _client(workers, scheduler)
         try:
@@ -226,6 +267,9 @@ def summarize(spec, rows):
         else:
             values = sorted({str(r[m.name]) for r in ok})
             s["metrics"][m.name] = {"n": len(ok), "values": values[:20]}
+    errors = Counter(r["error"] for r in rows if r["status"] != "ok" and r.get("error"))
+    s["errors"] = [{"error": e, "runs": n} for e, n in errors.most_common(3)]
+    s["min_success"] = spec.min_success
     ops = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal}
     for name, metric, op, threshold in spec.probabilities:
         vals = [r[metric] for r in ok if r[metric] is not None]
@@ -248,7 +292,19 @@ def table(s):
     for name, p in s["probabilities"].items():
         lines.append(f"  P({p['condition']}) = {p['p']:.3f}  [{p['ci95'][0]:.3f}, {p['ci95'][1]:.3f}] 95 % "
                      f"({p['k']}/{p['n']})  {name}")
+    for e in s.get("errors", []):
+        lines.append(f"  {e['runs']} run(s) failed with: {e['error']}")
     return "\n".join(lines)
+
+
+def failed_campaign(s):
+    """Why a finished campaign is a failure (exit 1), or None: no run succeeded, or fewer than
+    campaign.min_success."""
+    if s["runs"] and s["ok"] == 0:
+        return "no run succeeded"
+    if s.get("min_success") is not None and s["success_rate"] < s["min_success"]:
+        return f"success rate {100 * s['success_rate']:.1f} % is below campaign.min_success {s['min_success']:g}"
+    return None
 
 
 def figures(spec, rows, folder):
@@ -323,4 +379,8 @@ def main(argv=None):
     s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
     print(table(s))
     print(f"results in {args.out} (runs.parquet, summary.json, figures/)")
+    failure = failed_campaign(s)
+    if failure:
+        print(f"campaign failed: {failure}", file=sys.stderr)
+        return 1
     return 0

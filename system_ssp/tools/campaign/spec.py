@@ -28,6 +28,7 @@ HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f
                              "orbit's space_weather_file at the scaled copy"}
 PROBABILITY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>|==)\s*([-+0-9.eE]+|true|false)\s*$")
 CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_size", "timeout_s", "helper",
+                 "min_success",
                  "description"}
 TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities"}
 
@@ -75,6 +76,7 @@ class CampaignSpec:
     stop_time: Optional[float] = None
     step_size: Optional[float] = None
     timeout_s: Optional[float] = None
+    min_success: Optional[float] = None  # the campaign fails (exit 1) below this success rate
     helper: Optional[str] = None
     description: str = ""
     parameters: dict = field(default_factory=dict)
@@ -206,6 +208,10 @@ def _campaign_table(path, c, text):
         spec.step_size = _number(path, "campaign.step_size", c["step_size"], positive=True)
     if c.get("timeout_s") is not None:
         spec.timeout_s = _number(path, "campaign.timeout_s", c["timeout_s"], positive=True)
+    if c.get("min_success") is not None:
+        spec.min_success = _number(path, "campaign.min_success", c["min_success"], low=0)
+        if spec.min_success > 1:
+            raise SSPError(f"{path}: campaign.min_success = {c['min_success']!r}: expected a fraction in [0, 1]")
     if c.get("helper") is not None:
         if c["helper"] not in HELPERS:
             raise SSPError(f"{path}: campaign.helper = {c['helper']!r}: expected one of {', '.join(HELPERS)}")
