@@ -11,22 +11,24 @@ file and line, component or variable); 3 an unexpected error; 130 interrupted by
 import argparse
 import json
 import os
+from pathlib import Path
 import signal
 import sys
 import traceback
 
 from . import __version__
 from .neighbor import deorbit_study, mission, thesis, validation
-from .tools import campaign, flatten, replace
+from .tools import campaign, flatten, plot, replace
 from .tools.console import add_console_arguments, console_settings, parse_sets
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
+from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
         "replace": replace.main_replace, "compare": replace.main_compare, "flatten": flatten.main,
-        "campaign": campaign.main,
+        "campaign": campaign.main, "plot": plot.main,
         "propulsion": mission.main_propulsion, "validation": validation.main}
 
 
@@ -53,6 +55,7 @@ def _parser():
     r.add_argument("--outputs", help="signals to record, comma-separated component.variable")
     r.add_argument("--record-every", type=int, default=1)
     r.add_argument("--print-final", action="store_true", help="print all final values")
+    r.add_argument("--plot", metavar="FILE", help="also draw the recorded signals: .png, .svg or .html (interactive)")
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
@@ -69,6 +72,8 @@ def _parser():
     sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")
     sub.add_parser("flatten", add_help=False, help="the system with its system parameters folded into component "
                    "bindings, for hosts that do not read them (flatten SYSTEM --out X.ssp)")
+    sub.add_parser("plot", add_help=False, help="draw signals of a result file against time (plot RESULT "
+                   "[SIGNAL ...] [--out FILE.png|.svg|.html])")
     sub.add_parser("campaign", add_help=False, help="a sweep or Monte Carlo campaign on Dask (campaign SPEC.toml "
                    "--out DIR [--workers N] [--scheduler ADDRESS])")
     sub.add_parser("thesis", add_help=False,
@@ -156,6 +161,8 @@ def _run_or_info(argv):
         fmu = FmuInterface.read(args.path)
         print(json.dumps(fmu.as_dict(), indent=1) if args.json else describe_fmu(fmu))
         return 0
+    if args.command == "run" and args.plot and Path(args.plot).suffix.lower() not in PLOT_FORMATS:
+        raise SSPError(f"--plot {args.plot}: unknown format (expected {', '.join(PLOT_FORMATS)})")
     with System(args.path, validate=not args.no_validate) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
@@ -188,6 +195,8 @@ def _run_or_info(argv):
           "--print-final for all):")
     for k, v in shown:
         print(f"  {k} = {v!r}")
+    if args.plot:
+        print(f"plot:        {result.plot(out=args.plot, title=args.path)}")
     return 0
 
 

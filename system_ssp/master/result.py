@@ -5,12 +5,13 @@ import json
 import os
 from pathlib import Path
 import tempfile
-from typing import Any, Dict, List, Optional
+from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
 from ..atomic import PathLike, atomic_write
 from ..errors import SSPError
+from .plotting import default_signals, plot, select, units_path
 
 Units = Dict[str, Optional[str]]  # {column: unit or None}
 
@@ -71,6 +72,24 @@ class Result:
         """Write the rows to `path`: Parquet for .parquet, otherwise CSV (see write_result)."""
         write_result(self.data, path, self.units)
 
+    def to_pandas(self) -> Any:
+        """The rows as a pandas DataFrame (a `time` column, then one per signal); the units in
+        `df.attrs["units"]`."""
+        try:
+            import pandas as pd
+        except ImportError:
+            raise SSPError("Result.to_pandas needs pandas (pip install pandas)") from None
+        df = pd.DataFrame({name: self.data[name] for name in self.data.dtype.names or ()})
+        df.attrs["units"] = {name: self.units.get(name) for name in df.columns}
+        return df
+
+    def plot(self, signals: Sequence[str] = (), out: PathLike = "run.png", title: str = "") -> Path:
+        """Draw recorded signals (names or globs like "dynamics.q_BN*"; none: all) against time
+        into `out`: .png or .svg, or .html for an interactive page in one file. Returns the path."""
+        names = list(self.data.dtype.names or ())
+        chosen = select(names, list(signals)) if signals else default_signals(names, self.units)[0]
+        return plot({n: self.data[n] for n in names}, dict(self.units), chosen, out, title)
+
 
 FORMATS = (".csv", ".parquet")
 
@@ -101,12 +120,6 @@ def partial_path(path: PathLike) -> Path:
     """Where the rows of a failed or interrupted run go: x.csv -> x.partial.csv."""
     path = Path(path)
     return path.with_name(f"{path.stem}.partial{path.suffix or '.csv'}")
-
-
-def units_path(path: PathLike) -> Path:
-    """The units sidecar of a CSV file: x.csv -> x.units.json."""
-    path = Path(path)
-    return path.with_name(f"{path.stem}.units.json")
 
 
 def write_result(data: np.ndarray, path: PathLike, units: Optional[Units] = None) -> None:

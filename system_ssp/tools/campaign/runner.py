@@ -33,6 +33,9 @@ import numpy as np
 from ... import __version__
 from ...atomic import atomic_write, write_text_atomic
 from ...errors import SSPError
+from ...master import System
+from ...master.plan import RunOptions
+from ...master.planning import make_plan
 from ..console import add_console_arguments, console_settings
 from .spec import load_spec
 from .worker import run_batch
@@ -121,10 +124,6 @@ def check_against_system(spec):
     """Every name and value of the spec checked against its system before the first run: the
     master plans run 0 of every sweep point (parameters, parameter sets, the metrics' signals)
     as it would run it. SSPError naming the spec file, the key and the closest names."""
-    from ...master import System
-    from ...master.plan import RunOptions
-    from ...master.planning import make_plan
-
     record = tuple(sorted({m.variable for m in spec.metrics if m.variable}))
     with System(spec.system) as system:
         for point in range(len(spec.points)):

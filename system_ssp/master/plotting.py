@@ -1,0 +1,168 @@
+"""Looking at results: a result file read back with its units, signals picked by name or glob,
+drawn against time (PNG or SVG with matplotlib; one self-contained interactive HTML page with
+plotly). Signals that share a unit share a panel; the time axis is in seconds, minutes, hours,
+days or years, whichever reads best for the run's span. Used by `Result.plot` and the `plot`
+command (system_ssp.tools.plot)."""
+from __future__ import annotations
+
+import fnmatch
+import json
+from pathlib import Path
+from typing import Dict, List, Optional, Sequence, Tuple
+
+import numpy as np
+
+from ..atomic import PathLike, atomic_write
+from ..errors import SSPError
+from .names import near
+
+Units = Dict[str, Optional[str]]  # {column: unit or None}
+
+
+def units_path(path: PathLike) -> Path:
+    """The units sidecar of a CSV result file: x.csv -> x.units.json."""
+    path = Path(path)
+    return path.with_name(f"{path.stem}.units.json")
+
+TIME_UNITS = (("yr", 365.25 * 86400.0), ("d", 86400.0), ("h", 3600.0), ("min", 60.0), ("s", 1.0))
+FORMATS = (".png", ".svg", ".html")
+MAX_PANELS = 8
+
+
+def read_result(path: PathLike) -> Tuple[Dict[str, np.ndarray], Units]:
+    """({column: values}, {column: unit or None}) of a result file (CSV with its units sidecar,
+    or Parquet), columns in file order, `time` first."""
+    path = Path(path)
+    if not path.is_file():
+        raise SSPError(f"{path}: no such result file")
+    if path.suffix.lower() == ".parquet":
+        import pyarrow.parquet as pq
+
+        table = pq.read_table(path)
+        meta = table.schema.metadata or {}
+        units = json.loads(meta.get(b"neighbor-cosim.units", b"{}").decode())
+        columns = {name: table.column(name).to_numpy() for name in table.column_names}
+    else:
+        import csv
+
+        with open(path, newline="") as f:
+            rows = list(csv.reader(f))
+        if not rows or not rows[0]:
+            raise SSPError(f"{path}: empty result file")
+        header = rows[0]
+        try:
+            values = np.array([[float(x) for x in row] for row in rows[1:] if row], dtype=float)
+        except ValueError as exc:
+            raise SSPError(f"{path}: not a result file of numbers ({exc})") from None
+        values = values.reshape(-1, len(header))
+        columns = {name: values[:, i] for i, name in enumerate(header)}
+        sidecar = units_path(path)
+        units = json.loads(sidecar.read_text()) if sidecar.is_file() else {}
+    if "time" not in columns:
+        raise SSPError(f"{path}: no `time` column (columns: {', '.join(list(columns)[:8])}...)")
+    return columns, {name: units.get(name) for name in columns}
+
+
+def select(names: Sequence[str], patterns: Sequence[str], where: str = "") -> List[str]:
+    """The columns matching `patterns` (names or globs), in the file's order; SSPError naming a
+    pattern that matches nothing, with the closest names."""
+    candidates = [n for n in names if n != "time"]
+    if not patterns:
+        return candidates
+    chosen = []
+    for pattern in patterns:
+        hits = [n for n in candidates if fnmatch.fnmatchcase(n, pattern)] if any(
+            c in pattern for c in "*?[") else [n for n in candidates if n == pattern]
+        if not hits:
+            raise SSPError(f"{where}signal {pattern!r}: no such column{near(pattern, candidates)} (globs like "
+                           "'dynamics.q_BN*' match several; [[] matches a bracket)")
+        chosen += [h for h in hits if h not in chosen]
+    return [n for n in candidates if n in chosen]
+
+
+def default_signals(names: Sequence[str], units: Units) -> Tuple[List[str], str]:
+    """Every signal when none is named, as many units' worth as fit (the first MAX_PANELS units
+    in column order); the second item says what was left out ("" if nothing)."""
+    signals = [n for n in names if n != "time"]
+    groups = panels(signals, units)
+    if len(groups) <= MAX_PANELS:
+        return signals, ""
+    kept = [s for _, group in groups[:MAX_PANELS] for s in group]
+    return kept, (f"drew the {len(kept)} signals of the first {MAX_PANELS} units of {len(groups)}; name signals or "
+                  "globs to draw others")
+
+
+def time_axis(t: np.ndarray) -> Tuple[np.ndarray, str]:
+    """The time column in the unit that reads best for its span (years for a mission)."""
+    span = float(t[-1] - t[0]) if len(t) else 0.0
+    for unit, seconds in TIME_UNITS:
+        if span >= 2 * seconds or unit == "s":
+            return t / seconds, unit
+    return t, "s"  # pragma: no cover
+
+
+def panels(signals: Sequence[str], units: Units) -> List[Tuple[Optional[str], List[str]]]:
+    """[(unit, [signals])]: signals that share a unit share a panel, in first-seen order."""
+    groups: Dict[Optional[str], List[str]] = {}
+    for s in signals:
+        groups.setdefault(units.get(s), []).append(s)
+    return list(groups.items())
+
+
+def plot(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], out: PathLike,
+         title: str = "") -> Path:
+    """Draw `signals` against time into `out` (.png, .svg or .html); returns the path."""
+    out = Path(out)
+    if out.suffix.lower() not in FORMATS:
+        raise SSPError(f"--out {out}: unknown format {out.suffix!r} (expected {', '.join(FORMATS)})")
+    if not signals:
+        raise SSPError("nothing to plot: the result has no signal but time")
+    groups = panels(signals, units)
+    if len(groups) > MAX_PANELS:
+        raise SSPError(f"{len(signals)} signals in {len(groups)} different units: choose at most {MAX_PANELS} units' "
+                       "worth (name the signals or a glob)")
+    t, t_unit = time_axis(np.asarray(columns["time"], dtype=float))
+    if out.suffix.lower() == ".html":
+        return _plot_html(columns, groups, t, t_unit, out, title)
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(len(groups), 1, figsize=(10, 2.6 * len(groups) + 0.8), sharex=True, squeeze=False)
+    for ax, (unit, names) in zip(axes[:, 0], groups):
+        for name in names:
+            ax.plot(t, np.asarray(columns[name], dtype=float), label=name, linewidth=1.2)
+        ax.set_ylabel(unit or "(no unit)")
+        ax.grid(alpha=0.3)
+        ax.legend(loc="best", fontsize=8, ncol=1 if len(names) < 5 else 2)
+        ax.ticklabel_format(axis="y", useOffset=False)
+    axes[-1, 0].set_xlabel(f"time ({t_unit})")
+    if title:
+        fig.suptitle(title, fontsize=10)
+    fig.tight_layout(rect=(0.0, 0.0, 1.0, 1.0 - (0.35 / fig.get_figheight() if title else 0.0)))
+    with atomic_write(out, "wb") as f:
+        fig.savefig(f, format=out.suffix.lower()[1:], dpi=110)
+    plt.close(fig)
+    return out
+
+
+def _plot_html(columns: Dict[str, np.ndarray], groups: List[Tuple[Optional[str], List[str]]], t: np.ndarray,
+               t_unit: str, out: Path, title: str) -> Path:
+    try:
+        import plotly.graph_objects as go
+        from plotly.subplots import make_subplots
+    except ImportError:
+        raise SSPError(f"--out {out}: an HTML plot needs plotly (pip install plotly)") from None
+    fig = make_subplots(rows=len(groups), cols=1, shared_xaxes=True, vertical_spacing=0.04)
+    for row, (unit, names) in enumerate(groups, 1):
+        for name in names:
+            fig.add_trace(go.Scattergl(x=t, y=np.asarray(columns[name], dtype=float), name=name, mode="lines"),
+                          row=row, col=1)
+        fig.update_yaxes(title_text=unit or "(no unit)", row=row, col=1)
+    fig.update_xaxes(title_text=f"time ({t_unit})", row=len(groups), col=1)
+    fig.update_layout(title=title, height=260 * len(groups) + 120, template="plotly_white")
+    html = fig.to_html(include_plotlyjs=True, full_html=True)  # one file, no network to open it
+    with atomic_write(out, "w", encoding="utf-8") as f:
+        f.write(html)
+    return out

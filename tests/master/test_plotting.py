@@ -1,0 +1,76 @@
+"""Looking at a run (issue 29): Result.to_pandas and Result.plot, the `plot` command on CSV and
+Parquet results (units read back), globs, the time axis in the unit that reads best, and bad
+input refused with the closest names before any work."""
+import json
+
+import matplotlib.image
+import numpy as np
+import pytest
+
+import system_ssp
+from system_ssp.cli import main
+from system_ssp.master.plotting import read_result, time_axis
+
+
+@pytest.fixture(scope="module")
+def detumble(ssp_paths):
+    return system_ssp.simulate(ssp_paths["detumble"])
+
+
+def test_to_pandas_has_every_column_and_the_units(detumble):
+    df = detumble.to_pandas()
+    assert list(df.columns) == list(detumble.data.dtype.names)
+    np.testing.assert_array_equal(df["dynamics.omega_BN_B[1]"].to_numpy(), detumble["dynamics.omega_BN_B[1]"])
+    assert df.attrs["units"]["time"] == "s" and df.attrs["units"]["dynamics.omega_BN_B[1]"] == "rad/s"
+
+
+@pytest.mark.parametrize("suffix", [".csv", ".parquet"])
+def test_a_written_result_reads_back_with_its_units(detumble, tmp_path, suffix):
+    path = tmp_path / f"run{suffix}"
+    detumble.write(path)
+    columns, units = read_result(path)
+    assert list(columns) == list(detumble.data.dtype.names)
+    np.testing.assert_array_equal(columns["dynamics.q_BN[4]"], detumble["dynamics.q_BN[4]"])
+    assert units == {n: detumble.units.get(n) for n in columns}
+
+
+def test_plot_command_draws_globbed_signals_with_units(detumble, tmp_path, capsys):
+    result = tmp_path / "run.csv"
+    detumble.write(result)
+    assert main(["plot", str(result), "dynamics.omega_BN_B*", "detumble.torque_cmd_B[[]1]"]) == 0
+    assert "4 signal(s)" in capsys.readouterr().out
+    image = matplotlib.image.imread(tmp_path / "run.png")
+    assert image.shape[0] > 300 and image.std() > 0.05  # drawn, not blank
+    assert main(["plot", str(result), "dynamics.q_BN*", "--out", str(tmp_path / "q.svg")]) == 0
+    assert "dynamics.q_BN[4]" in (tmp_path / "q.svg").read_text()
+
+
+def test_html_plot_is_one_file_that_needs_no_network(detumble, tmp_path):
+    out = detumble.plot(["dynamics.omega_BN_B*"], tmp_path / "run.html", title="detumble")
+    text = out.read_text()
+    assert "dynamics.omega_BN_B[2]" in text and "rad\\u002fs" in text and "time (s)" in text  # plotly escapes /
+    assert '<script src="http' not in text  # plotly.js is inside the page
+
+
+def test_bad_signal_or_format_is_refused_with_the_closest_names(detumble, tmp_path, ssp_paths, capsys):
+    result = tmp_path / "run.csv"
+    detumble.write(result)
+    assert main(["plot", str(result), "dynamics.omega_BN"]) == 2
+    assert "did you mean 'dynamics.omega_BN_B[" in capsys.readouterr().err
+    assert main(["plot", str(result), "--out", str(tmp_path / "x.jpg")]) == 2
+    assert "unknown format '.jpg'" in capsys.readouterr().err
+    assert main(["plot", str(tmp_path / "missing.csv")]) == 2
+    # run --plot with a format it cannot write: refused before the run (no results written)
+    assert main(["run", str(ssp_paths["detumble"]), "--output", str(tmp_path / "r.csv"), "--plot",
+                 str(tmp_path / "r.pdf")]) == 2
+    assert not (tmp_path / "r.csv").exists()
+
+
+def test_run_plot_and_the_time_axis(ssp_paths, tmp_path, capsys):
+    assert main(["run", str(ssp_paths["detumble"]), "--outputs", "dynamics.omega_BN_B[1]", "--plot",
+                 str(tmp_path / "r.png")]) == 0
+    assert (tmp_path / "r.png").stat().st_size > 10000
+    assert time_axis(np.array([0.0, 40 * 3.15576e7]))[1] == "yr"
+    assert time_axis(np.array([0.0, 5 * 86400.0]))[1] == "d"
+    assert time_axis(np.array([0.0, 90.0]))[1] == "s"
+    assert json.dumps(time_axis(np.array([0.0, 7200.0]))[1]) == '"h"'
