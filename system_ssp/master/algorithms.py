@@ -247,6 +247,7 @@ class ScheduledAlgorithm:
         self.suspended = [ci not in active for ci in range(self.n)]
         self.ev_values = [sig.read() for sig in self.events]
         info.record_every = self.mode.record_every
+        info.mode = self.mode.name
 
     def run(self, info, observe):
         """Step until the stop time or a stop condition, calling `observe` (the observers' step
@@ -309,7 +310,11 @@ class ScheduledAlgorithm:
         info.t = t1
         info.steps += 1
         info.changed = changed
-        info.mode_changed = nxt is not mode
+        if nxt is not mode:
+            info.mode_changed = True
+            info.mode = nxt.name
+        else:
+            info.mode_changed = False
         info.record_every = mode.record_every
         info.last = t1 >= stop
 

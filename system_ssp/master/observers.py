@@ -5,6 +5,7 @@ algorithm has stepped the components (`step`, in list order: stop conditions fir
 recorder knows whether the run stops here), and at the end (`finish`). They share one `StepInfo`
 that the algorithm fills in."""
 import sys
+import threading
 import time
 from typing import Dict, Sequence, Union
 
@@ -22,7 +23,7 @@ RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_}
 
 class StepInfo:
     """The state of the run after a macro step, written by the algorithm and the observers."""
-    __slots__ = ("t", "steps", "changed", "mode_changed", "record_every", "last", "fired")
+    __slots__ = ("t", "steps", "changed", "mode_changed", "record_every", "last", "fired", "mode")
 
     def __init__(self, t, record_every):
         self.t = t  # time reached
@@ -32,6 +33,7 @@ class StepInfo:
         self.record_every = record_every  # the current recording interval, in macro steps
         self.last = False  # the stop time is reached
         self.fired = None  # name of the stop signal that is true, once one is
+        self.mode = None  # scheduled runs: the nc:Mode the next step is taken in
 
 
 class RunView:
@@ -167,9 +169,13 @@ class ProgressBar(Observer):
     of the stop time for runs that end there; without a total (no percentage, no ETA to a time
     the run may never reach) when a stop condition may end the run first. The ETA is the average
     rate since the start (smoothing 0: stable for runs whose speed changes with the mode), and
-    the bar shows only once a run has lasted a second."""
+    the bar shows only once a run has lasted a second. A scheduled run shows its mode, the time
+    spent in it (in the unit that reads best) and the steps per second. The bar is redrawn at
+    least twice a second whatever the steps' size: tqdm's adaptive `miniters` would wait for an
+    advance as large as the coasts' during a 15 ms phase, and the bar would look hung."""
 
     UNITS = ((2 * YEAR, "yr", YEAR), (2 * DAY, "d", DAY), (0.0, "s", 1.0))
+    SPANS = ((YEAR, "yr"), (DAY, "d"), (3600.0, "h"), (60.0, "min"), (0.0, "s"))
 
     def __init__(self, plan):
         self.plan = plan
@@ -177,6 +183,8 @@ class ProgressBar(Observer):
         span = plan.stop - plan.start
         _, self.unit, self.scale = next(u for u in self.UNITS if span >= u[0])
         self.chunk = 1 if plan.schedule is not None else max(1, plan.n_steps // 500)
+        self.mode, self.mode_t0 = None, plan.start
+        self.posted, self.posted_steps = 0.0, 0
 
     def start(self, info):
         try:
@@ -185,17 +193,46 @@ class ProgressBar(Observer):
             return
         p = self.plan
         total = None if p.stops else (p.stop - p.start) / self.scale
-        self.bar = tqdm(total=total, file=sys.stderr, unit=self.unit, leave=False, mininterval=0.5, delay=1.0,
-                        smoothing=0.0, dynamic_ncols=True, bar_format=None if total else
-                        "{desc}{n:.3g} {unit} simulated [{elapsed}, {rate_fmt}]")
+        self.bar = tqdm(total=total, file=sys.stderr, unit=self.unit, leave=False, mininterval=0.5, miniters=0,
+                        delay=1.0, smoothing=0.0, dynamic_ncols=True, bar_format=None if total else
+                        "{desc}{n:.4g} {unit} simulated [{elapsed}, {rate_fmt}{postfix}]")
+        self.mode, self.mode_t0 = info.mode, info.t
+        self.posted, self.posted_steps = time.perf_counter(), info.steps
+        # a step can take seconds (an FMU compiling its kernels, a long Cowell step): redraw the
+        # bar every second from a thread so that its clock never stops
+        self.stopped = threading.Event()
+        self.ticker = threading.Thread(target=self._tick, name="progress-bar", daemon=True)
+        self.ticker.start()
+
+    def _tick(self):
+        while not self.stopped.wait(1.0):
+            bar = self.bar
+            if bar is not None and time.time() - bar.start_t >= bar.delay:
+                bar.refresh()
 
     def step(self, info):
         bar = self.bar
-        if bar is not None and info.steps % self.chunk == 0:
-            bar.update((info.t - self.plan.start) / self.scale - bar.n)
+        if bar is None or info.steps % self.chunk:
+            return
+        if info.mode_changed or info.mode != self.mode:
+            self.mode, self.mode_t0 = info.mode, info.t
+        now = time.perf_counter()
+        if now - self.posted >= 0.5:
+            rate = (info.steps - self.posted_steps) / (now - self.posted)
+            where = f"{self.mode} for {self._span(info.t - self.mode_t0)}, " if self.mode else ""
+            bar.set_postfix_str(f"{where}{rate:,.0f} steps/s", refresh=False)
+            self.posted, self.posted_steps = now, info.steps
+        bar.update((info.t - self.plan.start) / self.scale - bar.n)
+
+    @classmethod
+    def _span(cls, seconds):
+        unit, size = next((u, s) for s, u in cls.SPANS if seconds >= 2 * s or s == 0.0)
+        return f"{seconds / (size or 1.0):.3g} {unit}"
 
     def close(self):
         if self.bar is not None:
+            self.stopped.set()
+            self.ticker.join()
             self.bar.close()
             self.bar = None
 

@@ -268,3 +268,30 @@ def test_progress_default_follows_the_terminal(monkeypatch):
     assert logging.getLogger("system_ssp").level == logging.INFO
     console_settings(ap.parse_args([]))
     assert logging.getLogger("system_ssp").level == logging.WARNING
+
+
+def test_progress_bar_never_looks_hung(fmus, tmp_path, capsys):
+    """The bar's clock moves every second even while one step takes seconds (it used to freeze for
+    45 s in the mission's de-orbit), and a scheduled run shows its mode, the time in it and the
+    steps per second."""
+    import time
+
+    ssd = loop_system(tmp_path, fmus)
+    with system_ssp.System(ssd) as system:
+        bar = ProgressBar(make_plan(system, RunOptions(stop_time=5 * 3.15576e7, step_size=86400.0)))
+    bar.chunk = 1  # every step, as in a scheduled run
+    info = StepInfo(0.0, 1)
+    info.mode = "coast"
+    bar.start(info)
+    try:
+        time.sleep(3.3)  # a step that takes seconds: no update() call at all
+        frames = [f for f in capsys.readouterr().err.split("\r") if "yr" in f]
+        assert {"00:01", "00:02", "00:03"} <= {re.search(r"(\d\d:\d\d)", f).group(1) for f in frames}, frames
+        for k, (mode, t) in enumerate((("coast", 86400.0), ("detumble", 86400.0 + 0.015), ("detumble", 86400.03))):
+            info = StepInfo(t, 1)
+            info.steps, info.mode, info.mode_changed = k + 1, mode, k == 1
+            bar.step(info)
+            time.sleep(0.6)
+        assert "detumble for 0.015 s" in bar.bar.postfix and "steps/s" in bar.bar.postfix
+    finally:
+        bar.close()
