@@ -14,7 +14,10 @@ import os
 from pathlib import Path
 import signal
 import sys
+import tempfile
 import traceback
+
+import fmpy
 
 from . import __version__
 from .neighbor import deorbit_study, mission, thesis, validation
@@ -25,6 +28,7 @@ from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
+from .ssp.writer import single_fmu_system
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
         "replace": replace.main_replace, "compare": replace.main_compare, "flatten": flatten.main,
@@ -37,7 +41,7 @@ def _parser():
                                  "and the NEIGHBOR applications (python -m system_ssp is the same command).")
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
-    r = sub.add_parser("run", help="run a system (.ssp or .ssd)")
+    r = sub.add_parser("run", help="run a system (.ssp or .ssd), or one FMU alone (.fmu)")
     r.add_argument("path")
     r.add_argument("--stop-time", type=float)
     r.add_argument("--step-size", type=float)
@@ -163,7 +167,26 @@ def _run_or_info(argv):
         return 0
     if args.command == "run" and args.plot and Path(args.plot).suffix.lower() not in PLOT_FORMATS:
         raise SSPError(f"--plot {args.plot}: unknown format (expected {', '.join(PLOT_FORMATS)})")
-    with System(args.path, validate=not args.no_validate) as system:
+    suffix = Path(args.path).suffix.lower()
+    if args.command == "run" and suffix not in (".ssp", ".ssd", ".fmu"):
+        raise SSPError(f"{args.path}: expected a system (.ssp, .ssd) or an FMU (.fmu) to run")
+    with tempfile.TemporaryDirectory(prefix="neighbor_one_fmu_") as tmp:
+        path = args.path
+        if args.command == "run" and suffix == ".fmu":  # the FMU alone, as a system of one
+            path = str(single_fmu_system(path, tmp))
+            experiment = fmpy.read_model_description(args.path).defaultExperiment
+            if args.stop_time is None and (experiment is None or experiment.stopTime is None):
+                raise SSPError(f"{args.path}: no stop time: pass --stop-time (the FMU has no DefaultExperiment)")
+            if args.step_size is None:
+                if experiment is None or experiment.stepSize is None:
+                    raise SSPError(f"{args.path}: no step size: pass --step-size (the FMU has no DefaultExperiment "
+                                   "stepSize)")
+                args.step_size = float(experiment.stepSize)
+        return _run(args, path)
+
+
+def _run(args, path):
+    with System(path, validate=not args.no_validate) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
             return 0

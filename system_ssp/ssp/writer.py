@@ -9,11 +9,13 @@ atomically. The output is byte-for-byte reproducible, which `python -m system_ss
 --check` relies on.
 """
 from pathlib import Path
+import shutil
 from xml.sax.saxutils import quoteattr
 
 from fmpy import read_model_description
 
 from ..atomic import write_text_atomic
+from ..errors import SSPError
 from .reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES, NS_NC, NS_SSC, NS_SSD, NS_SSV
 from .units import SI_BASE_UNITS
 
@@ -243,3 +245,36 @@ def _schedule_xml(name, schedule, comp_vars):
         out.append(f'            <nc:NextEvent component="{comp}" connector="{var}"/>')
     out.append("          </nc:Schedule>")
     return out
+
+
+def single_fmu_system(fmu, folder):
+    """A system of one component, the FMU `fmu`, written into `folder` (SystemStructure.ssd and
+    resources/<Model>.fmu): how `run MODEL.fmu` runs an FMU alone. The component is named after
+    the FMU's model identifier; the FMU's DefaultExperiment (if any) becomes the system's.
+    Returns the SSD's path."""
+    fmu, folder = Path(fmu), Path(folder)
+    try:
+        md = read_model_description(str(fmu))
+    except Exception as exc:  # fmpy raises several kinds for a file that is not an FMU
+        raise SSPError(f"{fmu}: not an FMU that can be read ({exc})") from None
+    if md.coSimulation is None:
+        raise SSPError(f"{fmu}: has no co-simulation interface (model exchange only), which the master needs")
+    name = md.coSimulation.modelIdentifier
+    (folder / "resources").mkdir(parents=True, exist_ok=True)
+    shutil.copyfile(fmu, folder / "resources" / f"{name}.fmu")
+    de = md.defaultExperiment
+    times = "" if de is None else "".join(f' {attr}="{value}"' for attr, value in (
+        ("startTime", de.startTime), ("stopTime", de.stopTime)) if value is not None)
+    ssd = folder / "SystemStructure.ssd"
+    write_text_atomic(ssd, "\n".join([
+        '<?xml version="1.0" encoding="UTF-8"?>',
+        f'<ssd:SystemStructureDescription {NS} version="1.0" name={quoteattr(name)}>',
+        f'  <ssd:System name={quoteattr(name)} description={quoteattr(f"{fmu.name} alone")}>',
+        "    <ssd:Elements>",
+        f'      <ssd:Component name={quoteattr(name)} type="application/x-fmu-sharedlibrary" '
+        f'source="resources/{name}.fmu"/>',
+        "    </ssd:Elements>",
+        "  </ssd:System>",
+        *([f"  <ssd:DefaultExperiment{times}/>"] if times else []),
+        "</ssd:SystemStructureDescription>", ""]))
+    return ssd

@@ -74,3 +74,20 @@ def test_run_plot_and_the_time_axis(ssp_paths, tmp_path, capsys):
     assert time_axis(np.array([0.0, 5 * 86400.0]))[1] == "d"
     assert time_axis(np.array([0.0, 90.0]))[1] == "s"
     assert json.dumps(time_axis(np.array([0.0, 7200.0]))[1]) == '"h"'
+
+
+def test_run_one_fmu_alone(fmu_paths, tmp_path, capsys):
+    """`run MODEL.fmu` runs the FMU as a system of one (it used to answer 'malformed XML'); what it
+    cannot know is asked for by name."""
+    assert main(["run", str(fmu_paths["Gyro"]), "--stop-time", "1", "--step-size", "0.1", "--output",
+                 str(tmp_path / "gyro.csv"), "--plot", str(tmp_path / "gyro.png")]) == 0
+    out = capsys.readouterr().out
+    assert "steps:       10 (h = 0.1 s" in out and "Gyro.omega_meas_B[1] =" in out
+    columns, units = read_result(tmp_path / "gyro.csv")
+    assert units["Gyro.omega_meas_B[1]"] == "rad/s" and len(columns["time"]) == 11
+    assert (tmp_path / "gyro.png").is_file()
+    assert main(["run", str(fmu_paths["Gyro"]), "--step-size", "0.1"]) == 2
+    assert "Gyro.fmu: no stop time: pass --stop-time" in capsys.readouterr().err
+    (tmp_path / "x.csv").write_text("time\n0\n")
+    assert main(["run", str(tmp_path / "x.csv")]) == 2
+    assert "expected a system (.ssp, .ssd) or an FMU (.fmu)" in capsys.readouterr().err
