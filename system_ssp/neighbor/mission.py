@@ -14,8 +14,8 @@ flight settle criteria, the controllers on the attitude estimator (sensors with 
 thesis` applies parameters/mission_gnc_thesis.ssv, the thesis' guidance and control on the true
 state, which gives its published numbers (system_ssp/systems/generators/mission.py).
 It writes into --out:
-- timeseries.csv   the recorded signals (RECORD below; rows per nc:Schedule mode), their units
-                   in timeseries.units.json;
+- timeseries.parquet  the recorded signals (RECORD below; rows per nc:Schedule mode) with their
+                   units (--timeseries csv: timeseries.csv and timeseries.units.json);
 - summary.json     every computed figure beside the thesis' (also printed as a table);
 - altitude.png (Fig. 11), detumble.png (Fig. 20-22), slew.png (Fig. 27-29), tracking.png
   (Fig. 43-44), battery.png (Fig. 46), data.png (Fig. 47); estimation.png (the estimator's
@@ -69,12 +69,20 @@ THESIS[DEFAULT_SCENARIO].update(tracking_propellant_g=propulsion_report.THESIS["
 RECORD = list(MISSION_RECORD)  # components.mission.neighbor
 
 
+TIMESERIES_FORMATS = ("parquet", "csv")
+
+
 def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
-                parameters=None, profile=False, progress=False, parameter_sets=(), gnc=DEFAULT_GNC):
+                parameters=None, profile=False, progress=False, parameter_sets=(), gnc=DEFAULT_GNC,
+                timeseries="parquet"):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
     `gnc` (GNC) picks the guidance and control parameter set, applied after the scenario's;
     `parameter_sets` (files, names component.variable) apply after it and `parameters`
-    ({component.variable: value}) after them."""
+    ({component.variable: value}) after them. `timeseries`: the recorded signals' format, "parquet"
+    (units in the file) or "csv" (units in timeseries.units.json)."""
+    if timeseries not in TIMESERIES_FORMATS:
+        raise SSPError(f"--timeseries {timeseries!r}: expected one of {', '.join(TIMESERIES_FORMATS)}")
+    series = f"timeseries.{timeseries}"
     if orbit not in SYSTEMS:
         raise SSPError(f"unknown orbit model {orbit!r} (expected one of: {', '.join(SYSTEMS)})")
     if scenario not in SCENARIOS:
@@ -89,7 +97,7 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         raise SSPError(f"unknown guidance and control set {gnc!r} (expected one of: {', '.join(GNC)})")
     ssv = [PARAMETERS_DIR / f"{scenario_set(SYSTEMS['cowell'], scenario)}.ssv"] + (
         [PARAMETERS_DIR / f"{GNC[gnc]}.ssv"] if GNC[gnc] else [])
-    with staged_results(out, lambda err: "timeseries.csv") as staged:
+    with staged_results(out, lambda err: series) as staged:
         with System(ssp) as system:
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
                            parameters=parameters or {},
@@ -97,7 +105,7 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         s = summarize(r, scenario, orbit)
         s["gnc"] = gnc
         if staged is not None:
-            write_result(r.data, staged.path / "timeseries.csv", r.units)
+            write_result(r.data, staged.path / series, r.units)
             write_text_atomic(staged.path / "summary.json", json.dumps(s, indent=1))
             plot(r.data, s, staged.path)
             staged.commit()
@@ -451,7 +459,10 @@ def main(argv=None):
     ap.add_argument("--out", default="results/mission")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
     ap.add_argument("--max-years", type=float, default=40.0)
-    ap.add_argument("--profile", action="store_true")
+    ap.add_argument("--profile", action="store_true", help="print the wall time per component")
+    ap.add_argument("--timeseries", choices=TIMESERIES_FORMATS, default="parquet",
+                    help="format of the recorded signals: parquet (default; units in the file; "
+                         "`neighbor-cosim plot` reads it) or csv (units in timeseries.units.json)")
     ap.add_argument("--ssv", action="append", default=[], metavar="FILE",
                     help="extra parameter set after the scenario's, names component.variable (repeatable)")
     ap.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
@@ -461,7 +472,7 @@ def main(argv=None):
     progress = console_settings(args)
     s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years,
                        parameters=parse_sets(args.set), profile=args.profile, progress=progress,
-                       parameter_sets=args.ssv, gnc=args.gnc)
+                       parameter_sets=args.ssv, gnc=args.gnc, timeseries=args.timeseries)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:

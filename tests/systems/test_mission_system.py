@@ -10,6 +10,7 @@ import time
 import pytest
 
 from paths import REPO
+from system_ssp.master.plotting import read_result
 from system_ssp import SimulationError, SSPError, System, cli
 from system_ssp.neighbor import mission
 from system_ssp.neighbor.validation import assert_reproduces
@@ -87,8 +88,8 @@ def test_results_folder(run):
     assert json.loads((out / "summary.json").read_text())["detumble_time_s"] == s["detumble_time_s"]
     for name in ("altitude", "detumble", "slew", "tracking", "battery", "data"):
         assert (out / f"{name}.png").stat().st_size > 10000, name
-    header = (out / "timeseries.csv").read_text().split("\n", 1)[0].split(",")
-    assert header[0] == "time" and "power.state_of_charge" in header
+    columns, _ = read_result(out / "timeseries.parquet")  # the default; --timeseries csv: below
+    assert list(columns)[0] == "time" and "power.state_of_charge" in columns
 
 
 @pytest.mark.parametrize("params, pattern", [
@@ -116,7 +117,7 @@ def test_unknown_parameter_in_a_scenario_file(ssp_paths, tmp_path):
 
 def test_results_folder_units_and_modes(run):
     _, _, out = run
-    units = json.loads((out / "timeseries.units.json").read_text())
+    _, units = read_result(out / "timeseries.parquet")
     assert units["time"] == "s" and units["orbit.sma"] == "m" and units["mission.mode"] is None
     umask = os.umask(0)
     os.umask(umask)
@@ -148,6 +149,7 @@ def test_interrupted_mission_leaves_a_marked_partial_folder(ssp_paths, tmp_path)
     (out / "summary.json").write_text("previous run")
     env = dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""))
     proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "mission", "--out", str(out), "--quiet",
+                             "--timeseries", "csv",
                              "--ssp-dir", str(ssp_paths["neighbor_mission"].parent), "--log-level", "info"],
                             stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True, env=env)
     try:
