@@ -15,8 +15,7 @@ import logging
 
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import Observer, Result, RunOptions, RunView, StepInfo, System, simulate, write_csv_atomic, write_result
-
-__version__ = "0.2.0"
+from .version import __version__
 
 # A library prints nothing by itself: the master's and the FMUs' messages go to the "system_ssp"
 # loggers for the application to show (the command line does, see --log-level).

@@ -26,6 +26,9 @@ from .tools.console import add_console_arguments, console_settings, parse_sets
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
+from .master.report import run_report
+from .master.result import check_output_file
+from .atomic import write_text_atomic
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 from .ssp.writer import single_fmu_system
@@ -60,6 +63,8 @@ def _parser():
     r.add_argument("--record-every", type=int, default=1)
     r.add_argument("--print-final", action="store_true", help="print all final values")
     r.add_argument("--plot", metavar="FILE", help="also draw the recorded signals: .png, .svg or .html (interactive)")
+    r.add_argument("--report", metavar="FILE.html", help="also write a report: outcome, an interactive figure of the "
+                   "recorded signals, settings and versions, in one HTML file that needs no network")
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
@@ -167,6 +172,8 @@ def _run_or_info(argv):
         return 0
     if args.command == "run" and args.plot and Path(args.plot).suffix.lower() not in PLOT_FORMATS:
         raise SSPError(f"--plot {args.plot}: unknown format (expected {', '.join(PLOT_FORMATS)})")
+    if args.command == "run" and args.report:
+        check_output_file(args.report, "--report", (".html",))
     suffix = Path(args.path).suffix.lower()
     if args.command == "run" and suffix not in (".ssp", ".ssd", ".fmu"):
         raise SSPError(f"{args.path}: expected a system (.ssp, .ssd) or an FMU (.fmu) to run")
@@ -220,6 +227,10 @@ def _run(args, path):
         print(f"  {k} = {v!r}")
     if args.plot:
         print(f"plot:        {result.plot(out=args.plot, title=args.path)}")
+    if args.report:
+        settings = {k: v for k, v in vars(args).items() if v not in (None, [], False) and k != "command"}
+        write_text_atomic(args.report, run_report(result, f"{Path(args.path).name}: {result.stop_reason}", settings))
+        print(f"report:      {args.report}")
     return 0
 
 

@@ -8,7 +8,7 @@ from __future__ import annotations
 import fnmatch
 import json
 from pathlib import Path
-from typing import Dict, List, Optional, Sequence, Tuple
+from typing import Any, Dict, List, Optional, Sequence, Tuple
 
 import numpy as np
 
@@ -121,9 +121,9 @@ def plot(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], o
     if len(groups) > MAX_PANELS:
         raise SSPError(f"{len(signals)} signals in {len(groups)} different units: choose at most {MAX_PANELS} units' "
                        "worth (name the signals or a glob)")
-    t, t_unit = time_axis(np.asarray(columns["time"], dtype=float))
     if out.suffix.lower() == ".html":
-        return _plot_html(columns, groups, t, t_unit, out, title)
+        return _plot_html(columns, units, signals, out, title)
+    t, t_unit = time_axis(np.asarray(columns["time"], dtype=float))
     import matplotlib
 
     matplotlib.use("Agg")
@@ -147,21 +147,46 @@ def plot(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], o
     return out
 
 
-def _plot_html(columns: Dict[str, np.ndarray], groups: List[Tuple[Optional[str], List[str]]], t: np.ndarray,
-               t_unit: str, out: Path, title: str) -> Path:
+Band = Tuple[float, float, str]  # (start, end, label) in seconds: a shaded span (a mode)
+
+
+def interactive_figure(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], title: str = "",
+                       bands: Sequence[Band] = ()) -> Any:
+    """A plotly figure of `signals` against time: a panel per unit, pan and zoom, `bands` shaded
+    and labelled (e.g. the mission's modes). SSPError without plotly."""
     try:
         import plotly.graph_objects as go
         from plotly.subplots import make_subplots
     except ImportError:
-        raise SSPError(f"--out {out}: an HTML plot needs plotly (pip install plotly)") from None
+        raise SSPError("an interactive (HTML) plot needs plotly (pip install plotly)") from None
+    groups = panels(signals, units)
+    t, t_unit = time_axis(np.asarray(columns["time"], dtype=float))
+    scale = float(columns["time"][-1]) / float(t[-1]) if len(t) and t[-1] else 1.0
     fig = make_subplots(rows=len(groups), cols=1, shared_xaxes=True, vertical_spacing=0.04)
+    # SVG traces draw everywhere (no WebGL, which a browser without a GPU only emulates, with
+    # console warnings); WebGL only where SVG would be slow
+    trace = go.Scatter if len(t) <= WEBGL_ABOVE else go.Scattergl
     for row, (unit, names) in enumerate(groups, 1):
         for name in names:
-            fig.add_trace(go.Scattergl(x=t, y=np.asarray(columns[name], dtype=float), name=name, mode="lines"),
+            fig.add_trace(trace(x=t, y=np.asarray(columns[name], dtype=float), name=name, mode="lines"),
                           row=row, col=1)
         fig.update_yaxes(title_text=unit or "(no unit)", row=row, col=1)
+    for k, (t0, t1, label) in enumerate(bands):
+        fig.add_vrect(x0=t0 / scale, x1=t1 / scale, fillcolor=BAND_COLORS[k % len(BAND_COLORS)], opacity=0.12,
+                      line_width=0, annotation_text=label, annotation_position="top left",
+                      annotation_font_size=9, row="all", col=1)
     fig.update_xaxes(title_text=f"time ({t_unit})", row=len(groups), col=1)
     fig.update_layout(title=title, height=260 * len(groups) + 120, template="plotly_white")
+    return fig
+
+
+WEBGL_ABOVE = 50_000  # points per signal
+BAND_COLORS = ("#1f77b4", "#ff7f0e", "#2ca02c", "#d62728", "#9467bd", "#8c564b")
+
+
+def _plot_html(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], out: Path,
+               title: str) -> Path:
+    fig = interactive_figure(columns, units, signals, title)
     html = fig.to_html(include_plotlyjs=True, full_html=True)  # one file, no network to open it
     with atomic_write(out, "w", encoding="utf-8") as f:
         f.write(html)

@@ -94,13 +94,13 @@ class Result:
 FORMATS = (".csv", ".parquet")
 
 
-def check_output_file(path: PathLike, what: str = "output file") -> Path:
+def check_output_file(path: PathLike, what: str = "output file", formats: Sequence[str] = FORMATS) -> Path:
     """Refuse, before a run starts, an output file the run could not write: its folder missing or
     not a folder, the path a folder, or no file creatable in the folder (tried)."""
     path = Path(path)
     folder = path.parent if str(path.parent) else Path(".")
-    if path.suffix.lower() not in FORMATS and path.suffix:
-        raise SSPError(f"{what} {path}: unknown format {path.suffix!r} (expected .csv or .parquet)")
+    if path.suffix.lower() not in formats and (path.suffix or formats != FORMATS):
+        raise SSPError(f"{what} {path}: unknown format {path.suffix!r} (expected {' or '.join(formats)})")
     if not folder.exists():
         raise SSPError(f"{what} {path}: folder {folder} does not exist")
     if not folder.is_dir():

@@ -39,7 +39,7 @@ from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS
 
 from ..atomic import atomic_write, write_text_atomic
 from ..errors import SSPError
-from ..master import System, write_result
+from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
 from . import deorbit_study, propulsion_report, thesis
@@ -106,11 +106,44 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         s["gnc"] = gnc
         if staged is not None:
             write_result(r.data, staged.path / series, r.units)
+            settings = {"scenario": scenario, "orbit": orbit, "gnc": gnc, "system": ssp.name,
+                        "parameter sets": ", ".join(map(str, [*ssv, *parameter_sets])),
+                        "parameters": ", ".join(f"{k}={v}" for k, v in (parameters or {}).items()) or "-"}
+            write_text_atomic(staged.path / "report.html", report_html(r, s, settings))
             write_text_atomic(staged.path / "summary.json", json.dumps(s, indent=1))
             plot(r.data, s, staged.path)
             staged.commit()
     return s, r
 
+
+
+def report_html(r, s, settings):
+    """report.html of a mission: the summary beside the thesis (rows 10 % or more away shaded), the
+    whole mission and the de-orbit maneuver as interactive figures with their modes and phases
+    shaded, the settings and versions; one file that opens without network access."""
+    data = r.data
+    columns = {n: data[n] for n in data.dtype.names}
+    t = data["time"]
+    modes = {int(m): m.name.lower() for m in MissionMode}
+    phases = {int(p): p.name.lower().replace("_", " ") for p in DeorbitPhase}
+    whole = ["orbit.altitude", "orbit.perigee_altitude", "power.state_of_charge", "data.storage_used",
+             "propulsion.propellant_used"]
+    sections = [("Summary", report.markdown(table(s), far_beyond=10.0)),
+                ("The mission", report.figure(
+                    columns, r.units, [n for n in whole if n in columns],
+                    bands=report.bands(t, data["mission.mode"], modes, (t[-1] - t[0]) / 300)))]
+    deorbit = np.flatnonzero(data["mission.mode"] == MissionMode.DEORBIT)
+    if deorbit.size:
+        window = slice(deorbit[0], deorbit[-1] + 2)
+        part = {n: col[window] for n, col in columns.items()}
+        maneuver = [*(n for n in columns if n.startswith("dynamics.omega_BN_B")), "tracking.pointing_error",
+                    "thrusters.propellant_mass", "propulsion.propellant_used"]
+        sections.append(("The de-orbit maneuver", report.figure(
+            part, r.units, [n for n in maneuver if n in part],
+            bands=report.bands(part["time"], part["mission.phase"], phases))))
+    sections += [("Settings", report.table(("setting", "value"), list(settings.items()))),
+                 ("Versions", report.table(("software", "version"), list(report.versions().items())))]
+    return report.page(f"NEIGHBOR mission, {s.get('scenario')} scenario", sections)
 
 
 def _first(mask):

@@ -9,6 +9,7 @@ import time
 
 import pytest
 
+from browser import open_page
 from paths import REPO
 from system_ssp.master.plotting import read_result
 from system_ssp import SimulationError, SSPError, System, cli
@@ -90,6 +91,19 @@ def test_results_folder(run):
         assert (out / f"{name}.png").stat().st_size > 10000, name
     columns, _ = read_result(out / "timeseries.parquet")  # the default; --timeseries csv: below
     assert list(columns)[0] == "time" and "power.state_of_charge" in columns
+
+
+def test_report_opens_in_a_browser(run, tmp_path):
+    """report.html: the summary beside the thesis, the mission with its modes and the de-orbit
+    maneuver with its phases, drawn by a real browser with a quiet console."""
+    _, _, out = run
+    text = (out / "report.html").read_text()
+    assert "NEIGHBOR mission, 420km scenario" in text and "The de-orbit maneuver" in text
+    assert "<script src=" not in text  # plotly.js inside: opens without network
+    dom, console = open_page(out / "report.html", screenshot=tmp_path / "report.png", size=(1250, 2600))
+    assert console == [], console[:3]
+    assert dom.count('class="main-svg"') >= 4  # both figures drawn
+    assert "burn time (min)" in dom and "monitoring" in dom and "detumble" in dom
 
 
 @pytest.mark.parametrize("params, pattern", [
