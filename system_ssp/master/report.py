@@ -90,6 +90,24 @@ def figure(columns: Mapping[str, np.ndarray], units: Mapping[str, Optional[str]]
     return str(fig.to_html(full_html=False, include_plotlyjs=False))
 
 
+def histograms(values: Mapping[str, Sequence[float]], units: Optional[Mapping[str, Optional[str]]] = None) -> str:
+    """Interactive histograms, one panel per named sample (a campaign's metrics), as a <div>."""
+    import plotly.graph_objects as go
+    from plotly.subplots import make_subplots
+
+    names = list(values)
+    cols = min(3, max(1, len(names)))
+    rows = -(-len(names) // cols)
+    fig = make_subplots(rows=rows, cols=cols, subplot_titles=names)
+    for k, name in enumerate(names):
+        fig.add_trace(go.Histogram(x=list(values[name]), name=name, showlegend=False), row=k // cols + 1,
+                      col=k % cols + 1)
+        fig.update_xaxes(title_text=(units or {}).get(name) or "", row=k // cols + 1, col=k % cols + 1)
+        fig.update_yaxes(title_text="runs", row=k // cols + 1, col=k % cols + 1)
+    fig.update_layout(height=300 * rows + 60, template="plotly_white")
+    return str(fig.to_html(full_html=False, include_plotlyjs=False))
+
+
 def bands(t: np.ndarray, codes: np.ndarray, labels: Mapping[int, str], shortest: float = 0.0) -> List[Band]:
     """Shaded spans of a mode signal: (start, end, label) for each run of equal `codes`; spans
     shorter than `shortest` seconds are folded into the one before (a daily five-second wake

@@ -8,6 +8,7 @@ import pyarrow.compute as pc
 import pyarrow.parquet as pq
 import pytest
 
+from browser import open_page
 from system_ssp import SSPError
 from system_ssp.tools.campaign import load_spec, run_campaign
 from system_ssp.tools.campaign.runner import wilson
@@ -96,6 +97,8 @@ def test_one_and_two_workers_give_the_same_rows_and_resume_skips(ssp_paths, tmp_
     assert s1["failed"] == s2["failed"] == len(failed) and s1["metrics"] == s2["metrics"]
     assert json.loads((tmp_path / "one" / "summary.json").read_text())["probabilities"]["slow_x"]["n"] == s1["ok"]
     assert (tmp_path / "one" / "figures" / "scatter.png").stat().st_size > 5000
+    dom, console = open_page(tmp_path / "one" / "report.html")  # one file, drawn by a real browser
+    assert console == [] and dom.count('class="main-svg"') >= 2 and "success rate" in dom
     # an interrupted campaign: only the first 2 runs were recorded; the same spec resumes
     parts = sorted((tmp_path / "two" / "runs").glob("part-*.parquet"))
     table = pa.concat_tables([pq.read_table(p) for p in parts])

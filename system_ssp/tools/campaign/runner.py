@@ -19,6 +19,7 @@ dies (an FMU that crashes it) is restarted by its nanny and its run recorded as 
 """
 import argparse
 from collections import Counter
+from html import escape
 import json
 import math
 import os
@@ -33,7 +34,7 @@ import numpy as np
 from ... import __version__
 from ...atomic import atomic_write, write_text_atomic
 from ...errors import SSPError
-from ...master import System
+from ...master import System, report
 from ...master.plan import RunOptions
 from ...master.planning import make_plan
 from ..console import add_console_arguments, console_settings
@@ -171,7 +172,26 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     summary["resumed_from"] = len(done)
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, default=_json) + "\n")
     figures(spec, rows, out / "figures")
+    write_text_atomic(out / "report.html", campaign_report(spec, rows, summary))
     return summary
+
+
+def campaign_report(spec, rows, s):
+    """report.html of a campaign: the summary table, the metrics' distributions (interactive),
+    the commonest errors, the spec and the versions; one file."""
+    ok = [r for r in rows if r["status"] == "ok"]
+    sections = [("Summary", report.markdown(table(s)))]
+    numeric = {m.name: [float(r[m.name]) for r in ok if isinstance(r[m.name], (int, float))
+                        and math.isfinite(float(r[m.name]))] for m in spec.metrics}
+    numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
+    if numeric:
+        sections.append(("Distributions over the successful runs", report.histograms(numeric)))
+    if s.get("errors"):
+        sections.append(("Commonest errors", report.table(("runs", "error"),
+                                                          [(e["runs"], e["error"]) for e in s["errors"]])))
+    sections += [("Spec", f"<pre>{escape(spec.text)}</pre>"),
+                 ("Versions", report.table(("software", "version"), list(report.versions().items())))]
+    return report.page(f"campaign {spec.path.name}: {s['runs']} runs of {spec.system.name}", sections)
 
 
 def _run(client, spec, out, todo, columns, progress, as_completed, batch=1):
@@ -377,7 +397,7 @@ def main(argv=None):
     print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {args.out}", file=sys.stderr)
     s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
     print(table(s))
-    print(f"results in {args.out} (runs.parquet, summary.json, figures/)")
+    print(f"results in {args.out} (runs.parquet, summary.json, report.html, figures/)")
     failure = failed_campaign(s)
     if failure:
         print(f"campaign failed: {failure}", file=sys.stderr)
