@@ -180,7 +180,16 @@ def campaign_report(spec, rows, s):
     """report.html of a campaign: the summary table, the metrics' distributions (interactive),
     the commonest errors, the spec and the versions; one file."""
     ok = [r for r in rows if r["status"] == "ok"]
-    sections = [("Summary", report.markdown(table(s)))]
+    stats = [(name, m["n"], *(f"{m[k]:.6g}" for k in ("mean", "std", "min", "p5", "p50", "p95", "max")))
+             for name, m in s["metrics"].items() if "mean" in m]
+    summary = [f"<p>{s['runs']} runs: {s['ok']} ok, {s['failed']} failed, {s['timeout']} timed out (success rate "
+               f"{100 * s['success_rate']:.1f} %)</p>",
+               report.table(("metric", "n", "mean", "std", "min", "p5", "p50", "p95", "max"), stats)]
+    if s["probabilities"]:
+        summary.append(report.table(("probability", "condition", "p", "95 % interval", "runs"), [
+            (name, p["condition"], f"{p['p']:.3f}", f"[{p['ci95'][0]:.3f}, {p['ci95'][1]:.3f}]", f"{p['k']}/{p['n']}")
+            for name, p in s["probabilities"].items()]))
+    sections = [("Summary", "\n".join(summary))]
     numeric = {m.name: [float(r[m.name]) for r in ok if isinstance(r[m.name], (int, float))
                         and math.isfinite(float(r[m.name]))] for m in spec.metrics}
     numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
