@@ -91,3 +91,11 @@ def test_run_one_fmu_alone(fmu_paths, tmp_path, capsys):
     (tmp_path / "x.csv").write_text("time\n0\n")
     assert main(["run", str(tmp_path / "x.csv")]) == 2
     assert "expected a system (.ssp, .ssd) or an FMU (.fmu)" in capsys.readouterr().err
+
+
+def test_thesis_says_which_case_did_not_finish(ssp_paths, capsys):
+    """`thesis` exits 1 naming each case that did not finish and why (it printed a bare "NO")."""
+    assert main(["thesis", "--ssp-dir", str(ssp_paths["slew"].parent), "--slew-stop-time", "1"]) == 1
+    err = capsys.readouterr().err
+    assert "slew_case1: did not finish: its stop condition was still false at t = 1 s, the run's limit" in err
+    assert "detumble_case1" not in err  # the detumbles finish
