@@ -394,8 +394,8 @@ def plot(d, s, out):
                 axes[2].annotate(f"first 10 s: up to {err.max():.1f} deg (off the scale)", (0.02, 0.9),
                                  xycoords="axes fraction", fontsize=8)
         axes[-1].set_xlabel("time in phase (s)")
-        for a in axes:
-            legend(a, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+        for a in axes:  # inside the axes: outside, the legends took two thirds of the width
+            legend(a, ncol=3 if len(a.get_legend_handles_labels()[1]) > 2 else 1)
             a.grid(alpha=0.3)
         axes[0].set_title(title)
         save(fig, name)
@@ -432,12 +432,12 @@ def plot(d, s, out):
                 a.set_xlabel("hours since the end of the grace period")
                 a.grid(alpha=0.3)
             ax.set_title(title, fontsize=10)
-            legend(ax, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+            legend(ax)
             if window is not None:
                 _phase_spans(zoom, th, m, ph)
                 zoom.set_xlim(*window)
                 zoom.set_title("zoom: final contact, de-orbit phases (shaded) and the downlink", fontsize=9)
-                legend(zoom, loc="upper left", bbox_to_anchor=(1.01, 1.0))
+                legend(zoom)
             save(fig, name)
 
 
@@ -452,23 +452,27 @@ def _plot_estimation(plt, d, s, save, legend):
     t0 = t[_first(mode == MissionMode.DEORBIT)]
     tm = (t[sel] - t0) / 60.0
     err = np.degrees(d["estimator.attitude_error"][sel])
-    sigma3 = 3.0 * np.degrees(np.max([d[f"estimator.sigma_attitude[{i}]"][sel] for i in (1, 2, 3)], axis=0))
+    # the error is an angle about any axis: compare it with the covariance's root-sum-square, not one axis
+    sigma3 = 3.0 * np.degrees(np.sqrt(np.sum([d[f"estimator.sigma_attitude[{i}]"][sel] ** 2 for i in (1, 2, 3)],
+                                             axis=0)))
     fig, axes = plt.subplots(3, 1, figsize=(9, 9))
     zoom = (tm - tm[0]) * 60.0 <= 180.0
     for ax, x, keep in ((axes[0], tm, slice(None)), (axes[1], (tm - tm[0]) * 60.0, zoom)):
         ax.semilogy(x[keep], err[keep], color="k", linewidth=0.6, label="attitude error (estimate vs truth)")
         ax.semilogy(x[keep], sigma3[keep], color="tab:red", linewidth=0.9,
-                    label="3 sigma, largest axis (filter covariance)")
+                    label="3 sigma, root-sum-square of the axes (filter covariance)")
         ax.set_ylabel("attitude knowledge (deg)")
     axes[0].set_xlabel("minutes since the de-orbit start (from the first attitude fix)")
     axes[1].set_xlabel("seconds since the first attitude fix")
-    for p, name in ((DeorbitPhase.DETUMBLE, "detumble"), (DeorbitPhase.SLEW, "slew"), (DeorbitPhase.BURN, "burn")):
+    phases = ((DeorbitPhase.DETUMBLE, "detumble"), (DeorbitPhase.SLEW, "slew"), (DeorbitPhase.BURN, "burn"))
+    for k, (p, name) in enumerate(phases):
         i = _first(phase[sel] == p)
         if i is not None and zoom[i]:
             x = (tm[i] - tm[0]) * 60.0
             axes[1].axvline(x, color="0.4", linestyle="--", linewidth=0.8)
-            axes[1].annotate(f"{name} starts", (x, 0.97), xycoords=("data", "axes fraction"), xytext=(3, 0),
-                             textcoords="offset points", fontsize=8, va="top")
+            # one height per label: the phases can start seconds apart
+            axes[1].annotate(f"{name} starts", (x, 0.97 - 0.1 * k), xycoords=("data", "axes fraction"),
+                             xytext=(3, 0), textcoords="offset points", fontsize=8, va="top")
     axes[2].semilogy(tm, np.degrees(np.maximum(d["estimator.rate_error"][sel], 1e-9)), color="tab:blue",
                      linewidth=0.6, label="|rate estimate - truth|")
     axes[2].set_ylabel("rate knowledge (deg/s)")
