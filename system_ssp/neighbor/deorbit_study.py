@@ -141,6 +141,9 @@ def table(summary):
     return "\n".join(lines) + "\n"
 
 
+REQUIREMENT_YEARS = 5.0  # the mission's goal: re-entry within five years of the burn
+
+
 def plot(summary, out):
     """altitude_<scenario>.png: a - R_eq (km) vs years since the burn, with and without NEIGHBOR."""
     import numpy as np
@@ -153,24 +156,34 @@ def plot(summary, out):
     for name, ref in THESIS.items():
         if name not in summary:
             continue
-        fig, ax = plt.subplots(figsize=(8, 4.5))
         runs = ((name + "_no_burn", "without NEIGHBOR", "tab:red"), (name, "with NEIGHBOR", "tab:blue"))
-        for run, label, color in runs:
-            data = np.genfromtxt(out / f"{run}.csv", delimiter=",", names=True, deletechars="")
-            years = data["time"] / YEAR
-            ax.plot(years, (data["orbit.sma"] - r_eq) / KM, color=color,
-                    label=f"{label}: {summary[run]['lifetime_years']:.2f} y "
-                          f"(thesis {summary[run]['thesis_lifetime_years']:.2f} y)")
-            ax.fill_between(years, data["orbit.perigee_altitude"] / KM, (data["orbit.sma"] - r_eq) / KM, color=color,
-                            alpha=0.15, linewidth=0)
-        ax.axhline(250.0, color="k", linestyle=":", linewidth=1, label="re-entry, 250 km")
+        with_burn = summary[name]["lifetime_years"]
+        # a host that stays up for decades squashes the de-orbit into the axis' first percent: zoom too
+        zoom = summary[name + "_no_burn"]["lifetime_years"] > 4.0 * max(with_burn, REQUIREMENT_YEARS)
+        fig, axes = plt.subplots(1, 2 if zoom else 1, figsize=(12 if zoom else 8, 4.5), squeeze=False)
+        for k, ax in enumerate(axes[0]):
+            for run, label, color in runs:
+                data = np.genfromtxt(out / f"{run}.csv", delimiter=",", names=True, deletechars="")
+                years = data["time"] / YEAR
+                ax.plot(years, (data["orbit.sma"] - r_eq) / KM, color=color,
+                        label=f"{label}: {summary[run]['lifetime_years']:.2f} y "
+                              f"(thesis {summary[run]['thesis_lifetime_years']:.2f} y)")
+                ax.fill_between(years, data["orbit.perigee_altitude"] / KM, (data["orbit.sma"] - r_eq) / KM,
+                                color=color, alpha=0.15, linewidth=0)
+            ax.axhline(250.0, color="k", linestyle=":", linewidth=1, label="re-entry, 250 km")
+            ax.axvline(REQUIREMENT_YEARS, color="tab:green", linestyle="--", linewidth=1,
+                       label=f"requirement: re-entry within {REQUIREMENT_YEARS:g} years")
+            ax.set_xlabel("years since the start of the burn")
+            ax.grid(alpha=0.3)
+            if k == 1:
+                ax.set_xlim(0.0, 1.5 * max(with_burn, REQUIREMENT_YEARS))
+                ax.set_title("zoom: the de-orbit with NEIGHBOR", fontsize=9)
+        ax = axes[0][0]
         s = summary[name]
         ax.set_title(f"Orbital lifetime from {ref['h0']:g} km (thesis Fig. {ref['figure']}); {s['model']} orbit, "
-                     f"{s['density_model']}")
-        ax.set_xlabel("years since the start of the burn")
+                     f"{s['density_model']}", fontsize=9 if zoom else 10)
         ax.set_ylabel("a - R_eq (km); shaded down to perigee")
         ax.legend(loc="upper right", fontsize=8)
-        ax.grid(alpha=0.3)
         fig.tight_layout()
         with atomic_write(out / f"altitude_{name}.png", "wb") as f:
             fig.savefig(f, dpi=110, format="png")
