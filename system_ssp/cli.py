@@ -45,22 +45,26 @@ def _parser():
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a system (.ssp or .ssd), or one FMU alone (.fmu)")
-    r.add_argument("path")
-    r.add_argument("--stop-time", type=float)
-    r.add_argument("--step-size", type=float)
-    r.add_argument("--start-time", type=float)
+    r.add_argument("path", help="the system (.ssp, or an .ssd in its folder) or one FMU (.fmu)")
+    r.add_argument("--stop-time", type=float, help="seconds (default: the SSD's DefaultExperiment)")
+    r.add_argument("--step-size", type=float,
+                   help="communication step in s (default: the SSD's master annotation; an nc:Schedule sets its own)")
+    r.add_argument("--start-time", type=float, help="seconds (default: the SSD's DefaultExperiment, else 0)")
     r.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
                    help="override a parameter or start value (repeatable)")
     r.add_argument("--ssv", action="append", default=[], metavar="FILE",
                    help="extra parameter set, names component.variable (repeatable)")
-    r.add_argument("--algorithm", choices=["jacobi", "gauss-seidel"])
-    r.add_argument("--order", help="component order, comma-separated")
-    r.add_argument("--step-multiple", action="append", default=[], metavar="COMP=K")
+    r.add_argument("--algorithm", choices=["jacobi", "gauss-seidel"],
+                   help="default: the SSD's master annotation, else gauss-seidel")
+    r.add_argument("--order", help="Gauss-Seidel component order, comma-separated (default: the SSD's, else by "
+                   "the connections)")
+    r.add_argument("--step-multiple", action="append", default=[], metavar="COMP=K",
+                   help="step this component every K-th communication step (repeatable)")
     r.add_argument("--stop-when", action="append", default=None, metavar="COMP.VAR",
                    help="Boolean output that stops the run when true (repeatable)")
     r.add_argument("--output", help="results file: .csv (units in <name>.units.json) or .parquet")
     r.add_argument("--outputs", help="signals to record, comma-separated component.variable")
-    r.add_argument("--record-every", type=int, default=1)
+    r.add_argument("--record-every", type=int, default=1, help="record a row every N steps (default 1)")
     r.add_argument("--print-final", action="store_true", help="print all final values")
     r.add_argument("--plot", metavar="FILE", help="also draw the recorded signals: .png, .svg or .html (interactive)")
     r.add_argument("--report", metavar="FILE.html", help="also write a report: outcome, an interactive figure of the "
@@ -73,9 +77,9 @@ def _parser():
     add_console_arguments(r)
     i = sub.add_parser("info", help="describe a system (.ssp/.ssd) or an FMU: every variable, where parameters "
                        "are bound")
-    i.add_argument("path")
+    i.add_argument("path", help="a system (.ssp, .ssd) or an FMU (.fmu)")
     i.add_argument("--json", action="store_true", help="the same as JSON, for tools")
-    i.add_argument("--no-validate", action="store_true")
+    i.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
                    "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
     sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")

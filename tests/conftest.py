@@ -83,6 +83,8 @@ def pytest_sessionfinish(session, exitstatus):
     session must have been checked by that test (system_ssp.neighbor.validation.assert_reproduces)."""
     from system_ssp.neighbor import validation
 
+    if session.config.option.collectonly:
+        return  # nothing ran (pytest --co)
     ran = {item.nodeid.split("[")[0] for item in session.items}
     missing = []
     for number in validation.NUMBERS:

@@ -486,16 +486,19 @@ def _plot_estimation(plt, d, s, save, legend):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO)
-    ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged")
+    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO,
+                    help="the thesis' de-orbit case (default: %(default)s)")
+    ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged",
+                    help="orbit fidelity: averaged (years in seconds; default) or cowell (the full orbit)")
     ap.add_argument("--gnc", choices=list(GNC), default=DEFAULT_GNC,
                     help="guidance and control: closed-loop (burn attitude from the orbit, thrust along the body "
                          "axis, flight settle criteria, controllers on the attitude estimator; default), "
                          "closed-loop-truth (the same on the true state) or thesis (the thesis' laws on the true "
                          "state, and its numbers)")
-    ap.add_argument("--out", default="results/mission")
-    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
-    ap.add_argument("--max-years", type=float, default=40.0)
+    ap.add_argument("--out", default="results/mission", help="results folder (default: %(default)s)")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR), help="folder of the built systems")
+    ap.add_argument("--max-years", type=float, default=40.0,
+                    help="the longest the mission may run before re-entry (default: %(default)s years)")
     ap.add_argument("--profile", action="store_true", help="print the wall time per component")
     ap.add_argument("--timeseries", choices=TIMESERIES_FORMATS, default="parquet",
                     help="format of the recorded signals: parquet (default; units in the file; "
