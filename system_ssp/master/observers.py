@@ -214,7 +214,7 @@ class ProgressBar(Observer):
         bar = self.bar
         if bar is None or info.steps % self.chunk:
             return
-        if info.mode_changed or info.mode != self.mode:
+        if info.mode != self.mode:  # the scheduled algorithm names the next step's mode
             self.mode, self.mode_t0 = info.mode, info.t
         now = time.perf_counter()
         if now - self.posted >= 0.5:
