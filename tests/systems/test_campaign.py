@@ -158,3 +158,53 @@ def test_cli_exit_codes_say_how_the_campaign_went(ssp_paths, tmp_path, capsys):
     assert "below campaign.min_success 0.99" in capsys.readouterr().err
     assert main(["campaign", str(strict), "--out", str(tmp_path / "strict"), "--workers", "1"]) == 1
     assert "6 of 6 runs already recorded there are kept, 0 to run" in capsys.readouterr().err
+
+
+DEORBIT = """
+[campaign]
+system = "{system}"
+parameter_sets = ["parameters/deorbit_lifetime_420km.ssv"]
+runs = 3
+seed = 11
+stop_time = 2592000.0
+keep_timeseries = ["orbit.altitude"]
+[dispersions."orbit.Cd"]
+distribution = "uniform"
+low = 2.0
+high = 2.4
+[metrics]
+burn_s = "duration:burn"
+coast_s = "duration:coast"
+burning_s = "time_in:propulsion.burning"
+sma = "final:orbit.sma"
+"""
+
+
+def test_durations_units_kept_series_and_rerun(ssp_paths, tmp_path, capsys):
+    """Metrics of time spent (in a schedule mode, or with a signal true) with their units; each
+    run's series kept and drawn as envelopes in the report; `--rerun N` gives run N again."""
+    from system_ssp.cli import main
+
+    spec = _spec(tmp_path, DEORBIT.format(system=ssp_paths["deorbit_lifetime"]))
+    s = run_campaign(spec, tmp_path / "out", workers=1)
+    assert s["ok"] == 3
+    rows = _rows(tmp_path / "out")
+    for r in rows:
+        assert r["burn_s"] == pytest.approx(38.74 * 60.0, abs=60.0)  # the thesis' 38.74 min burn
+        assert r["burn_s"] + r["coast_s"] == pytest.approx(2592000.0)
+        assert abs(r["burning_s"] - r["burn_s"]) <= 30.0  # rows every 30 s in the burn
+    assert s["metrics"]["sma"]["unit"] == "m" and s["metrics"]["burn_s"]["unit"] == "s"
+    kept = sorted(p.name for p in (tmp_path / "out" / "series").iterdir())
+    assert kept == [f"run-{i:06d}.parquet" for i in range(3)]
+    report = (tmp_path / "out" / "report.html").read_text()
+    assert "Envelopes over the runs" in report and "orbit.altitude p95" in report
+    capsys.readouterr()
+    assert main(["campaign", str(spec.path), "--out", str(tmp_path / "out"), "--rerun", "1"]) == 0
+    out = capsys.readouterr().out
+    assert f"sma = {rows[1]['sma']!r}" in out and f"burn_s = {rows[1]['burn_s']!r}" in out
+    assert (tmp_path / "out" / "rerun" / "run-000001.parquet").is_file()
+    bad = tmp_path / "bad.toml"
+    bad.write_text(DEORBIT.format(system=ssp_paths["deorbit_lifetime"]).replace("duration:burn", "duration:burnn"))
+    assert main(["campaign", str(bad), "--out", str(tmp_path / "bad")]) == 2
+    assert "metrics.burn_s: duration:burnn: the system has no nc:Schedule mode 'burnn' (did you mean 'burn'" in \
+        capsys.readouterr().err

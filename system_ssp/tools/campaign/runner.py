@@ -36,12 +36,15 @@ from ...atomic import atomic_write, write_text_atomic
 from ...errors import SSPError
 from ...master import System, report
 from ...master.plan import RunOptions
+from ...master.names import near, split_name
 from ...master.planning import make_plan
+from ...master.plotting import read_result
 from ..console import add_console_arguments, console_settings
 from .spec import load_spec
-from .worker import run_batch
+from .worker import run_batch, run_one
 
 FLUSH_SECONDS = 2.0
+SERIES = "series"  # keep_timeseries: <out>/series/run-<i>.parquet
 
 
 def _read_rows(out):
@@ -75,6 +78,8 @@ def _prepare_folder(spec, out):
         raise SSPError(f"--out {out}: exists and is not a folder")
     try:
         (out / "runs").mkdir(parents=True, exist_ok=True)
+        if spec.keep_timeseries:
+            (out / SERIES).mkdir(exist_ok=True)
     except OSError as exc:
         raise SSPError(f"--out {out}: cannot create it ({exc.strerror or exc})") from None
     stored = out / "spec.toml"
@@ -123,10 +128,18 @@ def _spec_key(spec, name):
 
 def check_against_system(spec):
     """Every name and value of the spec checked against its system before the first run: the
-    master plans run 0 of every sweep point (parameters, parameter sets, the metrics' signals)
-    as it would run it. SSPError naming the spec file, the key and the closest names."""
-    record = tuple(sorted({m.variable for m in spec.metrics if m.variable}))
+    master plans run 0 of every sweep point (parameters, parameter sets, the metrics' and the kept
+    signals) as it would run it; schedule modes of duration metrics. SSPError naming the spec
+    file, the key and the closest names. Returns {metric: unit or None}."""
+    record = spec.recorded()
     with System(spec.system) as system:
+        schedule = system.desc.master.schedule
+        mode_names = [m.name for m in schedule.modes] if schedule is not None else []
+        for m in spec.metrics:
+            if m.kind == "duration" and m.mode not in mode_names:
+                raise SSPError(f"{spec.path}: metrics.{m.name}: duration:{m.mode}: "
+                               + (f"the system has no nc:Schedule mode {m.mode!r}{near(m.mode, mode_names)} (modes: "
+                                  f"{', '.join(mode_names)})" if mode_names else "the system has no nc:Schedule"))
         for point in range(len(spec.points)):
             _, values = spec.inputs(point * spec.runs)
             options = RunOptions(stop_time=spec.stop_time, step_size=spec.step_size,
@@ -138,6 +151,14 @@ def check_against_system(spec):
                 named = re.search(r"'([^']+)'", str(exc))
                 key = _spec_key(spec, named.group(1)) if named else None
                 raise SSPError(f"{spec.path}: {key + ': ' if key else ''}{exc}") from None
+        units = {}
+        for m in spec.metrics:
+            if m.kind in ("final", "min", "max"):
+                comp, var = split_name(system.comps, m.variable)
+                units[m.name] = system.var_unit(comp, var)
+            elif m.kind in ("stop_time", "time_when", "time_in", "duration"):
+                units[m.name] = "s"
+    return units
 
 
 def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=1):
@@ -150,7 +171,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
 
     if not hasattr(spec, "inputs"):
         spec = load_spec(spec)
-    check_against_system(spec)  # before the folder is touched and before any run
+    units = check_against_system(spec)  # before the folder is touched and before any run
     out = _prepare_folder(spec, out)
     columns = _columns(spec)
     done = {r["run"] for r in _read_rows(out)}
@@ -168,23 +189,24 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
                 cluster.close()
     rows = sorted(_read_rows(out), key=lambda r: r["run"])
     _write_rows(out / "runs.parquet", rows, columns)
-    summary = summarize(spec, rows)
+    summary = summarize(spec, rows, units)
     summary["resumed_from"] = len(done)
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, default=_json) + "\n")
     figures(spec, rows, out / "figures")
-    write_text_atomic(out / "report.html", campaign_report(spec, rows, summary))
+    write_text_atomic(out / "report.html", campaign_report(spec, rows, summary, out / SERIES))
     return summary
 
 
-def campaign_report(spec, rows, s):
+def campaign_report(spec, rows, s, series_dir=None):
     """report.html of a campaign: the summary table, the metrics' distributions (interactive),
     the commonest errors, the spec and the versions; one file."""
     ok = [r for r in rows if r["status"] == "ok"]
-    stats = [(name, m["n"], *(f"{m[k]:.6g}" for k in ("mean", "std", "min", "p5", "p50", "p95", "max")))
+    stats = [(name, m.get("unit") or "", m["n"], *(f"{m[k]:.6g}" for k in ("mean", "std", "min", "p5", "p50", "p95",
+                                                                             "max")))
              for name, m in s["metrics"].items() if "mean" in m]
     summary = [f"<p>{s['runs']} runs: {s['ok']} ok, {s['failed']} failed, {s['timeout']} timed out (success rate "
                f"{100 * s['success_rate']:.1f} %)</p>",
-               report.table(("metric", "n", "mean", "std", "min", "p5", "p50", "p95", "max"), stats)]
+               report.table(("metric", "unit", "n", "mean", "std", "min", "p5", "p50", "p95", "max"), stats)]
     if s["probabilities"]:
         summary.append(report.table(("probability", "condition", "p", "95 % interval", "runs"), [
             (name, p["condition"], f"{p['p']:.3f}", f"[{p['ci95'][0]:.3f}, {p['ci95'][1]:.3f}]", f"{p['k']}/{p['n']}")
@@ -194,7 +216,12 @@ def campaign_report(spec, rows, s):
                         and math.isfinite(float(r[m.name]))] for m in spec.metrics}
     numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
     if numeric:
-        sections.append(("Distributions over the successful runs", report.histograms(numeric)))
+        units = {name: m.get("unit") for name, m in s["metrics"].items()}
+        sections.append(("Distributions over the successful runs", report.histograms(numeric, units)))
+    if spec.keep_timeseries and series_dir is not None:
+        kept = envelopes(spec, ok, series_dir)
+        if kept:
+            sections.append(("Envelopes over the runs (5th to 95th percentile, median)", kept))
     if s.get("errors"):
         sections.append(("Commonest errors", report.table(("runs", "error"),
                                                           [(e["runs"], e["error"]) for e in s["errors"]])))
@@ -203,14 +230,38 @@ def campaign_report(spec, rows, s):
     return report.page(f"campaign {spec.path.name}: {s['runs']} runs of {spec.system.name}", sections)
 
 
+def envelopes(spec, ok, series_dir, points=500):
+    """Percentile bands of each kept signal over the successful runs' series, on a common time grid
+    (a run that ended earlier stops contributing where it ended)."""
+    series = [read_result(p) for p in (Path(series_dir) / f"run-{r['run']:06d}.parquet" for r in ok) if p.is_file()]
+    signals = list(spec.keep_signals) or [v for v in spec.recorded()]
+    if not series or not signals:
+        return ""
+    end = max(float(c["time"][-1]) for c, _ in series)
+    grid = np.linspace(0.0, end, points)
+    columns, units = {"time": grid}, dict(series[0][1])
+    for name in signals:
+        curves = np.full((len(series), points), np.nan)
+        for k, (c, _) in enumerate(series):
+            t = np.asarray(c["time"], dtype=float)
+            inside = grid <= t[-1]
+            curves[k, inside] = np.interp(grid[inside], t, np.asarray(c[name], dtype=float))
+        for q in (5, 50, 95):
+            columns[f"{name} p{q}"] = np.nanpercentile(curves, q, axis=0)
+            units[f"{name} p{q}"] = units.get(name)
+    return report.figure(columns, units, [n for n in columns if n != "time"])
+
+
 def _run(client, spec, out, todo, columns, progress, as_completed, batch=1):
     """Submit the runs `todo` in tasks of `batch` runs, write their rows as they come. A task
     whose worker died is split: each of its runs is submitted alone, and a run that kills a
     worker alone too is a failed row."""
+    series_dir = str(out / SERIES) if spec.keep_timeseries else None
+
     def submit(runs):
         # the spec goes with each task (a few kB): scattered once, it would be lost with a worker
         # that an FMU crashed, and the retries that need it with it
-        return client.submit(run_batch, spec, runs, pure=False, key=f"runs-{runs[0]}-{time.time_ns()}")
+        return client.submit(run_batch, spec, runs, series_dir, pure=False, key=f"runs-{runs[0]}-{time.time_ns()}")
 
     futures = {submit(todo[k:k + batch]): tuple(todo[k:k + batch]) for k in range(0, len(todo), batch)}
     buffer, last = [], time.monotonic()
@@ -278,8 +329,8 @@ def wilson(k, n, z=1.959963984540054):
     return (max(0.0, c - h), min(1.0, c + h))
 
 
-def summarize(spec, rows):
-    """Success rate, per-metric statistics over the successful runs, probabilities."""
+def summarize(spec, rows, units=None):
+    """Success rate, per-metric statistics over the successful runs (with their unit), probabilities."""
     ok = [r for r in rows if r["status"] == "ok"]
     s = {"campaign": str(spec.path), "system": str(spec.system), "runs": len(rows), "ok": len(ok),
          "failed": sum(r["status"] == "failed" for r in rows), "timeout": sum(r["status"] == "timeout" for r in rows),
@@ -289,7 +340,8 @@ def summarize(spec, rows):
         vals = vals[np.isfinite(vals)] if vals.size else vals
         if vals.size:
             p5, p50, p95 = np.percentile(vals, [5, 50, 95])
-            s["metrics"][m.name] = {"n": int(vals.size), "mean": float(vals.mean()), "std": float(vals.std()),
+            s["metrics"][m.name] = {"unit": (units or {}).get(m.name), "n": int(vals.size),
+                                    "mean": float(vals.mean()), "std": float(vals.std()),
                                     "min": float(vals.min()), "p5": float(p5), "p50": float(p50), "p95": float(p95),
                                     "max": float(vals.max())}
         else:
@@ -313,7 +365,8 @@ def table(s):
              f"(success rate {100 * s['success_rate']:.1f} %)"]
     for name, m in s["metrics"].items():
         if "mean" in m:
-            lines.append(f"  {name:<24} mean {m['mean']:<12.6g} std {m['std']:<11.4g} p5 {m['p5']:<11.6g} "
+            unit = f" ({m['unit']})" if m.get("unit") else ""
+            lines.append(f"  {name + unit:<24} mean {m['mean']:<12.6g} std {m['std']:<11.4g} p5 {m['p5']:<11.6g} "
                          f"p50 {m['p50']:<11.6g} p95 {m['p95']:.6g}")
         else:
             lines.append(f"  {name:<24} {', '.join(m['values'])}")
@@ -388,6 +441,24 @@ def _save(fig, path):
     plt.close(fig)
 
 
+def rerun(spec, index, out):
+    """Run `index` of the campaign alone in this process: the same seed and values (they depend
+    on the spec and the index only), its row printed, its series written."""
+    if not 0 <= index < spec.total_runs:
+        raise SSPError(f"--rerun {index}: the campaign has runs 0 to {spec.total_runs - 1}")
+    check_against_system(spec)
+    folder = out / "rerun"
+    folder.mkdir(parents=True, exist_ok=True)
+    row = run_one(spec, index, str(folder))
+    for key, value in row.items():
+        print(f"  {key} = {value!r}")
+    if row["status"] != "ok":
+        print(f"run {index} {row['status']}: {row['error']}", file=sys.stderr)
+        return 1
+    print(f"series: {folder / f'run-{index:06d}.parquet'}")
+    return 0
+
+
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim campaign", description="Run a parameter sweep or Monte Carlo "
                                  "campaign on Dask (see docs/campaigns.md).")
@@ -397,12 +468,17 @@ def main(argv=None):
     ap.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786) instead")
     ap.add_argument("--batch", type=int, default=1,
                     help="runs per Dask task (default 1; more for runs shorter than a second)")
+    ap.add_argument("--rerun", type=int, metavar="N",
+                    help="run N alone, here, with the values it had in the campaign; its recorded signals (the "
+                         "metrics' and keep_timeseries') go to DIR/rerun/run-N.parquet")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
     if args.workers is not None and args.workers < 1:
         raise SSPError(f"--workers {args.workers}: expected a number >= 1")
     spec = load_spec(args.spec)
+    if args.rerun is not None:
+        return rerun(spec, args.rerun, Path(args.out))
     print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {args.out}", file=sys.stderr)
     s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
     print(table(s))

@@ -23,11 +23,13 @@ else:  # pragma: no cover - Python 3.10
 DISTRIBUTIONS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
                  "truncnormal": ("mean", "std", "low", "high"), "choice": ("values",),
                  "integers": ("low", "high")}  # integers: low..high inclusive (e.g. a sensor's noise seed)
-METRIC_KINDS = ("stop_time", "stop_reason", "steps", "final", "min", "max", "time_when")
+METRIC_KINDS = ("stop_time", "stop_reason", "steps", "final", "min", "max", "time_when", "time_in", "duration")
+SIGNAL_METRICS = ("final", "min", "max", "time_when", "time_in")  # kind:comp.var
 HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f107_scale and points the "
                              "orbit's space_weather_file at the scaled copy"}
 PROBABILITY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>|==)\s*([-+0-9.eE]+|true|false)\s*$")
 CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_size", "timeout_s", "helper",
+                 "keep_timeseries",
                  "min_success",
                  "description"}
 TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities"}
@@ -63,7 +65,8 @@ class Metric:
     name: str
     kind: str
     variable: Optional[str] = None
-    equals: Optional[float] = None  # time_when:comp.var==value: the first time the signal equals it
+    equals: Optional[float] = None  # time_when/time_in:comp.var==value: the signal equal to it (else true)
+    mode: Optional[str] = None  # duration:mode: the simulated time the run spent in this nc:Schedule mode
 
 
 @dataclass
@@ -77,6 +80,8 @@ class CampaignSpec:
     step_size: Optional[float] = None
     timeout_s: Optional[float] = None
     min_success: Optional[float] = None  # the campaign fails (exit 1) below this success rate
+    keep_timeseries: bool = False  # store each run's recorded signals (series/run-<i>.parquet)
+    keep_signals: tuple = ()  # recorded (and kept) besides the metrics' signals
     helper: Optional[str] = None
     description: str = ""
     parameters: dict = field(default_factory=dict)
@@ -107,6 +112,10 @@ class CampaignSpec:
         for d in self.dispersions:
             values[d.name] = d.draw(rng)
         return int(ss.generate_state(1)[0]), values
+
+    def recorded(self):
+        """The signals each run records: the metrics' and, with keep_timeseries, the kept ones."""
+        return tuple(sorted({m.variable for m in self.metrics if m.variable} | set(self.keep_signals)))
 
     def overrides(self, values):
         """The system parameters for a run's drawn values: fixed parameters, then the values (and
@@ -208,6 +217,14 @@ def _campaign_table(path, c, text):
         spec.step_size = _number(path, "campaign.step_size", c["step_size"], positive=True)
     if c.get("timeout_s") is not None:
         spec.timeout_s = _number(path, "campaign.timeout_s", c["timeout_s"], positive=True)
+    keep = c.get("keep_timeseries", False)
+    if isinstance(keep, list) and keep and all(isinstance(k, str) for k in keep):
+        spec.keep_timeseries, spec.keep_signals = True, tuple(keep)
+    elif isinstance(keep, bool):
+        spec.keep_timeseries = keep
+    else:
+        raise SSPError(f"{path}: campaign.keep_timeseries = {keep!r}: expected true (the metrics' signals) or a "
+                       "list of component.variable names (recorded besides them)")
     if c.get("min_success") is not None:
         spec.min_success = _number(path, "campaign.min_success", c["min_success"], low=0)
         if spec.min_success > 1:
@@ -257,17 +274,21 @@ def _metric(path, name, m):
         raise SSPError(f"{path}: metrics.{name} = {m!r}: expected a string")
     kind, _, var = m.partition(":")
     equals = None
-    if kind == "time_when" and "==" in var:
+    if kind in ("time_when", "time_in") and "==" in var:
         var, _, value = var.partition("==")
         var = var.strip()
         try:
             equals = float(value)
         except ValueError:
             var = ""  # reported below
-    if kind not in METRIC_KINDS or (kind in ("final", "min", "max", "time_when")) != bool(var):
-        raise SSPError(f"{path}: metrics.{name} = {m!r}: expected \"stop_time\", \"stop_reason\", \"steps\" or "
+    if kind not in METRIC_KINDS or (kind in SIGNAL_METRICS or kind == "duration") != bool(var):
+        raise SSPError(f"{path}: metrics.{name} = {m!r}: expected \"stop_time\", \"stop_reason\", \"steps\", "
                        "\"final:comp.var\", \"min:comp.var\", \"max:comp.var\", \"time_when:comp.var\" (first time "
-                       "true) or \"time_when:comp.var==number\" (first time equal)")
+                       "true), \"time_when:comp.var==number\" (first time equal), \"time_in:comp.var\" or "
+                       "\"time_in:comp.var==number\" (simulated time true or equal) or \"duration:mode\" (simulated "
+                       "time in an nc:Schedule mode)")
+    if kind == "duration":
+        return Metric(name, kind, mode=var)
     return Metric(name, kind, var or None, equals)
 
 

@@ -3,6 +3,7 @@ and reused by every run the worker gets (no per-run extraction, schema check or 
 the run's values come from the spec and its index alone; any failure becomes a row."""
 import math
 import os
+from pathlib import Path
 import tempfile
 import time
 from typing import Dict
@@ -12,7 +13,7 @@ import numpy as np
 from components.environment import space_weather
 
 from ...errors import RunTimedOut, SSPError
-from ...master import System
+from ...master import System, write_result
 
 _SYSTEMS: Dict[str, System] = {}  # system path -> System, for the life of this process
 
@@ -53,14 +54,21 @@ def metric_values(spec, result):
         elif m.kind in ("min", "max"):
             col = data[m.variable].astype(float)
             out[m.name] = float(col.min() if m.kind == "min" else col.max())
-        else:  # time_when: the first recorded time the signal is true (non-zero) or equals m.equals; NaN if never
+        elif m.kind == "duration":  # simulated time in a schedule mode (0 if never in it; NaN: no schedule)
+            modes = result.modes
+            out[m.name] = math.nan if modes is None else float(modes.get(m.mode, {}).get("simulated_time", 0.0))
+        else:
             col = data[m.variable]
-            hit = np.flatnonzero(col != 0 if m.equals is None else col == m.equals)
-            out[m.name] = float(data["time"][hit[0]]) if len(hit) else math.nan
+            hold = col != 0 if m.equals is None else col == m.equals
+            if m.kind == "time_in":  # each recorded row holds until the next: the time true (or equal)
+                out[m.name] = float(np.sum(np.diff(data["time"])[hold[:-1]]))
+            else:  # time_when: the first recorded time the signal is true or equal; NaN if never
+                hit = np.flatnonzero(hold)
+                out[m.name] = float(data["time"][hit[0]]) if len(hit) else math.nan
     return out
 
 
-def run_one(spec, index):
+def run_one(spec, index, series_dir=None):
     """The result row of run `index`: run, seed, the swept and dispersed values (one column each),
     every metric, status ("ok", "failed", "timeout"), error, wall_s."""
     seed, values = spec.inputs(index)
@@ -76,12 +84,14 @@ def run_one(spec, index):
         if spec.helper is not None:
             extra, cleanup = HELPERS[spec.helper](values, tempfile.gettempdir())
             params.update(extra)
-        record = sorted({m.variable for m in spec.metrics if m.variable})
+        record = list(spec.recorded())
         result = system.run(stop_time=spec.stop_time, step_size=spec.step_size, parameter_sets=spec.parameter_sets,
                             parameters=params,
                             outputs=record, timeout=spec.timeout_s)
         row.update(metric_values(spec, result))
         row.update(status="ok", error="")
+        if series_dir is not None:  # keep_timeseries, or a rerun
+            write_result(result.data, Path(series_dir) / f"run-{index:06d}.parquet", result.units)
     except RunTimedOut as exc:
         row.update(status="timeout", error=str(exc))
     except SSPError as exc:
@@ -98,6 +108,6 @@ def run_one(spec, index):
     return row
 
 
-def run_batch(spec, runs):
+def run_batch(spec, runs, series_dir=None):
     """The rows of several runs, one after another in this worker (one Dask task)."""
-    return [run_one(spec, i) for i in runs]
+    return [run_one(spec, i, series_dir) for i in runs]
