@@ -208,3 +208,18 @@ def test_durations_units_kept_series_and_rerun(ssp_paths, tmp_path, capsys):
     assert main(["campaign", str(bad), "--out", str(tmp_path / "bad")]) == 2
     assert "metrics.burn_s: duration:burnn: the system has no nc:Schedule mode 'burnn' (did you mean 'burn'" in \
         capsys.readouterr().err
+
+
+def test_a_vector_dispersion_in_one_table(ssp_paths, tmp_path):
+    """`elements = n`: name[1]..name[n] each drawn on its own (a column each), checked against the
+    system like any other name."""
+    text = DETUMBLE.format(system=ssp_paths["detumble"], runs=2).replace(
+        '[dispersions."dynamics.omega0[1]"]', '[dispersions."detumble.Kd"]\nelements = 3')
+    spec = _spec(tmp_path, text)
+    assert [d.name for d in spec.dispersions][:3] == [f"detumble.Kd[{i}]" for i in (1, 2, 3)]
+    _, values = spec.inputs(0)
+    assert len({values[f"detumble.Kd[{i}]"] for i in (1, 2, 3)}) == 3  # three draws
+    assert run_campaign(spec, tmp_path / "out", workers=1)["runs"] == 4
+    bad = _spec(tmp_path, text.replace('[dispersions."detumble.Kd"]', '[dispersions."detumble.Kdd"]'), "bad.toml")
+    with pytest.raises(SSPError, match=r"dispersions.detumble.Kdd\[1\]: parameter 'detumble.Kdd\[1\]'"):
+        run_campaign(bad, tmp_path / "bad", workers=1)

@@ -164,7 +164,7 @@ def load_spec(path):
         raise SSPError(f"{path}: [parameters] holds component.variable = value pairs")
     spec.parameters = dict(params)
     for name, d in doc.get("dispersions", {}).items():
-        spec.dispersions.append(_dispersion(path, name, d, spec.helper))
+        spec.dispersions.extend(_dispersions(path, name, d, spec.helper))
     for name, s in doc.get("sweep", {}).items():
         key = f"sweep.{name!r}"
         if not isinstance(s, dict) or set(s) != {"values"} or not isinstance(s["values"], list) or not s["values"]:
@@ -235,6 +235,19 @@ def _campaign_table(path, c, text):
         spec.helper = c["helper"]
     spec.description = str(c.get("description", ""))
     return spec
+
+
+def _dispersions(path, name, d, helper):
+    """One dispersion, or with `elements = n` one per element name[1]..name[n] of a vector
+    parameter, each drawn on its own from the same distribution (in element order)."""
+    if not isinstance(d, dict) or "elements" not in d:
+        return [_dispersion(path, name, d, helper)]
+    n = _number(path, f"dispersions.{name!r}.elements", d["elements"], integer=True, positive=True)
+    if "[" in name or d.get("also"):
+        raise SSPError(f"{path}: [dispersions.{name!r}]: elements = {n} names a vector parameter without an index "
+                       "and takes no `also`")
+    rest = {k: v for k, v in d.items() if k != "elements"}
+    return [_dispersion(path, f"{name}[{i}]", rest, helper) for i in range(1, n + 1)]
 
 
 def _dispersion(path, name, d, helper):
