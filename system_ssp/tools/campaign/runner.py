@@ -44,6 +44,8 @@ from .spec import load_spec
 from .worker import run_batch, run_one
 
 FLUSH_SECONDS = 2.0
+SCATTER_INPUTS = 6  # inputs drawn against each metric in scatter.png
+TIME_UNITS = (("yr", 365.25 * 86400.0), ("d", 86400.0), ("h", 3600.0), ("min", 60.0), ("s", 1.0))
 SERIES = "series"  # keep_timeseries: <out>/series/run-<i>.parquet
 
 
@@ -192,7 +194,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     summary = summarize(spec, rows, units)
     summary["resumed_from"] = len(done)
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, default=_json) + "\n")
-    figures(spec, rows, out / "figures")
+    figures(spec, rows, out / "figures", units)
     write_text_atomic(out / "report.html", campaign_report(spec, rows, summary, out / SERIES))
     return summary
 
@@ -388,44 +390,94 @@ def failed_campaign(s):
     return None
 
 
-def figures(spec, rows, folder):
-    """A histogram per numeric metric that varies and a scatter of each input against each."""
+def figures(spec, rows, folder, units=None):
+    """A histogram per numeric metric that varies, with the probabilities' thresholds; a scatter of
+    each metric against the inputs that vary, at most SCATTER_INPUTS per metric (those most
+    correlated with it: a campaign of 32 noise seeds would otherwise draw hundreds of panels)."""
     import matplotlib
 
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
+    from matplotlib.ticker import MaxNLocator
 
+    units = units or {}
     ok = [r for r in rows if r["status"] == "ok"]
     metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) for r in ok)]
     inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
-    inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)]
+    inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)
+              and len({float(r[n]) for r in ok}) > 1]
     # a metric that is the same in every run (a budget always spent) has nothing to show
     metrics = [m for m in metrics if len({float(r[m]) for r in ok if math.isfinite(float(r[m]))}) > 1]
     if not metrics:
         return
+    thresholds = {}
+    for name, metric, op, value in spec.probabilities:
+        thresholds.setdefault(metric, []).append((float(value), f"{name}: {metric} {op} {value:g}"))
+
+    scale = {}  # times in the unit that reads best for the values (a lifetime in years, not 1e8 s)
+    for name in metrics:
+        unit = units.get(name)
+        if unit == "s":
+            span = max(abs(float(r[name])) for r in ok if math.isfinite(float(r[name])))
+            unit, factor = next((u, f) for u, f in TIME_UNITS if span >= 2 * f or u == "s")
+            scale[name] = (factor, unit)
+        else:
+            scale[name] = (1.0, unit)
+
+    def label(name):
+        unit = scale[name][1] if name in scale else units.get(name)
+        return f"{name} ({unit})" if unit else name
+
+    def value(r, name):
+        return float(r[name]) / scale.get(name, (1.0, None))[0]
+
     folder.mkdir(exist_ok=True)
     for name in metrics:
-        vals = [float(r[name]) for r in ok if math.isfinite(float(r[name]))]
+        vals = [value(r, name) for r in ok if math.isfinite(float(r[name]))]
         if not vals:
             continue
         fig, ax = plt.subplots(figsize=(6, 4))
         ax.hist(vals, bins=min(40, max(5, len(vals) // 5)), color="tab:blue")
-        ax.set_xlabel(name)
+        for limit, text in thresholds.get(name, []):
+            ax.axvline(limit / scale[name][0], color="tab:red", linestyle="--", linewidth=1, label=text)
+        if name in thresholds:
+            ax.legend(fontsize=8)
+        ax.yaxis.set_major_locator(MaxNLocator(integer=True))  # counts
+        ax.ticklabel_format(axis="x", useOffset=False)
+        ax.set_xlabel(label(name))
         ax.set_ylabel("runs")
         ax.set_title(f"{name}: {len(ok)} successful runs")
         ax.grid(alpha=0.3)
         _save(fig, folder / f"hist_{_safe(name)}.png")
-    if inputs:
-        fig, axes = plt.subplots(len(metrics), len(inputs), figsize=(3.2 * len(inputs), 2.8 * len(metrics)),
-                                 squeeze=False)
-        for a, m in enumerate(metrics):
-            for b, x in enumerate(inputs):
-                ax = axes[a][b]
-                ax.scatter([r[x] for r in ok], [r[m] for r in ok], s=8)
-                ax.set_xlabel(x)
-                ax.set_ylabel(m)
-                ax.grid(alpha=0.3)
-        _save(fig, folder / "scatter.png")
+    if not inputs:
+        return
+    panels = {}
+    for m in metrics:
+        y = np.array([float(r[m]) for r in ok])
+        score = []
+        for x_name in inputs:
+            x = np.array([float(r[x_name]) for r in ok])
+            good = np.isfinite(x) & np.isfinite(y)
+            c = np.corrcoef(x[good], y[good])[0, 1] if good.sum() > 2 and np.std(x[good]) and np.std(y[good]) else 0.0
+            score.append(abs(c) if math.isfinite(c) else 0.0)
+        panels[m] = [inputs[k] for k in np.argsort(score)[::-1][:SCATTER_INPUTS]]
+    cols = max(len(v) for v in panels.values())
+    fig, axes = plt.subplots(len(metrics), cols, figsize=(3.2 * cols, 2.8 * len(metrics)), squeeze=False)
+    for a, m in enumerate(metrics):
+        for b in range(cols):
+            ax = axes[a][b]
+            if b >= len(panels[m]):
+                ax.set_visible(False)
+                continue
+            x = panels[m][b]
+            ax.scatter([r[x] for r in ok], [value(r, m) for r in ok], s=8)
+            for limit, _ in thresholds.get(m, []):
+                ax.axhline(limit / scale[m][0], color="tab:red", linestyle="--", linewidth=1)
+            ax.ticklabel_format(useOffset=False)
+            ax.set_xlabel(x, fontsize=8)
+            ax.set_ylabel(label(m), fontsize=8)
+            ax.grid(alpha=0.3)
+    _save(fig, folder / "scatter.png")
 
 
 def _safe(name):
