@@ -23,6 +23,8 @@ from pathlib import Path
 import sys
 import tempfile
 
+import numpy as np
+
 from components.environment import space_weather
 from components.orbit import propulsion
 from components.core import constants
@@ -31,7 +33,8 @@ from components.mission.neighbor import DEORBIT_RECORD, DEORBIT_SYSTEMS, SCENARI
 
 from ..atomic import atomic_write, write_text_atomic
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
-from ..master import System, write_result
+from ..master import System, report, write_result
+from ..master.plotting import read_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
 
@@ -76,6 +79,7 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
             write_text_atomic(staged.path / "summary.json", json.dumps(summary, indent=1))
             write_text_atomic(staged.path / "table.md", table(summary))
             plot(summary, staged.path)
+            write_text_atomic(staged.path / "report.html", report_html(summary, staged.path))
             staged.commit()
     return summary
 
@@ -146,7 +150,6 @@ REQUIREMENT_YEARS = 5.0  # the mission's goal: re-entry within five years of the
 
 def plot(summary, out):
     """altitude_<scenario>.png: a - R_eq (km) vs years since the burn, with and without NEIGHBOR."""
-    import numpy as np
     import matplotlib
 
     matplotlib.use("Agg")
@@ -188,6 +191,34 @@ def plot(summary, out):
         with atomic_write(out / f"altitude_{name}.png", "wb") as f:
             fig.savefig(f, dpi=110, format="png")
         plt.close(fig)
+
+
+def report_html(summary, folder):
+    """report.html of the study: its table beside the thesis, and per scenario the altitude with and
+    without NEIGHBOR as an interactive figure (the five-year requirement shaded), versions."""
+    sections = [("Lifetimes beside the thesis", report.markdown(table(summary), far_beyond=None))]
+    for name in THESIS:
+        if name not in summary:
+            continue
+        columns, units = {}, {}
+        runs = [(name, "with NEIGHBOR"), (name + "_no_burn", "without NEIGHBOR")]
+        for run, label in runs:
+            data, data_units = read_result(folder / f"{run}.csv")
+            columns[f"time {label}"] = data["time"]
+            columns[f"a - R_eq, {label}"] = (data["orbit.sma"] - constants.R_EQ) / KM
+            units[f"a - R_eq, {label}"] = "km"
+        # one time axis: each run on the longer run's times (NaN past its re-entry)
+        t = max((columns[f"time {label}"] for _, label in runs), key=len)
+        figure_columns = {"time": t}
+        for _, label in runs:
+            own = columns[f"time {label}"]
+            y = np.interp(t, own, columns[f"a - R_eq, {label}"], right=np.nan)
+            figure_columns[f"a - R_eq, {label}"] = y
+        sections.append((f"{name}: orbital lifetime (thesis Fig. {THESIS[name]['figure']})", report.figure(
+            figure_columns, units, [n for n in figure_columns if n != "time"],
+            bands=[(0.0, REQUIREMENT_YEARS * YEAR, f"re-entry required within {REQUIREMENT_YEARS:g} years")])))
+    sections.append(("Versions", report.table(("software", "version"), list(report.versions().items()))))
+    return report.page("NEIGHBOR de-orbit lifetime study", sections)
 
 
 def main(argv=None):

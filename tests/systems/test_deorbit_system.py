@@ -5,6 +5,8 @@ import math
 import numpy as np
 import pytest
 
+from browser import open_page
+
 from components.orbit import propulsion
 import system_ssp
 from system_ssp import SimulationError, SSPError
@@ -75,6 +77,8 @@ def test_thesis_compliance_conclusions_with_jacchia_roberts(tmp_path):
         assert (tmp_path / f"altitude_{name}.png").stat().st_size > 10000
     assert "| 420km | 19.84 (19.84) | 0.564 (0.564) | 38.74 (38.74) |" in (tmp_path / "table.md").read_text()
     assert "(4.38; " in (tmp_path / "table.md").read_text()  # the relative difference beside the thesis' value
+    dom, console = open_page(tmp_path / "report.html")  # the study's report, drawn by a real browser
+    assert console == [] and dom.count('class="main-svg"') >= 6 and "420km: orbital lifetime" in dom
 
 
 def test_lifetimes_with_the_thesis_space_weather_stand_in(tmp_path):
