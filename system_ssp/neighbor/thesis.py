@@ -97,10 +97,13 @@ def _initial(q, w, e):
     return out
 
 
-def _case(name, system, integrator, stop_time, parameters=None):
+def _case(name, system, integrator, stop_time, parameters=None, progress=False):
     params = {"dynamics.integrator": integrator}
     params.update(parameters or {})
-    result = system.run(parameter_sets=[f"parameters/{name}.ssv"], parameters=params, stop_time=stop_time)
+    if progress:  # which case runs: the run's own bar shows its simulated time once it lasts a second
+        print(f"thesis: {name}", file=sys.stderr, flush=True)
+    result = system.run(parameter_sets=[f"parameters/{name}.ssv"], parameters=params, stop_time=stop_time,
+                        progress=progress)
     q, w, e = end = _state(result)
     converged = result.stop_reason.startswith("stop condition")
     duration = result.stop_time - float(result.data["time"][0])
@@ -113,7 +116,7 @@ def _degrees(values):
     return tuple(math.degrees(x) for x in values)
 
 
-def slew_case3(slew, start, integrator="euler", stop_time=None):
+def slew_case3(slew, start, integrator="euler", stop_time=None, progress=False):
     """Appendix G: 180 deg about x, then y, then z; targets from the start attitude (Eq. 57-59)."""
     end = start
     target = start[0]
@@ -122,7 +125,7 @@ def slew_case3(slew, start, integrator="euler", stop_time=None):
         target = rotations.circle_cross(rotations.from_axis_angle(AXES[axis], math.pi), target)
         params = _initial(*end)
         params.update({f"slew.q_d[{i}]": v for i, v in enumerate(target, 1)})
-        part, end = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params)
+        part, end = _case(f"slew_case3_{axis}", slew, integrator, stop_time, params, progress)
         parts.append(part)
         if not part.converged:
             break
@@ -134,7 +137,7 @@ def slew_case3(slew, start, integrator="euler", stop_time=None):
     return total
 
 
-def run_cases(ssp_dir=DEFAULT_SSP_DIR, integrator="euler", slew_stop_time=None, cases=None):
+def run_cases(ssp_dir=DEFAULT_SSP_DIR, integrator="euler", slew_stop_time=None, cases=None, progress=False):
     """Run the thesis cases (all, or the names in `cases`); returns {name: CaseResult}."""
     ssp_dir = Path(ssp_dir)
     wanted = set(cases or ("detumble_case1", "detumble_case2", "slew_case1", "slew_case2", "slew_case3"))
@@ -143,14 +146,14 @@ def run_cases(ssp_dir=DEFAULT_SSP_DIR, integrator="euler", slew_stop_time=None, 
         ends = {}
         for k in (1, 2):
             if {f"detumble_case{k}", f"slew_case{k}"} & wanted or (k == 1 and "slew_case3" in wanted):
-                res, ends[k] = _case(f"detumble_case{k}", detumble, integrator, None)
+                res, ends[k] = _case(f"detumble_case{k}", detumble, integrator, None, progress=progress)
                 out[res.name] = res
         for k in (1, 2):
             if f"slew_case{k}" in wanted:
-                res, _ = _case(f"slew_case{k}", slew, integrator, slew_stop_time, _initial(*ends[k]))
+                res, _ = _case(f"slew_case{k}", slew, integrator, slew_stop_time, _initial(*ends[k]), progress)
                 out[res.name] = res
         if "slew_case3" in wanted:
-            total = slew_case3(slew, ends[1], integrator, slew_stop_time)
+            total = slew_case3(slew, ends[1], integrator, slew_stop_time, progress)
             for part in total.parts:
                 out[part.name] = part
             out["slew_case3"] = total
@@ -187,10 +190,10 @@ def main(argv=None):
                     help="folder of the built systems (default: %(default)s)")
     ap.add_argument("--slew-stop-time", type=float, default=None,
                     help="limit of each slew run in s (default: the SSD's 1500 s, Appendix G)")
-    add_console_arguments(ap, progress=False)
+    add_console_arguments(ap)
     args = ap.parse_args(argv)
-    console_settings(args)
-    results = run_cases(args.ssp_dir, args.integrator, args.slew_stop_time)
+    progress = console_settings(args)
+    results = run_cases(args.ssp_dir, args.integrator, args.slew_stop_time, progress=progress)
     print(report(results, args.integrator))
     unfinished = [name for name, r in results.items() if not r.converged and not r.parts]
     for name in unfinished:

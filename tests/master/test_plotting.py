@@ -94,8 +94,10 @@ def test_run_one_fmu_alone(fmu_paths, tmp_path, capsys):
 
 
 def test_thesis_says_which_case_did_not_finish(ssp_paths, capsys):
-    """`thesis` exits 1 naming each case that did not finish and why (it printed a bare "NO")."""
-    assert main(["thesis", "--ssp-dir", str(ssp_paths["slew"].parent), "--slew-stop-time", "1"]) == 1
+    """`thesis` says which case runs (--progress) and exits 1 naming each case that did not finish
+    and why (it printed a bare "NO")."""
+    assert main(["thesis", "--ssp-dir", str(ssp_paths["slew"].parent), "--slew-stop-time", "1", "--progress"]) == 1
     err = capsys.readouterr().err
+    assert "thesis: detumble_case1\n" in err and "thesis: slew_case3_x\n" in err  # progress: which case runs
     assert "slew_case1: did not finish: its stop condition was still false at t = 1 s, the run's limit" in err
     assert "detumble_case1" not in err  # the detumbles finish
