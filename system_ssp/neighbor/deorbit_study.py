@@ -223,16 +223,19 @@ def report_html(summary, folder):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim deorbit-study", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--model", choices=list(SYSTEMS), default="averaged")
+    ap.add_argument("--model", choices=list(SYSTEMS), default="averaged",
+                    help="orbit fidelity: averaged (default; seconds for a century) or cowell (the full orbit)")
     ap.add_argument("--density", default="jacchia_roberts",
                     help="exponential | harris_priester | msis | jacchia_roberts (default)")
     ap.add_argument("--space-weather", default="", metavar="FILE|thesis",
                     help="CSSI space-weather file (default: the bundled copy), or `thesis`: the stand-in for the "
                     "thesis' file (history to 2023, 130 sfu to 2030, then 75 sfu held; docs/models/orbit.md)")
     ap.add_argument("--scenarios", default=",".join(THESIS), help="comma-separated, e.g. 420km,475km")
-    ap.add_argument("--max-years", type=float, default=150.0)
-    ap.add_argument("--out", default="results/deorbit_study")
-    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--max-years", type=float, default=150.0,
+                    help="the longest a run may last before re-entry (default: %(default)s years)")
+    ap.add_argument("--out", default="results/deorbit_study", help="results folder (default: %(default)s)")
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),
+                    help="folder of the built systems (default: %(default)s)")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)

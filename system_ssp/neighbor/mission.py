@@ -532,13 +532,15 @@ def main_propulsion(argv=None):
     case and of a mission run, read from --mission or run here."""
     ap = argparse.ArgumentParser(prog="neighbor-cosim propulsion",
                                  description=propulsion_report.__doc__.split("\n\n")[0])
-    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO)
+    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO,
+                    help="the thesis' de-orbit case (default: %(default)s)")
     ap.add_argument("--mission", metavar="SUMMARY_JSON",
                     help="summary.json of a mission run of the scenario (default: run the mission now)")
     ap.add_argument("--gnc", choices=list(GNC), default="thesis",
                     help="guidance and control of the mission run here (default: thesis, whose numbers the "
                          "thesis' sizing used)")
-    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),
+                    help="folder of the built systems (default: %(default)s)")
     ap.add_argument("--json", metavar="FILE", help="also write both budgets as JSON")
     add_console_arguments(ap)
     args = ap.parse_args(argv)

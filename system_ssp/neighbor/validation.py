@@ -306,7 +306,8 @@ def write_markdown(path, ours):
 
 def main(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim validation", description=__doc__.split("\n\n")[0])
-    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR))
+    ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),
+                    help="folder of the built systems (default: %(default)s)")
     ap.add_argument("--markdown", metavar="FILE", help="rewrite the generated table block of this Markdown file")
     ap.add_argument("--json", metavar="FILE", help="also write {key: ours} as JSON")
     add_console_arguments(ap)

@@ -476,9 +476,9 @@ def main_replace(argv=None):
 def main_compare(argv=None):
     ap = argparse.ArgumentParser(prog="neighbor-cosim compare", description="The differences between two FMUs' "
                                  "interfaces (inputs, outputs, parameters: name, causality, type, unit).")
-    ap.add_argument("a")
-    ap.add_argument("b")
-    ap.add_argument("--json", action="store_true")
+    ap.add_argument("a", help="the first FMU (.fmu)")
+    ap.add_argument("b", help="the FMU to compare it with (.fmu)")
+    ap.add_argument("--json", action="store_true", help="the differences as JSON, for tools")
     args = ap.parse_args(argv)
     a, b = FmuInterface.read(args.a), FmuInterface.read(args.b)
     if args.json:

@@ -101,3 +101,29 @@ def test_thesis_says_which_case_did_not_finish(ssp_paths, capsys):
     assert "thesis: detumble_case1\n" in err and "thesis: slew_case3_x\n" in err  # progress: which case runs
     assert "slew_case1: did not finish: its stop condition was still false at t = 1 s, the run's limit" in err
     assert "detumble_case1: did not finish" not in err  # the detumbles finish
+
+
+COMMANDS = ("run", "info", "plot", "campaign", "thesis", "deorbit-study", "mission", "propulsion", "validation",
+            "replace", "compare", "flatten")
+
+
+def test_every_option_of_every_command_says_what_it_does(monkeypatch, capsys):
+    """Each argument of each subcommand has a help text (many had none)."""
+    import argparse
+
+    silent = []
+    original = argparse._ActionsContainer.add_argument
+
+    def recording(self, *args, **kwargs):
+        action = original(self, *args, **kwargs)
+        if action.help is None and not isinstance(action, (argparse._HelpAction, argparse._SubParsersAction,
+                                                           argparse._VersionAction)):
+            silent.append(f"{getattr(self, 'prog', '?')} {'/'.join(action.option_strings) or action.dest}")
+        return action
+
+    monkeypatch.setattr(argparse._ActionsContainer, "add_argument", recording)
+    for command in COMMANDS:
+        with pytest.raises(SystemExit):
+            main([command, "--help"])
+    capsys.readouterr()
+    assert silent == []
