@@ -228,7 +228,8 @@ def _run(args, path):
     print("final values:" if args.print_final else f"final values (first {len(shown)} of {len(items)}; "
           "--print-final for all):")
     for k, v in shown:
-        print(f"  {k} = {v!r}")
+        unit = result.units.get(k)
+        print(f"  {k} = {v!r}" + (f" {unit}" if unit and unit != "1" else ""))
     if args.plot:
         print(f"plot:        {result.plot(out=args.plot, title=args.path)}")
     if args.report:

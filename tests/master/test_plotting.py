@@ -2,6 +2,7 @@
 Parquet results (units read back), globs, the time axis in the unit that reads best, and bad
 input refused with the closest names before any work."""
 import json
+import re
 
 import matplotlib.image
 import numpy as np
@@ -83,6 +84,7 @@ def test_run_one_fmu_alone(fmu_paths, tmp_path, capsys):
                  str(tmp_path / "gyro.csv"), "--plot", str(tmp_path / "gyro.png")]) == 0
     out = capsys.readouterr().out
     assert "steps:       10 (h = 0.1 s" in out and "Gyro.omega_meas_B[1] =" in out
+    assert re.search(r"Gyro.omega_meas_B\[1\] = \S+ rad/s\n", out)  # final values with their units
     columns, units = read_result(tmp_path / "gyro.csv")
     assert units["Gyro.omega_meas_B[1]"] == "rad/s" and len(columns["time"]) == 11
     assert (tmp_path / "gyro.png").is_file()
