@@ -13,6 +13,7 @@ import numpy as np
 
 from .instances import read_ops
 from .names import split_name
+from .plotting import TIME_UNITS
 
 # The progress bar's display units (the master knows nothing of the models, so not from components).
 DAY = 86400.0  # s
@@ -175,7 +176,6 @@ class ProgressBar(Observer):
     advance as large as the coasts' during a 15 ms phase, and the bar would look hung."""
 
     UNITS = ((2 * YEAR, "yr", YEAR), (2 * DAY, "d", DAY), (0.0, "s", 1.0))
-    SPANS = ((YEAR, "yr"), (DAY, "d"), (3600.0, "h"), (60.0, "min"), (0.0, "s"))
 
     def __init__(self, plan):
         self.plan = plan
@@ -224,10 +224,10 @@ class ProgressBar(Observer):
             self.posted, self.posted_steps = now, info.steps
         bar.update((info.t - self.plan.start) / self.scale - bar.n)
 
-    @classmethod
-    def _span(cls, seconds):
-        unit, size = next((u, s) for s, u in cls.SPANS if seconds >= 2 * s or s == 0.0)
-        return f"{seconds / (size or 1.0):.3g} {unit}"
+    @staticmethod
+    def _span(seconds):
+        unit, size = next((u, s) for u, s in TIME_UNITS if seconds >= 2 * s or u == "s")
+        return f"{seconds / size:.3g} {unit}"
 
     def close(self):
         if self.bar is not None:

@@ -38,14 +38,13 @@ from ...master import System, report
 from ...master.plan import RunOptions
 from ...master.names import near, split_name
 from ...master.planning import make_plan
-from ...master.plotting import read_result
+from ...master.plotting import TIME_UNITS, read_result
 from ..console import add_console_arguments, console_settings
 from .spec import load_spec
 from .worker import run_batch, run_one
 
 FLUSH_SECONDS = 2.0
 SCATTER_INPUTS = 6  # inputs drawn against each metric in scatter.png
-TIME_UNITS = (("yr", 365.25 * 86400.0), ("d", 86400.0), ("h", 3600.0), ("min", 60.0), ("s", 1.0))
 SERIES = "series"  # keep_timeseries: <out>/series/run-<i>.parquet
 
 
@@ -236,7 +235,7 @@ def envelopes(spec, ok, series_dir, points=500):
     """Percentile bands of each kept signal over the successful runs' series, on a common time grid
     (a run that ended earlier stops contributing where it ended)."""
     series = [read_result(p) for p in (Path(series_dir) / f"run-{r['run']:06d}.parquet" for r in ok) if p.is_file()]
-    signals = list(spec.keep_signals) or [v for v in spec.recorded()]
+    signals = list(spec.keep_signals or spec.recorded())
     if not series or not signals:
         return ""
     end = max(float(c["time"][-1]) for c, _ in series)
