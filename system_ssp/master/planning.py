@@ -74,6 +74,8 @@ def _stops(system, stop_when):
         v = comp.vars[var]
         if v.type != "Boolean":
             raise SSPError(f"stop condition {s!r} must be a Boolean variable, it is {v.type}")
+        if v.causality != "output":  # an input or parameter holds what it was given: it stops nothing
+            raise SSPError(f"stop condition {s!r} must be an output of its component (its causality is {v.causality})")
         stops.append((comp.index, var))
     return stops
 
@@ -126,6 +128,9 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
     if isinstance(o.record_every, bool) or not isinstance(o.record_every, numbers.Integral) or o.record_every < 1:
         raise SSPError(f"record_every must be an integer >= 1, got {o.record_every!r}")
     n_float = (stop - start) / h
+    if not math.isfinite(n_float):
+        raise SSPError(f"stop time {stop:g} s: {stop - start:g} s in steps of {h:g} s are more communication steps "
+                       f"than can be counted (a run may take at most {MAX_STEPS:,})")
     n_steps = int(round(n_float))
     if abs(n_float - n_steps) > 1e-9 * max(1.0, n_float):
         n_steps = int(math.ceil(n_float))

@@ -24,6 +24,7 @@ from components.mission.neighbor import DEFAULT_SCENARIO
 
 from ..atomic import write_text_atomic
 from ..errors import SSPError
+from ..master.result import check_output_file
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings
 from . import deorbit_study, mission, propulsion_report, thesis
 
@@ -315,6 +316,16 @@ def main(argv=None):
     progress = console_settings(args)
     if not (Path(args.ssp_dir) / "detumble.ssp").is_file():
         raise SSPError(f"{args.ssp_dir}/detumble.ssp not found: build the systems first with `python build_fmus.py`")
+    # the places the results go, checked before the two-minute run (they used to fail after it)
+    if args.markdown:
+        check_output_file(args.markdown, "--markdown", (".md", ".markdown"))
+        if Path(args.markdown).is_file():
+            try:
+                Path(args.markdown).read_text(encoding="utf-8")
+            except (OSError, UnicodeDecodeError) as exc:
+                raise SSPError(f"--markdown {args.markdown}: cannot read it as UTF-8 text ({exc})") from None
+    if args.json:
+        check_output_file(args.json, "--json", (".json",))
     ours = compute(args.ssp_dir, progress)
     print(table(ours), end="")
     if args.markdown:

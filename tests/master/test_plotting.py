@@ -129,3 +129,20 @@ def test_every_option_of_every_command_says_what_it_does(monkeypatch, capsys):
             main([command, "--help"])
     capsys.readouterr()
     assert silent == []
+
+
+def test_bad_stop_conditions_times_and_output_places_are_refused_up_front(ssp_paths, tmp_path, capsys):
+    """Issue 30: a stop condition on an input stopped at t = 0 with exit 0; --stop-time 1e308 was an
+    OverflowError (exit 3); validation checked its --json/--markdown places after its 2-minute run."""
+    detumble = str(ssp_paths["detumble"])
+    assert main(["run", detumble, "--stop-when", "detumble.enabled"]) == 2
+    assert "stop condition 'detumble.enabled' must be an output of its component (its causality is input)" in \
+        capsys.readouterr().err
+    assert main(["run", detumble, "--stop-time", "1e308"]) == 2
+    assert "more communication steps than can be counted" in capsys.readouterr().err
+    assert main(["validation", "--ssp-dir", str(ssp_paths["detumble"].parent), "--json",
+                 str(tmp_path / "missing" / "v.json")]) == 2
+    assert f"--json {tmp_path / 'missing' / 'v.json'}: folder" in capsys.readouterr().err
+    assert main(["validation", "--ssp-dir", str(ssp_paths["detumble"].parent), "--markdown",
+                 str(tmp_path / "v.txt")]) == 2
+    assert "unknown format '.txt' (expected .md or .markdown)" in capsys.readouterr().err
