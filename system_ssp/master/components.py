@@ -1,6 +1,8 @@
 """The static side of one component of a loaded system: its SSD declaration, its FMU's model
 description and the folder the FMU is extracted to."""
-from fmpy import extract, read_model_description
+from fmpy import read_model_description
+
+from .. import archive
 
 from ..errors import SSPError
 from ..ssp.interface import unit_definitions, variable_unit
@@ -45,15 +47,16 @@ def load_components(desc, extract_root, namer, validate):
             raise SSPError(f"{decl.origin}: component {decl.name!r}: FMU file not found "
                            f"(source={decl.source!r}, tried {namer(decl.fmu_path)}); the product's "
                            "systems are packed with their FMUs by `python build_fmus.py` into build/ssp/")
+        unzipdir = str(archive.extract(decl.fmu_path, extract_root / f"{i}_{decl.name}",
+                                       f"component {decl.name!r}: {namer(decl.fmu_path)}"))
         try:
-            md = read_model_description(str(decl.fmu_path), validate=validate)
+            md = read_model_description(unzipdir, validate=validate)
         except Exception as exc:  # fmpy raises various exceptions for broken FMUs
             raise SSPError(f"component {decl.name!r}: cannot read the model description of "
                            f"{namer(decl.fmu_path)}: {exc}") from None
         if md.fmiVersion != "2.0" or md.coSimulation is None:
             raise SSPError(f"component {decl.name!r}: {namer(decl.fmu_path)} is not an FMI 2.0 "
                            "co-simulation FMU")
-        unzipdir = extract(str(decl.fmu_path), unzipdir=str(extract_root / f"{i}_{decl.name}"))
         info = ComponentInfo(i, decl, md, unzipdir)
         for cname, conn in decl.connectors.items():
             v = info.vars.get(cname)

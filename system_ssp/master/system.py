@@ -7,8 +7,8 @@ import shutil
 import tempfile
 import time
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
-import zipfile
 
+from .. import archive
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
@@ -37,8 +37,9 @@ class System:
     the direct-feedthrough graph. Use as a context manager (or call `close()`) to delete the
     extracted files."""
 
-    def __init__(self, path: PathLike, validate: bool = True):
-        tmp = Path(tempfile.mkdtemp(prefix="system_ssp_"))
+    def __init__(self, path: PathLike, validate: bool = True, scratch: Optional[PathLike] = None):
+        # scratch: the folder to extract into (default: the system's temporary folder)
+        tmp = Path(tempfile.mkdtemp(prefix="system_ssp_", dir=scratch))
         self._tmp: Optional[Path] = tmp
         try:
             self._load(Path(path), validate, tmp)
@@ -57,15 +58,7 @@ class System:
             self.namer = reader.FileNamer()
         elif path.suffix.lower() == ".ssp":
             root = tmp / "ssp"
-            try:
-                with zipfile.ZipFile(path) as z:
-                    for n in z.namelist():
-                        target = (root / n).resolve()
-                        if not str(target).startswith(str(root.resolve())):
-                            raise SSPError(f"{path}: archive member {n!r} points outside the archive")
-                    z.extractall(root)
-            except zipfile.BadZipFile as exc:
-                raise SSPError(f"{path}: not a valid .ssp (zip) archive: {exc}") from None
+            archive.extract(path, root)
             ssd_path = root / "SystemStructure.ssd"
             if not ssd_path.is_file():
                 raise SSPError(f"{path}: archive has no SystemStructure.ssd at its root")

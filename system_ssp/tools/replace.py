@@ -30,7 +30,8 @@ import zipfile
 
 from lxml import etree
 
-from ..atomic import atomic_write
+from .. import archive
+from ..atomic import atomic_write, check_output_place
 from ..errors import SSPError
 from ..master import System
 from ..ssp import reader
@@ -87,18 +88,14 @@ def _unpack(source, root):
     source = Path(source)
     if not source.exists():
         raise SSPError(f"{source}: not found")
+    if not source.is_dir() and source.suffix.lower() not in (".ssp", ".ssd"):
+        raise SSPError(f"{source}: expected a system: an .ssp archive, an .ssd file or a folder with "
+                       "SystemStructure.ssd")
     if source.is_dir():
         shutil.copytree(source, root, dirs_exist_ok=True)
         ssd = root / "SystemStructure.ssd"
     elif source.suffix.lower() == ".ssp":
-        try:
-            with zipfile.ZipFile(source) as z:
-                for n in z.namelist():
-                    if not str((root / n).resolve()).startswith(str(root.resolve())):
-                        raise SSPError(f"{source}: archive member {n!r} points outside the archive")
-                z.extractall(root)
-        except zipfile.BadZipFile as exc:
-            raise SSPError(f"{source}: not a valid .ssp (zip) archive: {exc}") from None
+        archive.extract(source, root)
         ssd = root / "SystemStructure.ssd"
     else:
         shutil.copytree(source.parent, root, dirs_exist_ok=True)
@@ -165,11 +162,7 @@ def replace_component(source, component, new_fmu, out, drop_unmatched=False):
     """Replace the FMU of `component` in the system at `source` by `new_fmu` and write the
     result to `out` (.ssp). Returns a ReplaceReport; raises ReplaceRefused (nothing written)
     when the new FMU does not fit."""
-    out = Path(out)
-    if out.suffix.lower() != ".ssp":
-        raise SSPError(f"--out {out}: the result is an .ssp archive (name it *.ssp)")
-    if not out.parent.is_dir():
-        raise SSPError(f"--out {out}: folder {out.parent} does not exist")
+    out = check_output_place(out, "--out", (".ssp",))
     new = FmuInterface.read(new_fmu)
     with tempfile.TemporaryDirectory(prefix="neighbor_replace_") as tmp:
         root = Path(tmp) / "system"
