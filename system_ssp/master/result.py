@@ -2,14 +2,12 @@
 (units in the schema metadata)."""
 import csv
 import json
-import os
 from pathlib import Path
-import tempfile
 from typing import Any, Dict, List, Optional, Sequence
 
 import numpy as np
 
-from ..atomic import PathLike, atomic_write
+from ..atomic import PathLike, atomic_write, check_output_place, is_stream
 from ..errors import SSPError
 from .plotting import default_signals, plot, select, units_path
 
@@ -95,30 +93,20 @@ FORMATS = (".csv", ".parquet")
 
 
 def check_output_file(path: PathLike, what: str = "output file", formats: Sequence[str] = FORMATS) -> Path:
-    """Refuse, before a run starts, an output file the run could not write: its folder missing or
-    not a folder, the path a folder, or no file creatable in the folder (tried)."""
-    path = Path(path)
-    folder = path.parent if str(path.parent) else Path(".")
-    if path.suffix.lower() not in formats and (path.suffix or formats != FORMATS):
-        raise SSPError(f"{what} {path}: unknown format {path.suffix!r} (expected {' or '.join(formats)})")
-    if not folder.exists():
-        raise SSPError(f"{what} {path}: folder {folder} does not exist")
-    if not folder.is_dir():
-        raise SSPError(f"{what} {path}: {folder} is not a folder")
-    if path.is_dir():
-        raise SSPError(f"{what} {path}: is a folder")
-    try:
-        fd, probe = tempfile.mkstemp(prefix=f".{path.name}.", suffix=".probe", dir=folder)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise SSPError(f"{what} {path}: cannot write in {folder} ({exc.strerror or exc})") from None
-    return path
+    """Refuse, before a run starts, an output file the run could not write (atomic.check_output_place)."""
+    if Path(path).suffix == "" and formats == FORMATS:
+        formats = ()  # no suffix: CSV
+    checked = check_output_place(path, what, formats)
+    if formats == FORMATS and checked.suffix.lower() != ".parquet" and not is_stream(checked):
+        check_output_place(units_path(checked), f"{what}'s units file")
+    return checked
 
 
 def partial_path(path: PathLike) -> Path:
     """Where the rows of a failed or interrupted run go: x.csv -> x.partial.csv."""
     path = Path(path)
+    if is_stream(path):  # the rows go where the whole run would have gone
+        return path
     return path.with_name(f"{path.stem}.partial{path.suffix or '.csv'}")
 
 
@@ -145,10 +133,12 @@ def write_csv_atomic(data: np.ndarray, path: PathLike, units: Optional[Units] = 
         w = csv.writer(f)  # the default dialect is RFC 4180's: minimal quoting, CRLF
         w.writerow(names)
         w.writerows(zip(*(c.tolist() for c in cols)))
-    if units is not None:
-        with atomic_write(units_path(path), "w", newline="") as f:
-            json.dump({n: units.get(n) for n in names}, f, indent=1)
-            f.write("\n")
+        # the sidecar before the data file is renamed into place: never data without its units;
+        # a stream (FIFO, /dev/null) has no place beside it for one
+        if units is not None and not is_stream(path):
+            with atomic_write(units_path(path), "w", newline="") as u:
+                json.dump({n: units.get(n) for n in names}, u, indent=1)
+                u.write("\n")
 
 
 def write_parquet_atomic(data: np.ndarray, path: PathLike, units: Optional[Units] = None) -> None:

@@ -35,10 +35,11 @@ import numpy as np
 from components.core.constants import DAY, MU_EARTH, R_EQ, YEAR
 from components.mission.modes import DeorbitPhase, MissionMode
 from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS, MISSION_RECORD, MISSION_SYSTEMS,
-                                         SCENARIOS as DEFINED_SCENARIOS, scenario_set)
+                                         SCENARIOS as DEFINED_SCENARIOS, SPACECRAFT, scenario_set)
 
-from ..atomic import atomic_write, write_text_atomic
+from ..atomic import atomic_write, check_output_place, write_text_atomic
 from ..errors import SSPError
+from ..limits import refuse_over
 from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
@@ -527,6 +528,41 @@ def main(argv=None):
     return 0
 
 
+PROPELLANT_KEYS = {"burn_propellant_kg": 1.0, "detumble_propellant_g": 1e-3, "slew_propellant_g": 1e-3,
+                   "tracking_propellant_g": 1e-3}  # key: kg per unit
+
+
+def read_mission_summary(path: Path, scenario: str) -> dict:
+    """A mission's summary.json, checked: a JSON object of `scenario`, its propellant numbers
+    finite, >= 0 and below the spacecraft's mass (SSPError naming the file and key otherwise)."""
+    try:
+        size = path.stat().st_size
+        refuse_over("max_spec_bytes", size, f"--mission {path} (bytes)")
+        summary = json.loads(path.read_text(encoding="utf-8"))
+    except OSError as err:
+        raise SSPError(f"--mission {path}: cannot read it ({err.strerror or err})") from None
+    except UnicodeDecodeError as err:
+        raise SSPError(f"--mission {path}: not UTF-8 text (byte {err.object[err.start]:#04x} at {err.start}): "
+                       "expected the summary.json of a mission run") from None
+    except ValueError as err:
+        raise SSPError(f"--mission {path}: not JSON ({err}): expected the summary.json of a mission run") from None
+    if not isinstance(summary, dict):
+        raise SSPError(f"--mission {path}: holds a JSON {type(summary).__name__}, expected an object (the "
+                       "summary.json of a mission run)")
+    if summary.get("scenario") != scenario:
+        raise SSPError(f"--mission {path} is a {summary.get('scenario')!r} mission run, not --scenario {scenario}")
+    missing = [key for key in PROPELLANT_KEYS if summary.get(key) is None]
+    if missing:
+        why = str(summary.get("error", "an incomplete run"))[:200]
+        raise SSPError(f"--mission {path}: has no {', '.join(missing)} ({why})")
+    for key, kg in PROPELLANT_KEYS.items():
+        value = summary[key]
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not 0 <= value * kg <= SPACECRAFT.mass:
+            raise SSPError(f"--mission {path}: {key} = {value!r}: expected a number from 0 to "
+                           f"{SPACECRAFT.mass / kg:g} (the spacecraft's mass)")
+    return summary
+
+
 def main_propulsion(argv=None):
     """`neighbor-cosim propulsion` (system_ssp.neighbor.propulsion_report): the budget of the worst
     case and of a mission run, read from --mission or run here."""
@@ -545,14 +581,10 @@ def main_propulsion(argv=None):
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
+    if args.json:
+        check_output_place(args.json, "--json", (".json",))
     if args.mission:
-        path = Path(args.mission)
-        try:
-            summary = json.loads(path.read_text())
-        except (OSError, ValueError) as err:
-            raise SSPError(f"{path}: cannot read a mission summary ({err})") from None
-        if summary.get("scenario") != args.scenario:
-            raise SSPError(f"{path} is a {summary.get('scenario')!r} mission run, not --scenario {args.scenario}")
+        summary = read_mission_summary(Path(args.mission), args.scenario)
     else:
         summary, _ = run_mission(args.scenario, ssp_dir=args.ssp_dir, progress=progress, gnc=args.gnc)
     budget = propulsion_report.of_mission(summary)

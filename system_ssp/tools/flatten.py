@@ -17,6 +17,7 @@ import tempfile
 
 from lxml import etree
 
+from ..atomic import check_output_place
 from ..errors import SSPError
 from ..master import System
 from ..master.names import split_name
@@ -28,6 +29,7 @@ from .replace import _pack, _unpack
 def flatten_system_parameters(source, out):
     """Write `out` (.ssp): `source` with its system parameters folded into component bindings.
     Returns {system parameter: [component.variable, ...]} of what was folded."""
+    check_output_place(out, "--out", (".ssp",))
     with System(source) as system:
         names = set(system.parameter_links)
         links = {name: targets for name, targets in system.parameter_links.items() if targets}

@@ -11,7 +11,8 @@ from pathlib import Path
 import sys
 from typing import Optional, Sequence
 
-from ..master.plotting import default_signals, plot, read_result, select
+from ..atomic import check_output_place
+from ..master.plotting import FORMATS, default_signals, plot, read_result, select
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
@@ -21,13 +22,14 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     ap.add_argument("--out", help="the figure: .png (default: beside RESULT), .svg, or .html (interactive, one file)")
     ap.add_argument("--title", default=None, help="the figure's title (default: the result file's name)")
     args = ap.parse_args(argv)
+    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
+    check_output_place(out, "--out" if args.out else "figure", FORMATS)
     columns, units = read_result(args.result)
     note = ""
     if args.signals:
         signals = select(list(columns), args.signals, f"{args.result}: ")
     else:
         signals, note = default_signals(list(columns), units)
-    out = Path(args.out) if args.out else Path(args.result).with_suffix(".png")
     path = plot(columns, units, signals, out, args.title if args.title is not None else Path(args.result).name)
     print(f"{len(signals)} signal(s) of {args.result} in {path}" + (f" ({note})" if note else ""))
     return 0
