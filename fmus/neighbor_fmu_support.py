@@ -16,6 +16,7 @@ getters, so an output that depends directly on inputs is recomputed from the inp
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
 """
 import copy
+import math
 from collections import OrderedDict
 from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
 
@@ -106,6 +107,9 @@ class NeighborSlave(Fmi2Slave):
         self.values[name] = kind(start)
 
         def setter(value, name=name):
+            if kind is float and not math.isfinite(value):  # no model of ours can use a NaN or inf parameter
+                raise ParameterError(f"{type(self).__name__} instance '{self.instance_name}': parameter {name} = "
+                                     f"{value!r}: expected a finite number")
             self.values[name] = kind(value)
             self._model = None  # rebuilt from the new parameter values on next use
 

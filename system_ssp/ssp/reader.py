@@ -199,6 +199,8 @@ def _float_attr(el, name, origin, default=None):
         x = float(v)
     except ValueError:
         raise SSPError(f"{origin}: attribute {name}={v!r} is not a number") from None
+    if not math.isfinite(x):  # factors, offsets, times and step sizes: a NaN or inf fills a run with NaN
+        raise SSPError(f"{origin}: attribute {name}={v!r}: expected a finite number")
     return x
 
 

@@ -26,7 +26,11 @@ import os
 from pathlib import Path
 import platform
 import re
+import shutil
+import signal
 import sys
+import tempfile
+import threading
 import time
 
 import numpy as np
@@ -41,6 +45,7 @@ from ...master.planning import make_plan
 from ...master.plotting import TIME_UNITS, read_result
 from ..console import add_console_arguments, console_settings
 from .spec import load_spec
+from . import worker as worker_module
 from .worker import run_batch, run_one
 
 FLUSH_SECONDS = 2.0
@@ -98,6 +103,34 @@ def _prepare_folder(spec, out):
     return out
 
 
+SCHEDULER_TIMEOUT_S = 10.0
+SCHEDULER_ADDRESS = re.compile(r"^(?:(?:tcp|tls|ws|wss|ucx)://)?(\[[0-9A-Fa-f:.]+\]|[A-Za-z0-9_.-]+):(\d{1,5})/?$")
+
+
+def check_scheduler_address(address):
+    """A Dask scheduler address as `dask scheduler` prints it: [tcp|tls|ws|wss|ucx://]host:port."""
+    match = SCHEDULER_ADDRESS.match(address)
+    if match is None or not 0 < int(match.group(2)) < 65536:
+        raise SSPError(f"--scheduler {address!r}: expected a Dask scheduler's address, tcp://host:port (as `dask "
+                       "scheduler` prints it; port 1-65535)")
+
+
+def _start_resource_tracker():
+    """multiprocessing's resource tracker (a process the workers' start needs) ignores SIGINT and
+    SIGTERM but dies of SIGHUP, and its successor then prints tracebacks: it is started here with
+    SIGHUP ignored, which it keeps (the runner itself handles SIGHUP like SIGTERM)."""
+    from multiprocessing import resource_tracker
+
+    if threading.current_thread() is not threading.main_thread():
+        resource_tracker.ensure_running()
+        return
+    previous = signal.signal(signal.SIGHUP, signal.SIG_IGN)
+    try:
+        resource_tracker.ensure_running()
+    finally:
+        signal.signal(signal.SIGHUP, previous)
+
+
 def _client(workers, scheduler):
     import dask
     from dask.distributed import Client, LocalCluster
@@ -109,9 +142,28 @@ def _client(workers, scheduler):
     dask.config.set({"distributed.scheduler.allowed-failures": 0, "distributed.scheduler.worker-saturation": 1.0,
                      "distributed.worker.profile.enabled": False})
     if scheduler:
-        return Client(scheduler), None
+        check_scheduler_address(scheduler)
+        try:
+            return Client(scheduler, timeout=SCHEDULER_TIMEOUT_S), None
+        except (OSError, TimeoutError) as exc:
+            raise SSPError(f"--scheduler {scheduler}: no Dask scheduler answered within {SCHEDULER_TIMEOUT_S:g} s "
+                           f"({type(exc).__name__}); start one (dask scheduler) or leave out --scheduler for workers "
+                           "on this machine") from None
     n = workers or os.cpu_count() or 1
-    cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0")
+    # Ctrl-C reaches every process of the terminal's group: the workers ignore it and SIGTERM (their
+    # preload, worker.dask_setup), so that only this process sees it and shuts them down, without
+    # their tracebacks. The cluster's scratch space (Dask's and the extracted systems) is one
+    # temporary folder, removed after the cluster closes, also when a worker was killed.
+    scratch = tempfile.mkdtemp(prefix="neighbor_campaign_")
+    dask.config.set({"temporary-directory": scratch})
+    _start_resource_tracker()
+    try:
+        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                               local_directory=scratch, preload=[worker_module.__name__])
+    except BaseException:
+        shutil.rmtree(scratch, ignore_errors=True)
+        raise
+    cluster.neighbor_scratch = scratch
     return Client(cluster), cluster
 
 
@@ -153,10 +205,15 @@ def check_against_system(spec):
                 key = _spec_key(spec, named.group(1)) if named else None
                 raise SSPError(f"{spec.path}: {key + ': ' if key else ''}{exc}") from None
         units = {}
+        in_probabilities = {metric for _, metric, _, _ in spec.probabilities}
         for m in spec.metrics:
             if m.kind in ("final", "min", "max"):
                 comp, var = split_name(system.comps, m.variable)
                 units[m.name] = system.var_unit(comp, var)
+                if comp.vars[var].type == "String" and (m.kind != "final" or m.name in in_probabilities):
+                    raise SSPError(f"{spec.path}: metrics.{m.name}: {m.variable} is a String"
+                                   + (": min and max take numbers" if m.kind != "final" else
+                                      ", which a probability cannot compare with a number"))
             elif m.kind in ("stop_time", "time_when", "time_in", "duration"):
                 units[m.name] = "s"
     return units
@@ -173,21 +230,27 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     if not hasattr(spec, "inputs"):
         spec = load_spec(spec)
     units = check_against_system(spec)  # before the folder is touched and before any run
-    out = _prepare_folder(spec, out)
-    columns = _columns(spec)
-    done = {r["run"] for r in _read_rows(out)}
+    out = Path(out)
+    done = {r["run"] for r in _read_rows(out)} if (out / "runs").is_dir() else set()
     todo = [i for i in range(spec.total_runs) if i not in done]
-    if done:
-        print(f"resuming {out}: {len(done)} of {spec.total_runs} runs already recorded there are kept, "
-              f"{len(todo)} to run", file=sys.stderr)
-    if todo:
+    client = cluster = None
+    if todo:  # a scheduler that does not answer is said before the folder is touched
         client, cluster = _client(workers, scheduler)
-        try:
+    try:
+        out = _prepare_folder(spec, out)
+        columns = _columns(spec)
+        if done:
+            print(f"resuming {out}: {len(done)} of {spec.total_runs} runs already recorded there are kept, "
+                  f"{len(todo)} to run", file=sys.stderr)
+        if client is not None:
+            print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {out}", file=sys.stderr)
             _run(client, spec, out, todo, columns, progress, as_completed, batch)
-        finally:
+    finally:
+        if client is not None:
             client.close()
-            if cluster is not None:
-                cluster.close()
+        if cluster is not None:
+            cluster.close()
+            shutil.rmtree(cluster.neighbor_scratch, ignore_errors=True)
     rows = sorted(_read_rows(out), key=lambda r: r["run"])
     _write_rows(out / "runs.parquet", rows, columns)
     summary = summarize(spec, rows, units)
@@ -527,10 +590,11 @@ def main(argv=None):
     progress = console_settings(args)
     if args.workers is not None and args.workers < 1:
         raise SSPError(f"--workers {args.workers}: expected a number >= 1")
+    if args.scheduler is not None:
+        check_scheduler_address(args.scheduler)
     spec = load_spec(args.spec)
     if args.rerun is not None:
         return rerun(spec, args.rerun, Path(args.out))
-    print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {args.out}", file=sys.stderr)
     s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
     print(table(s))
     print(f"results in {args.out} (runs.parquet, summary.json, report.html, figures/)")

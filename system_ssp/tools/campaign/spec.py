@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
+from ...limits import refuse_over
 from ..console import DEFAULT_SSP_DIR
 
 if sys.version_info >= (3, 11):
@@ -24,6 +25,7 @@ DISTRIBUTIONS = {"uniform": ("low", "high"), "normal": ("mean", "std"),
                  "truncnormal": ("mean", "std", "low", "high"), "choice": ("values",),
                  "integers": ("low", "high")}  # integers: low..high inclusive (e.g. a sensor's noise seed)
 METRIC_KINDS = ("stop_time", "stop_reason", "steps", "final", "min", "max", "time_when", "time_in", "duration")
+TEXT_METRICS = ("stop_reason",)
 SIGNAL_METRICS = ("final", "min", "max", "time_when", "time_in")  # kind:comp.var
 HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f107_scale and points the "
                              "orbit's space_weather_file at the scaled copy"}
@@ -129,7 +131,7 @@ class CampaignSpec:
 
 
 def _number(path, key, value, low=-math.inf, integer=False, positive=False):
-    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and math.isfinite(value)
+    ok = isinstance(value, (int, float)) and not isinstance(value, bool) and abs(value) < 1e300
     if ok and integer:
         ok = float(value).is_integer()
     if ok and (value < low or (positive and value <= 0)):
@@ -144,13 +146,24 @@ def _number(path, key, value, low=-math.inf, integer=False, positive=False):
     return int(value) if integer else float(value)
 
 
+def _runs(path, value):
+    runs = _number(path, "campaign.runs", value, integer=True, positive=True)
+    refuse_over("max_runs", runs, f"{path}: campaign.runs")
+    return runs
+
+
 def load_spec(path):
     """Read and check a campaign spec; SSPError naming the file, the key and what is allowed."""
     path = Path(path)
     try:
+        refuse_over("max_spec_bytes", path.stat().st_size, f"{path}: the campaign spec's size in bytes")
         text = path.read_text(encoding="utf-8")
     except OSError as exc:
         raise SSPError(f"{path}: cannot read the campaign spec ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        line = exc.object[:exc.start].count(b"\n") + 1
+        raise SSPError(f"{path}:{line}: not UTF-8 text (byte {exc.object[exc.start]:#04x}); a campaign spec is TOML, "
+                       "which is UTF-8: save it as UTF-8") from None
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
@@ -170,6 +183,8 @@ def load_spec(path):
         if not isinstance(s, dict) or set(s) != {"values"} or not isinstance(s["values"], list) or not s["values"]:
             raise SSPError(f"{path}: [{key}] needs exactly values = [a non-empty list]")
         spec.sweeps.append((name, list(s["values"])))
+    refuse_over("max_runs", spec.runs * math.prod(len(v) for _, v in spec.sweeps),
+                f"{path}: campaign.runs" + (" times the sweep points" if spec.sweeps else ""))
     names = [d.name for d in spec.dispersions] + [n for n, _ in spec.sweeps]
     twice = sorted({n for n in names if names.count(n) > 1} | (set(names) & set(spec.parameters)))
     if twice:
@@ -182,12 +197,20 @@ def load_spec(path):
     mnames = {m.name for m in spec.metrics}
     for name, expr in doc.get("probabilities", {}).items():
         match = PROBABILITY.match(expr) if isinstance(expr, str) else None
+        threshold = match.group(3) if match else ""
+        if threshold not in ("true", "false"):
+            try:
+                threshold = float(threshold)
+            except ValueError:
+                match = None
         if match is None or match.group(1) not in mnames:
             raise SSPError(f"{path}: probabilities.{name} = {expr!r}: expected \"<metric> <op> <number>\" with a "
                            f"metric of [metrics] ({', '.join(sorted(mnames))}) and op one of < <= > >= ==")
-        threshold = match.group(3)
+        if next(m for m in spec.metrics if m.name == match.group(1)).kind in TEXT_METRICS:
+            raise SSPError(f"{path}: probabilities.{name} = {expr!r}: metric {match.group(1)} is text (stop_reason); "
+                           "a probability takes a numeric or Boolean metric")
         spec.probabilities.append((name, match.group(1), match.group(2),
-                                   threshold == "true" if threshold in ("true", "false") else float(threshold)))
+                                   threshold == "true" if threshold in ("true", "false") else threshold))
     return spec
 
 
@@ -205,7 +228,7 @@ def _campaign_table(path, c, text):
     if not isinstance(c["system"], str) or not c["system"]:
         raise SSPError(f"{path}: campaign.system = {c['system']!r}: expected a path or a built system's name")
     spec = CampaignSpec(path=path, system=resolve_system(c["system"], path),
-                        runs=_number(path, "campaign.runs", c["runs"], integer=True, positive=True),
+                        runs=_runs(path, c["runs"]),
                         seed=_number(path, "campaign.seed", c["seed"], low=0, integer=True), text=text)
     ps = c.get("parameter_sets", [])
     if not isinstance(ps, list) or not all(isinstance(p, str) for p in ps):
@@ -243,6 +266,7 @@ def _dispersions(path, name, d, helper):
     if not isinstance(d, dict) or "elements" not in d:
         return [_dispersion(path, name, d, helper)]
     n = _number(path, f"dispersions.{name!r}.elements", d["elements"], integer=True, positive=True)
+    refuse_over("max_vector_elements", n, f"{path}: dispersions.{name!r}.elements")
     if "[" in name or d.get("also"):
         raise SSPError(f"{path}: [dispersions.{name!r}]: elements = {n} names a vector parameter without an index "
                        "and takes no `also`")

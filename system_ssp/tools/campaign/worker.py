@@ -3,6 +3,7 @@ and reused by every run the worker gets (no per-run extraction, schema check or 
 the run's values come from the spec and its index alone; any failure becomes a row."""
 import math
 import os
+import signal
 from pathlib import Path
 import tempfile
 import time
@@ -18,10 +19,28 @@ from ...master import System, write_result
 _SYSTEMS: Dict[str, System] = {}  # system path -> System, for the life of this process
 
 
+def dask_setup(worker):
+    """Run by each local worker process as it starts (the runner's LocalCluster preloads this
+    module): Ctrl-C, SIGTERM or SIGHUP sent to the terminal's process group are for the runner,
+    which closes the workers itself (and its nannies kill a worker that does not close)."""
+    for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
+        signal.signal(sig, signal.SIG_IGN)
+
+
+def _scratch():
+    """The Dask worker's own folder (removed with the worker, and for a local cluster by the
+    runner whatever happened), so that a killed worker leaves no extracted system behind."""
+    try:
+        from distributed import get_worker
+        return get_worker().local_directory
+    except (ImportError, ValueError):  # not in a Dask worker (--rerun, tests)
+        return None
+
+
 def _system(path):
     key = str(path)
     if key not in _SYSTEMS:
-        _SYSTEMS[key] = System(path)
+        _SYSTEMS[key] = System(path, scratch=_scratch())
     return _SYSTEMS[key]
 
 
