@@ -11,11 +11,28 @@
 the parameter order, the `org.neighbor-cosim.master` annotation and `nc:Schedule` are described
 in docs/master.md.
 """
+import importlib
 import logging
+from typing import TYPE_CHECKING, Any
 
 from .errors import RunInterrupted, SimulationError, SSPError
-from .master import Observer, Result, RunOptions, RunView, StepInfo, System, simulate, write_csv_atomic, write_result
 from .version import __version__
+
+if TYPE_CHECKING:
+    from .master import (Observer, Result, RunOptions, RunView, StepInfo, System, simulate, write_csv_atomic,
+                         write_result)
+
+_FROM_MASTER = ("Observer", "Result", "RunOptions", "RunView", "StepInfo", "System", "simulate", "write_csv_atomic",
+                "write_result")
+
+
+def __getattr__(name: str) -> Any:
+    # the master (numpy, fmpy, lxml) is imported on first use, so that the command line's first
+    # code (system_ssp.launch) runs before those imports
+    if name in _FROM_MASTER:
+        return getattr(importlib.import_module(".master", __name__), name)
+    raise AttributeError(f"module {__name__!r} has no attribute {name!r}")
+
 
 # A library prints nothing by itself: the master's and the FMUs' messages go to the "system_ssp"
 # loggers for the application to show (the command line does, see --log-level).

@@ -5,7 +5,7 @@
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
 file and line, component or variable); 3 an unexpected error; 130 interrupted by Ctrl-C (SIGINT),
-143 by SIGTERM. A run that fails or is interrupted writes what it had recorded to
+143 by SIGTERM, 129 by SIGHUP. A run that fails or is interrupted writes what it had recorded to
 <output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
 """
 import argparse
@@ -28,7 +28,7 @@ from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.report import run_report
 from .master.result import check_output_file
-from .atomic import write_text_atomic
+from .atomic import check_output_place, write_text_atomic
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 from .ssp.writer import single_fmu_system
@@ -116,12 +116,19 @@ def _parse_multiples(items):
 
 
 class Terminated(BaseException):
-    """SIGTERM outside a run (a run stops at its next communication point instead): unwinds like
-    Ctrl-C, so temporary folders and half-written files are cleaned up."""
+    """SIGTERM or SIGHUP outside a run (a run stops at its next communication point instead):
+    unwinds like Ctrl-C, so temporary folders and half-written files are cleaned up."""
+
+    def __init__(self, signum: int) -> None:
+        super().__init__(signum)
+        self.signum = signum
 
 
 def _terminate(signum, frame):
-    raise Terminated()
+    raise Terminated(signum)
+
+
+HANDLERS = {signal.SIGINT: signal.default_int_handler, signal.SIGTERM: _terminate, signal.SIGHUP: _terminate}
 
 
 def main(argv=None):
@@ -129,36 +136,44 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--log-level=debug" in argv or any(a == "--log-level" and argv[k + 1:k + 2] == ["debug"]
                                                  for k, a in enumerate(argv))
-    previous = signal.signal(signal.SIGTERM, _terminate)
+    previous = {sig: signal.signal(sig, handler) for sig, handler in HANDLERS.items()}
     try:
         if argv[:1] and argv[0] in APPS:
             return APPS[argv[0]](argv[1:])
         return _run_or_info(argv)
     except RunInterrupted as exc:
-        print(exc, file=sys.stderr)
+        print(one_line(exc), file=sys.stderr)
         _say_partial(exc)
         return 128 + exc.signal
     except SSPError as exc:
-        print(f"error: {exc}", file=sys.stderr)
+        print(f"error: {one_line(exc)}", file=sys.stderr)
         if isinstance(exc, SimulationError):
             _say_partial(exc)
         return 2
     except KeyboardInterrupt:
         print("interrupted (SIGINT)", file=sys.stderr)
         return 130
-    except Terminated:
-        print("interrupted (SIGTERM)", file=sys.stderr)
-        return 143
+    except Terminated as exc:
+        print(f"interrupted ({signal.Signals(exc.signum).name})", file=sys.stderr)
+        return 128 + exc.signum
     except BrokenPipeError:  # the reader went away (| head): not an error of ours
         sys.stdout = open(os.devnull, "w")
         return 0
     except Exception as exc:  # unexpected: one line, the traceback only with --log-level debug
         if debug:
             traceback.print_exc()
-        print(f"error: unexpected {type(exc).__name__}: {exc} (--log-level debug shows where)", file=sys.stderr)
+        print(f"error: unexpected {type(exc).__name__}: {one_line(exc)} (--log-level debug shows where)",
+              file=sys.stderr)
         return 3
     finally:
-        signal.signal(signal.SIGTERM, previous)
+        for sig, handler in previous.items():
+            signal.signal(sig, handler)
+
+
+def one_line(message: object) -> str:
+    """A message as one line: line breaks in it (a file name with a newline, an FMU's multi-line
+    log) escaped, so that a script reading the last line of stderr gets all of it."""
+    return str(message).replace("\r", "\\r").replace("\n", "\\n")
 
 
 def _say_partial(exc):
@@ -174,8 +189,8 @@ def _run_or_info(argv):
         fmu = FmuInterface.read(args.path)
         print(json.dumps(fmu.as_dict(), indent=1) if args.json else describe_fmu(fmu))
         return 0
-    if args.command == "run" and args.plot and Path(args.plot).suffix.lower() not in PLOT_FORMATS:
-        raise SSPError(f"--plot {args.plot}: unknown format (expected {', '.join(PLOT_FORMATS)})")
+    if args.command == "run" and args.plot:
+        check_output_place(args.plot, "--plot", PLOT_FORMATS)
     if args.command == "run" and args.report:
         check_output_file(args.report, "--report", (".html",))
     suffix = Path(args.path).suffix.lower()
@@ -240,5 +255,7 @@ def _run(args, path):
 
 
 def console_main():
-    """Entry point of the `neighbor-cosim` command (and `python -m system_ssp`)."""
-    sys.exit(main())
+    """Entry point of the `neighbor-cosim` command (and `python -m system_ssp`), through system_ssp.launch."""
+    from .launch import console_main as launch
+
+    launch()

@@ -28,7 +28,7 @@ class SimulationError(_Stopped):
 
 
 class RunInterrupted(_Stopped):
-    """The run was stopped by SIGINT (Ctrl-C) or SIGTERM at a communication point.
+    """The run was stopped by SIGINT (Ctrl-C), SIGTERM or SIGHUP at a communication point.
 
     signal: the signal number (exit code 128 + signal in the command line)."""
 

@@ -1,8 +1,8 @@
-"""Ctrl-C and SIGTERM stop a run at the next communication point.
+"""Ctrl-C, SIGTERM and SIGHUP stop a run at the next communication point.
 
 Python runs signal handlers between bytecodes, which, with FMUs that run Python in this
 interpreter, can be inside a model's doStep: a KeyboardInterrupt raised there would come back as
-that component's fmi2Error. While a run executes, SIGINT and SIGTERM only set a flag, which the
+that component's fmi2Error. While a run executes, SIGINT, SIGTERM and SIGHUP only set a flag, which the
 `Interruption` observer reads after every macro step (only in the main thread: elsewhere signals
 cannot be caught and the run is not interruptible this way)."""
 import signal
@@ -11,11 +11,11 @@ import time
 
 from .observers import Observer
 
-SIGNALS = (signal.SIGINT, signal.SIGTERM)
+SIGNALS = (signal.SIGINT, signal.SIGTERM, signal.SIGHUP)
 
 
 class SignalWatch:
-    """`with SignalWatch() as watch:` SIGINT/SIGTERM set `watch.received` (the first signal's
+    """`with SignalWatch() as watch:` SIGINT/SIGTERM/SIGHUP set `watch.received` (the first signal's
     number) instead of their usual action; the earlier handlers come back on exit."""
 
     def __init__(self):

@@ -208,3 +208,35 @@ def test_wrappers_take_declared_names_from_their_declarations():
     assert _retyped_element_names(support) == [], "the support module takes element names from components.core.names"
     offenders = {name: lines for name, lines in found.items() if lines}
     assert offenders == {}, f"wrappers that retype declared names (file: lines): {offenders}"
+
+
+def test_every_real_parameter_of_every_fmu_refuses_nan_and_inf(fmu_paths, tmp_path, capsys):
+    """Issue 30: a NaN or infinite parameter (q0, valid_sigma, ...) was taken and turned the
+    outputs to NaN. Every Real parameter of every FMU now refuses it with fmi2Error and a message
+    naming the parameter, keeps its value, and the FMU then initializes and steps with finite
+    outputs. (FMPy raises FMICallException on fmi2Error and prints the FMU's messages.)"""
+    from fmpy.fmi1 import FMICallException
+
+    tried = 0
+    for name, path in sorted(fmu_paths.items()):
+        md = fmpy.read_model_description(str(path))
+        params = [v for v in md.modelVariables if v.causality == "parameter" and v.type == "Real"]
+        outputs = [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"]
+        fmu, _ = instantiate(path, tmp_path, name)
+        try:
+            for v in params:
+                before = fmu.getReal([v.valueReference])
+                for bad in (math.nan, math.inf, -math.inf):
+                    with pytest.raises(FMICallException):
+                        fmu.setReal([v.valueReference], [bad])
+                    assert f"parameter {v.name} = {bad!r}: expected a finite number" in capsys.readouterr().out
+                    tried += 1
+                assert fmu.getReal([v.valueReference]) == before, f"{name}.{v.name} changed"
+            fmu.enterInitializationMode()
+            fmu.exitInitializationMode()
+            fmu.doStep(0.0, 0.01)
+            assert all(math.isfinite(x) for x in fmu.getReal(outputs)), name
+        finally:
+            fmu.terminate()
+            fmu.freeInstance()
+    assert tried > 300, tried

@@ -101,7 +101,8 @@ def _cli_env(tmpdir):
     return dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), TMPDIR=str(tmpdir))
 
 
-@pytest.mark.parametrize("signum, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM")])
+@pytest.mark.parametrize("signum, code, name", [(signal.SIGINT, 130, "SIGINT"), (signal.SIGTERM, 143, "SIGTERM"),
+                                               (signal.SIGHUP, 129, "SIGHUP")])
 def test_signal_stops_at_a_communication_point(fmus, tmp_path, signum, code, name):
     """A signal in the middle of a run (while a model's Python code runs) stops it at the next
     communication point: exit 128 + signal, 'interrupted at t = ...', the rows so far in
