@@ -36,6 +36,10 @@ def _temporary_prefix(path: Path) -> str:
     return f".{path.name[:40]}."
 
 
+_NULL_DEVICE = os.makedev(1, 3)
+_TERMINAL_MAJORS = {4, 5} | set(range(136, 144))  # tty*, /dev/tty and the console, pseudo-terminals
+
+
 def is_stream(path: PathLike) -> bool:
     """True when `path` exists and is a FIFO, a terminal or the null device: written through, as a
     stream, never replaced (no temporary file, no sidecar files beside it)."""
@@ -45,19 +49,9 @@ def is_stream(path: PathLike) -> bool:
         return False
     if stat.S_ISFIFO(st.st_mode):
         return True
-    if stat.S_ISCHR(st.st_mode):
-        null = os.stat(os.devnull)
-        if (st.st_rdev == null.st_rdev):
-            return True
-        try:
-            fd = os.open(path, os.O_WRONLY | os.O_NONBLOCK | os.O_NOCTTY)
-        except OSError:
-            return False
-        try:
-            return os.isatty(fd)
-        finally:
-            os.close(fd)
-    return False
+    # told apart by their device numbers, never opened to ask (opening a device can act: a
+    # watchdog starts, a tape rewinds): the null device, the terminals (Linux' majors)
+    return stat.S_ISCHR(st.st_mode) and (st.st_rdev == _NULL_DEVICE or os.major(st.st_rdev) in _TERMINAL_MAJORS)
 
 
 def _check_name_length(path: Path, folder: Path, what: str) -> None:
@@ -113,6 +107,28 @@ def check_output_place(path: PathLike, what: str = "output file", formats: Seque
     return path
 
 
+def check_output_folder(path: PathLike, what: str = "results folder") -> Path:
+    """Refuse, before any work, a folder a command could not create or write into: a file
+    there, a name too long, no writable folder above it (tried with a probe file)."""
+    path = Path(path)
+    shown = repr(str(path)) if any(c in str(path) for c in "\n\r\t") else str(path)
+    _check_name_length(path, path.parent, what)
+    if path.exists() and not path.is_dir():
+        raise SSPError(f"{what} {shown}: exists and is not a folder")
+    existing = path
+    while not existing.exists():  # the folder that will hold the new ones
+        existing = existing.parent
+    if not existing.is_dir():
+        raise SSPError(f"{what} {shown}: {existing} is not a folder")
+    try:
+        fd, probe = tempfile.mkstemp(prefix=".probe.", dir=existing)
+        os.close(fd)
+        os.unlink(probe)
+    except OSError as exc:
+        raise SSPError(f"{what} {shown}: cannot write in {existing} ({exc.strerror or exc})") from None
+    return path
+
+
 @contextmanager
 def atomic_write(path: PathLike, mode: str = "w", **open_kwargs: Any) -> Iterator[IO[Any]]:
     """`with atomic_write(path, "w") as f: f.write(...)`; `mode` "w" (text) or "wb". The file
@@ -161,9 +177,9 @@ class StagedFolder:
 
     def __init__(self, target: PathLike, what: str = "results folder") -> None:
         self.target = Path(target)
+        _check_name_length(self.target, self.target.parent, what)
         if self.target.exists() and not self.target.is_dir():
             raise SSPError(f"{what} {self.target}: exists and is not a folder")
-        _check_name_length(self.target, self.target.parent, what)
         try:
             self.target.parent.mkdir(parents=True, exist_ok=True)
             self.path = Path(tempfile.mkdtemp(prefix=_temporary_prefix(self.target), suffix=".tmp",

@@ -8,7 +8,6 @@ file and line, component or variable); 3 an unexpected error; 130 interrupted by
 143 by SIGTERM, 129 by SIGHUP. A run that fails or is interrupted writes what it had recorded to
 <output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
 """
-import argparse
 import json
 import os
 from pathlib import Path
@@ -22,7 +21,8 @@ import fmpy
 from . import __version__
 from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, flatten, plot, replace
-from .tools.console import add_console_arguments, console_settings, parse_sets
+from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
+                            add_console_arguments, console_settings, parse_sets)
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
@@ -40,16 +40,16 @@ APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": m
 
 
 def _parser():
-    ap = argparse.ArgumentParser(prog="neighbor-cosim", description="Run SSP 1.0 co-simulations of FMI 2.0 FMUs "
+    ap = ArgumentParser(prog="neighbor-cosim", description="Run SSP 1.0 co-simulations of FMI 2.0 FMUs "
                                  "and the NEIGHBOR applications (python -m system_ssp is the same command).")
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a system (.ssp or .ssd), or one FMU alone (.fmu)")
     r.add_argument("path", help="the system (.ssp, or an .ssd in its folder) or one FMU (.fmu)")
-    r.add_argument("--stop-time", type=float, help="seconds (default: the SSD's DefaultExperiment)")
-    r.add_argument("--step-size", type=float,
+    r.add_argument("--stop-time", type=finite_float, help="seconds (default: the SSD's DefaultExperiment)")
+    r.add_argument("--step-size", type=positive_float,
                    help="communication step in s (default: the SSD's master annotation; an nc:Schedule sets its own)")
-    r.add_argument("--start-time", type=float, help="seconds (default: the SSD's DefaultExperiment, else 0)")
+    r.add_argument("--start-time", type=finite_float, help="seconds (default: the SSD's DefaultExperiment, else 0)")
     r.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
                    help="override a parameter or start value (repeatable)")
     r.add_argument("--ssv", action="append", default=[], metavar="FILE",
@@ -64,7 +64,7 @@ def _parser():
                    help="Boolean output that stops the run when true (repeatable)")
     r.add_argument("--output", help="results file: .csv (units in <name>.units.json) or .parquet")
     r.add_argument("--outputs", help="signals to record, comma-separated component.variable")
-    r.add_argument("--record-every", type=int, default=1, help="record a row every N steps (default 1)")
+    r.add_argument("--record-every", type=positive_int, default=1, help="record a row every N steps (default 1)")
     r.add_argument("--print-final", action="store_true", help="print all final values")
     r.add_argument("--plot", metavar="FILE", help="also draw the recorded signals: .png, .svg or .html (interactive)")
     r.add_argument("--report", metavar="FILE.html", help="also write a report: outcome, an interactive figure of the "
@@ -252,10 +252,3 @@ def _run(args, path):
         write_text_atomic(args.report, run_report(result, f"{Path(args.path).name}: {result.stop_reason}", settings))
         print(f"report:      {args.report}")
     return 0
-
-
-def console_main():
-    """Entry point of the `neighbor-cosim` command (and `python -m system_ssp`), through system_ssp.launch."""
-    from .launch import console_main as launch
-
-    launch()

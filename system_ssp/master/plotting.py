@@ -33,34 +33,51 @@ def read_result(path: PathLike) -> Tuple[Dict[str, np.ndarray], Units]:
     """({column: values}, {column: unit or None}) of a result file (CSV with its units sidecar,
     or Parquet), columns in file order, `time` first."""
     path = Path(path)
-    if not path.is_file():
+    if not path.exists():
         raise SSPError(f"{path}: no such result file")
-    if path.suffix.lower() == ".parquet":
-        import pyarrow.parquet as pq
-
-        table = pq.read_table(path)
-        meta = table.schema.metadata or {}
-        units = json.loads(meta.get(b"neighbor-cosim.units", b"{}").decode())
-        columns = {name: table.column(name).to_numpy() for name in table.column_names}
-    else:
-        import csv
-
-        with open(path, newline="") as f:
-            rows = list(csv.reader(f))
-        if not rows or not rows[0]:
-            raise SSPError(f"{path}: empty result file")
-        header = rows[0]
-        try:
-            values = np.array([[float(x) for x in row] for row in rows[1:] if row], dtype=float)
-        except ValueError as exc:
-            raise SSPError(f"{path}: not a result file of numbers ({exc})") from None
-        values = values.reshape(-1, len(header))
-        columns = {name: values[:, i] for i, name in enumerate(header)}
-        sidecar = units_path(path)
-        units = json.loads(sidecar.read_text()) if sidecar.is_file() else {}
+    if not path.is_file():
+        raise SSPError(f"{path}: not a file (expected a result file: .csv or .parquet)")
+    try:
+        columns, units = _read_parquet(path) if path.suffix.lower() == ".parquet" else _read_csv(path)
+    except SSPError:
+        raise
+    except Exception as exc:  # pyarrow's, csv's, json's and the decoder's errors: all say the file is not one
+        raise SSPError(f"{path}: not a result file ({type(exc).__name__}: {str(exc)[:200]})") from None
+    if not isinstance(units, dict):
+        units = {}
     if "time" not in columns:
         raise SSPError(f"{path}: no `time` column (columns: {', '.join(list(columns)[:8])}...)")
     return columns, {name: units.get(name) for name in columns}
+
+
+def _read_parquet(path: Path) -> Tuple[Dict[str, np.ndarray], Any]:
+    import pyarrow.parquet as pq
+
+    table = pq.read_table(path)
+    meta = table.schema.metadata or {}
+    units = json.loads(meta.get(b"neighbor-cosim.units", b"{}").decode())
+    return {name: table.column(name).to_numpy() for name in table.column_names}, units
+
+
+def _read_csv(path: Path) -> Tuple[Dict[str, np.ndarray], Any]:
+    import csv
+
+    with open(path, newline="", encoding="utf-8") as f:
+        rows = list(csv.reader(f))
+    if not rows or not rows[0]:
+        raise SSPError(f"{path}: empty result file")
+    header = rows[0]
+    bad = next((k for k, row in enumerate(rows[1:], 2) if row and len(row) != len(header)), None)
+    if bad is not None:
+        raise SSPError(f"{path}:{bad}: {len(rows[bad - 1])} values, the header has {len(header)} columns")
+    try:
+        values = np.array([[float(x) for x in row] for row in rows[1:] if row], dtype=float)
+    except ValueError as exc:
+        raise SSPError(f"{path}: not a result file of numbers ({exc})") from None
+    values = values.reshape(-1, len(header))
+    sidecar = units_path(path)
+    units = json.loads(sidecar.read_text(encoding="utf-8")) if sidecar.is_file() else {}
+    return {name: values[:, i] for i, name in enumerate(header)}, units
 
 
 def select(names: Sequence[str], patterns: Sequence[str], where: str = "") -> List[str]:
@@ -115,6 +132,7 @@ def plot(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], o
     out = Path(out)
     if out.suffix.lower() not in FORMATS:
         raise SSPError(f"--out {out}: unknown format {out.suffix!r} (expected {', '.join(FORMATS)})")
+    title = "".join(c if c.isprintable() else " " for c in title)  # no font draws a NUL or a line break
     if not signals:
         raise SSPError("nothing to plot: the result has no signal but time")
     groups = panels(signals, units)

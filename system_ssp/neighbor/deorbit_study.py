@@ -16,7 +16,6 @@ Writes into --out: summary.json, table.md (also printed), <scenario>[_no_burn].c
 and altitude_<scenario>.png (semi-major-axis altitude a - R_eq vs time, like the thesis' plots of
 "NEIGHBOR.A - Earth.Radius", with perigee altitude shaded).
 """
-import argparse
 import json
 import math
 from pathlib import Path
@@ -25,7 +24,7 @@ import tempfile
 
 import numpy as np
 
-from components.environment import space_weather
+from components.environment import atmosphere, space_weather
 from components.orbit import propulsion
 from components.core import constants
 from components.core.constants import YEAR
@@ -36,7 +35,8 @@ from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import System, report, write_result
 from ..master.plotting import read_result
 from ..systems import PARAMETERS_DIR
-from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, staged_results
+from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, positive_float,
+                             staged_results)
 
 KM = 1000.0
 SYSTEMS = DEORBIT_SYSTEMS
@@ -64,6 +64,10 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
         raise SSPError(f"unknown scenario(s) {', '.join(unknown)} (expected: {', '.join(THESIS)})")
     if not (isinstance(max_years, (int, float)) and max_years > 0 and math.isfinite(max_years)):
         raise SSPError(f"max_years must be a positive number, got {max_years!r}")
+    if density not in atmosphere.MODELS:  # the FMU would say so only when the first run starts
+        raise SSPError(f"--density {density!r}: expected one of {', '.join(atmosphere.MODELS)}")
+    if space_weather_file not in ("", "thesis") and not Path(space_weather_file).is_file():
+        raise SSPError(f"--space-weather {space_weather_file}: no such file (a CSSI space-weather file, or thesis)")
     ssp = Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"
     if not ssp.is_file():
         raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
@@ -222,7 +226,7 @@ def report_html(summary, folder):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim deorbit-study", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim deorbit-study", description=__doc__.split("\n\n")[0])
     ap.add_argument("--model", choices=list(SYSTEMS), default="averaged",
                     help="orbit fidelity: averaged (default; seconds for a century) or cowell (the full orbit)")
     ap.add_argument("--density", default="jacchia_roberts",
@@ -231,7 +235,7 @@ def main(argv=None):
                     help="CSSI space-weather file (default: the bundled copy), or `thesis`: the stand-in for the "
                     "thesis' file (history to 2023, 130 sfu to 2030, then 75 sfu held; docs/models/orbit.md)")
     ap.add_argument("--scenarios", default=",".join(THESIS), help="comma-separated, e.g. 420km,475km")
-    ap.add_argument("--max-years", type=float, default=150.0,
+    ap.add_argument("--max-years", type=positive_float, default=150.0,
                     help="the longest a run may last before re-entry (default: %(default)s years)")
     ap.add_argument("--out", default="results/deorbit_study", help="results folder (default: %(default)s)")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),

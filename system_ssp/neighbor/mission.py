@@ -24,7 +24,6 @@ It writes into --out:
 written as one unit (replacing an earlier one only when complete); a failed or interrupted run
 leaves <out>.partial with the rows so far and PARTIAL.txt saying why.
 """
-import argparse
 import json
 from pathlib import Path
 import sys
@@ -42,7 +41,8 @@ from ..errors import SSPError
 from ..limits import refuse_over
 from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
-from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets, staged_results
+from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
+                             positive_float, staged_results)
 from . import deorbit_study, propulsion_report, thesis
 
 SYSTEMS = MISSION_SYSTEMS
@@ -486,7 +486,7 @@ def _plot_estimation(plt, d, s, save, legend):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim mission", description=__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO,
                     help="the thesis' de-orbit case (default: %(default)s)")
     ap.add_argument("--orbit", choices=list(SYSTEMS), default="averaged",
@@ -498,7 +498,7 @@ def main(argv=None):
                          "state, and its numbers)")
     ap.add_argument("--out", default="results/mission", help="results folder (default: %(default)s)")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR), help="folder of the built systems")
-    ap.add_argument("--max-years", type=float, default=40.0,
+    ap.add_argument("--max-years", type=positive_float, default=40.0,
                     help="the longest the mission may run before re-entry (default: %(default)s years)")
     ap.add_argument("--profile", action="store_true", help="print the wall time per component")
     ap.add_argument("--timeseries", choices=TIMESERIES_FORMATS, default="parquet",
@@ -566,7 +566,7 @@ def read_mission_summary(path: Path, scenario: str) -> dict:
 def main_propulsion(argv=None):
     """`neighbor-cosim propulsion` (system_ssp.neighbor.propulsion_report): the budget of the worst
     case and of a mission run, read from --mission or run here."""
-    ap = argparse.ArgumentParser(prog="neighbor-cosim propulsion",
+    ap = ArgumentParser(prog="neighbor-cosim propulsion",
                                  description=propulsion_report.__doc__.split("\n\n")[0])
     ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO,
                     help="the thesis' de-orbit case (default: %(default)s)")

@@ -16,7 +16,6 @@ so its printed time counts one step less (664 updates: 9.96 s here, 9.945 s by t
 clock; the thesis prints "about 9.97 s"). Propellant is Eq. 74 over the summed pair firing
 time.
 """
-import argparse
 import math
 import sys
 from dataclasses import dataclass, field
@@ -26,7 +25,7 @@ from pathlib import Path
 from components.core import rotations
 
 from ..master import System
-from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from ..tools.console import ArgumentParser, positive_float, DEFAULT_SSP_DIR, add_console_arguments, console_settings
 
 
 # Published results (thesis Eq. 34, 38, 47, 50, 62, 64, 66 and section 3.3.9), q as printed,
@@ -183,12 +182,12 @@ def report(results, integrator):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim thesis", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim thesis", description=__doc__.split("\n\n")[0])
     ap.add_argument("--integrator", choices=["euler", "rk4"], default="euler",
                     help="the rigid body's integrator: euler (the thesis' Appendix D loop; default) or rk4")
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),
                     help="folder of the built systems (default: %(default)s)")
-    ap.add_argument("--slew-stop-time", type=float, default=None,
+    ap.add_argument("--slew-stop-time", type=positive_float, default=None,
                     help="limit of each slew run in s (default: the SSD's 1500 s, Appendix G)")
     add_console_arguments(ap)
     args = ap.parse_args(argv)

@@ -10,7 +10,6 @@ mission, the worst-case propulsion budget and the de-orbit study (orbit-averaged
 lifetimes), a few minutes in all, prints the table and, with --markdown, rewrites the generated
 block of docs/validation.md.
 """
-import argparse
 from dataclasses import dataclass
 import json
 import math
@@ -25,7 +24,7 @@ from components.mission.neighbor import DEFAULT_SCENARIO
 from ..atomic import write_text_atomic
 from ..errors import SSPError
 from ..master.result import check_output_file
-from ..tools.console import DEFAULT_SSP_DIR, add_console_arguments, console_settings
+from ..tools.console import ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings
 from . import deorbit_study, mission, propulsion_report, thesis
 
 
@@ -306,7 +305,7 @@ def write_markdown(path, ours):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim validation", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim validation", description=__doc__.split("\n\n")[0])
     ap.add_argument("--ssp-dir", default=str(DEFAULT_SSP_DIR),
                     help="folder of the built systems (default: %(default)s)")
     ap.add_argument("--markdown", metavar="FILE", help="rewrite the generated table block of this Markdown file")

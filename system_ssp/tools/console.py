@@ -1,8 +1,10 @@
 """What every command shares, the generic tools and the NEIGHBOR application alike: the console
 options (--progress/--quiet, --log-level), a results folder written as one unit, --set parsing,
 and where `python build_fmus.py` packs the systems."""
+import argparse
 from contextlib import contextmanager
 import logging
+import math
 from pathlib import Path
 import sys
 
@@ -15,6 +17,55 @@ DEFAULT_SSP_DIR = Path(__file__).resolve().parents[2] / "build" / "ssp"
 
 
 LOG_LEVELS = ("error", "warning", "info", "debug")
+
+
+def finite_float(text: str) -> float:
+    """An option's number: finite (NaN, inf refused as the option is read)."""
+    try:
+        value = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r} is not a number") from None
+    if not math.isfinite(value):
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a finite number")
+    return value
+
+
+def positive_float(text: str) -> float:
+    """A duration or a limit: a finite number > 0."""
+    value = finite_float(text)
+    if value <= 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a number > 0")
+    return value
+
+
+def positive_int(text: str) -> int:
+    """A count: a whole number >= 1."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a whole number >= 1") from None
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a whole number >= 1")
+    return value
+
+
+def run_index(text: str) -> int:
+    """A run index: a whole number >= 0."""
+    try:
+        value = int(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a whole number >= 0") from None
+    if value < 0:
+        raise argparse.ArgumentTypeError(f"{text!r}: expected a whole number >= 0")
+    return value
+
+
+class ArgumentParser(argparse.ArgumentParser):
+    """argparse's parser whose refusal is one line (not the usage and then the error), exit 2,
+    like every other refusal of the commands."""
+
+    def error(self, message):
+        self.exit(2, f"error: {self.prog}: {message} (--help shows the options)\n")
 
 
 def add_console_arguments(ap, progress=True):

@@ -11,7 +11,6 @@ system's parameter connectors, their connections and the system-level bindings (
 for a component's variable directly goes into that component's binding too). The result runs
 the same in any host; what it loses is the single place to change a value.
 """
-import argparse
 from pathlib import Path
 import tempfile
 
@@ -24,6 +23,7 @@ from ..master.names import split_name
 from ..master.parameters import collect_parameters
 from ..ssp.reader import NS, NS_SSV
 from .replace import _pack, _unpack
+from .console import ArgumentParser
 
 
 def flatten_system_parameters(source, out):
@@ -109,7 +109,7 @@ def _fold(root, system_name, comp_el, params):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim flatten", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim flatten", description=__doc__.split("\n\n")[0])
     ap.add_argument("system", help=".ssp, .ssd or a folder with SystemStructure.ssd")
     ap.add_argument("--out", required=True, help="the flattened system (.ssp)")
     args = ap.parse_args(argv)

@@ -6,17 +6,17 @@ sidecar, or a Parquet file (units in its metadata). SIGNALs are `component.varia
 shell-style globs (`dynamics.q_BN*`, `*.omega_BN_B[[]1]`); none: every column (see
 system_ssp.master.plotting).
 """
-import argparse
 from pathlib import Path
 import sys
 from typing import Optional, Sequence
 
 from ..atomic import check_output_place
 from ..master.plotting import FORMATS, default_signals, plot, read_result, select
+from .console import ArgumentParser
 
 
 def main(argv: Optional[Sequence[str]] = None) -> int:
-    ap = argparse.ArgumentParser(prog="neighbor-cosim plot", description=__doc__.split("\n\n")[0])
+    ap = ArgumentParser(prog="neighbor-cosim plot", description=__doc__.split("\n\n")[0])
     ap.add_argument("result", help="a result file: .csv (with its .units.json) or .parquet")
     ap.add_argument("signals", nargs="*", help="component.variable names or globs (default: every column)")
     ap.add_argument("--out", help="the figure: .png (default: beside RESULT), .svg, or .html (interactive, one file)")

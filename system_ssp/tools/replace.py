@@ -18,7 +18,6 @@ Like OMSimulator's replaceSubModel, but nothing is written unless the new FMU fi
 A refusal (`ReplaceRefused`) lists every mismatch: the connector or parameter, what the system
 needs, what the new FMU has.
 """
-import argparse
 from dataclasses import asdict, dataclass, field
 import json
 import os
@@ -38,6 +37,7 @@ from ..ssp import reader
 from ..ssp.interface import FmuInterface, compare, unit_conversion
 from ..ssp.reader import NS, NS_SSC, NS_SSV
 from ..ssp.units import SI_BASE_UNITS
+from .console import ArgumentParser
 
 
 class ReplaceRefused(SSPError):
@@ -198,7 +198,7 @@ class _Replacement:
 
     def __init__(self, root, ssd, component, new, source):
         self.root, self.ssd, self.component, self.new, self.source = root, ssd, component, new, source
-        self.tree = etree.parse(str(ssd))
+        self.tree = reader.load_xml(ssd, "ssd", reader.FileNamer(root, str(source))).getroottree()
         self.system = self.tree.getroot().find("ssd:System", NS)
         self.comps = {c.get("name"): c for c in self.system.findall("ssd:Elements/ssd:Component", NS)}
         if component not in self.comps:
@@ -453,7 +453,7 @@ def compare_text(a, b):
 
 
 def main_replace(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim replace", description="Replace one component's FMU in an SSP "
+    ap = ArgumentParser(prog="neighbor-cosim replace", description="Replace one component's FMU in an SSP "
                                  "system, checked against its connections, units, annotation and parameters.")
     ap.add_argument("system", help=".ssp, .ssd or a folder with SystemStructure.ssd")
     ap.add_argument("component", help="the component (instance) name")
@@ -467,7 +467,7 @@ def main_replace(argv=None):
 
 
 def main_compare(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim compare", description="The differences between two FMUs' "
+    ap = ArgumentParser(prog="neighbor-cosim compare", description="The differences between two FMUs' "
                                  "interfaces (inputs, outputs, parameters: name, causality, type, unit).")
     ap.add_argument("a", help="the first FMU (.fmu)")
     ap.add_argument("b", help="the FMU to compare it with (.fmu)")

@@ -89,10 +89,16 @@ def test_find_cycle_finds_one():
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
+# The command's first code installs its signal handlers and only then imports the command line
+# (a second of numpy, fmpy, lxml): the one import that must wait for a function to run (the
+# package's __init__ gives the master's names on first use for the same reason, by importlib).
+DEFERRED = {("system_ssp.launch", "system_ssp.cli")}
+
+
 def test_no_project_import_inside_a_function():
     modules = project_modules()
     hidden = [f"{path.relative_to(REPO)}:{line} imports {t}" for name, path in modules.items()
-              for t, line, inside in imports_of(name, path, modules) if inside]
+              for t, line, inside in imports_of(name, path, modules) if inside and (name, t) not in DEFERRED]
     assert hidden == []
 
 

@@ -17,10 +17,10 @@ thread each); with --scheduler any running Dask cluster (dask-jobqueue on SLURM/
 A run that fails or passes timeout_s is a row with its status and error; a worker process that
 dies (an FMU that crashes it) is restarted by its nanny and its run recorded as failed.
 """
-import argparse
 from collections import Counter
 from html import escape
 import json
+import logging
 import math
 import os
 from pathlib import Path
@@ -36,14 +36,14 @@ import time
 import numpy as np
 
 from ... import __version__
-from ...atomic import atomic_write, write_text_atomic
+from ...atomic import atomic_write, check_output_folder, write_text_atomic
 from ...errors import SSPError
 from ...master import System, report
 from ...master.plan import RunOptions
 from ...master.names import near, split_name
 from ...master.planning import make_plan
 from ...master.plotting import TIME_UNITS, read_result
-from ..console import add_console_arguments, console_settings
+from ..console import ArgumentParser, positive_int, run_index, add_console_arguments, console_settings
 from .spec import load_spec
 from . import worker as worker_module
 from .worker import run_batch, run_one
@@ -230,7 +230,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     if not hasattr(spec, "inputs"):
         spec = load_spec(spec)
     units = check_against_system(spec)  # before the folder is touched and before any run
-    out = Path(out)
+    out = check_output_folder(out, "--out")
     done = {r["run"] for r in _read_rows(out)} if (out / "runs").is_dir() else set()
     todo = [i for i in range(spec.total_runs) if i not in done]
     client = cluster = None
@@ -245,6 +245,11 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
         if client is not None:
             print(f"campaign {spec.path}: {spec.total_runs} runs of {spec.system.name} into {out}", file=sys.stderr)
             _run(client, spec, out, todo, columns, progress, as_completed, batch)
+    except BaseException:
+        # stopped (Ctrl-C, SIGTERM, an error): the scheduler's and nannies' reports of the runs
+        # cancelled under them are not news; what finished is kept and the runner says why
+        logging.getLogger("distributed").setLevel(logging.CRITICAL + 1)  # off, its CRITICAL "closed comm" too
+        raise
     finally:
         if client is not None:
             client.close()
@@ -574,15 +579,15 @@ def rerun(spec, index, out):
 
 
 def main(argv=None):
-    ap = argparse.ArgumentParser(prog="neighbor-cosim campaign", description="Run a parameter sweep or Monte Carlo "
+    ap = ArgumentParser(prog="neighbor-cosim campaign", description="Run a parameter sweep or Monte Carlo "
                                  "campaign on Dask (see docs/campaigns.md).")
     ap.add_argument("spec", help="the campaign spec (TOML)")
     ap.add_argument("--out", required=True, help="results folder (the same spec into the same folder resumes)")
-    ap.add_argument("--workers", type=int, help="local worker processes (default: the machine's cores)")
+    ap.add_argument("--workers", type=positive_int, help="local worker processes (default: the machine's cores)")
     ap.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786) instead")
-    ap.add_argument("--batch", type=int, default=1,
+    ap.add_argument("--batch", type=positive_int, default=1,
                     help="runs per Dask task (default 1; more for runs shorter than a second)")
-    ap.add_argument("--rerun", type=int, metavar="N",
+    ap.add_argument("--rerun", type=run_index, metavar="N",
                     help="run N alone, here, with the values it had in the campaign; its recorded signals (the "
                          "metrics' and keep_timeseries') go to DIR/rerun/run-N.parquet")
     add_console_arguments(ap)

@@ -1,6 +1,7 @@
 """One campaign run, as a Dask worker executes it: the system is loaded once per worker process
 and reused by every run the worker gets (no per-run extraction, schema check or compilation);
 the run's values come from the spec and its index alone; any failure becomes a row."""
+import logging
 import math
 import os
 import signal
@@ -25,6 +26,8 @@ def dask_setup(worker):
     which closes the workers itself (and its nannies kill a worker that does not close)."""
     for sig in (signal.SIGINT, signal.SIGTERM, signal.SIGHUP):
         signal.signal(sig, signal.SIG_IGN)
+    # its warnings (a run cancelled when the runner stops) are not the user's news; errors are
+    logging.getLogger("distributed").setLevel(logging.ERROR)
 
 
 def _scratch():
