@@ -156,6 +156,8 @@ def main(argv=None):
     except Terminated as exc:
         print(f"interrupted ({signal.Signals(exc.signum).name})", file=sys.stderr)
         return 128 + exc.signum
+    except SystemExit as exc:  # argparse's refusal (one line, see ArgumentParser), --help, --version
+        return exc.code if isinstance(exc.code, int) else (0 if exc.code is None else 2)
     except BrokenPipeError:  # the reader went away (| head): not an error of ours
         sys.stdout = open(os.devnull, "w")
         return 0

@@ -214,10 +214,7 @@ def test_every_command_works_or_refuses_in_one_line(files, tmp_path_factory, dat
                 m.setattr(system_module, "execute", work)  # after the run's plan (its checks), before a step
                 m.setattr(runner, "_client", work)
                 m.setattr(runner, "run_one", work)
-            try:
-                code = cli.main(argv)
-            except SystemExit as exc:  # argparse: a refusal of the options
-                code = exc.code
+            code = cli.main(argv)
         left = os.listdir(scratch)
     finally:
         tempfile.tempdir = saved

@@ -142,7 +142,7 @@ def test_results_folder_units_and_modes(run):
 
 @pytest.mark.parametrize("args, pattern", [
     (["--out", "/proc/mission"], "results folder /proc/mission: cannot write in /proc"),
-    (["--max-years", "0"], "--max-years 0: must be a positive number of years"),
+    (["--max-years", "0"], "argument --max-years: '0': expected a number > 0"),
 ])
 def test_mission_command_refuses_before_the_run(ssp_paths, tmp_path, capsys, args, pattern):
     """Refused in one line, exit 2, before the system is even loaded (before: an unwritable --out
