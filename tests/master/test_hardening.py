@@ -376,6 +376,19 @@ def test_signal_to_a_campaigns_process_group_leaves_no_traceback_and_no_debris(s
     assert subprocess.run(["pgrep", "-f", str(spec)], capture_output=True).stdout == b""
 
 
+def test_finished_campaign_leaves_nothing_in_tmpdir(ssp_paths, tmp_path):
+    """Before: every campaign left $TMPDIR/dask-scratch-space behind."""
+    tmpdir = tmp_path / "tmp"
+    tmpdir.mkdir()
+    spec = tmp_path / "c.toml"
+    spec.write_text(LONG_CAMPAIGN.format(system=ssp_paths["detumble"]).replace("runs = 5000", "runs = 4")
+                    .replace("stop_time = 60.0", "stop_time = 1.0"))
+    proc = subprocess.run([sys.executable, "-m", "system_ssp", "campaign", str(spec), "--out", str(tmp_path / "out"),
+                           "--workers", "2", "--quiet"], capture_output=True, text=True, env=_env(tmpdir), timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    assert list(tmpdir.iterdir()) == []
+
+
 def _rows(out):
     import pyarrow.parquet as pq
 

@@ -150,16 +150,16 @@ def _client(workers, scheduler):
                            f"({type(exc).__name__}); start one (dask scheduler) or leave out --scheduler for workers "
                            "on this machine") from None
     n = workers or os.cpu_count() or 1
-    # Ctrl-C reaches every process of the terminal's group: the workers ignore it and SIGTERM (their
-    # preload, worker.dask_setup), so that only this process sees it and shuts them down, without
-    # their tracebacks. The cluster's scratch space (Dask's and the extracted systems) is one
-    # temporary folder, removed after the cluster closes, also when a worker was killed.
+    # Ctrl-C reaches every process of the terminal's group: the workers ignore it (and SIGTERM,
+    # SIGHUP: their preload, worker.dask_setup), so that only this process sees it and shuts them
+    # down, without their tracebacks. The cluster's scratch space (Dask's and the extracted
+    # systems) is one temporary folder, removed after the cluster closes, also when a worker was killed.
     scratch = tempfile.mkdtemp(prefix="neighbor_campaign_")
-    dask.config.set({"temporary-directory": scratch})
     _start_resource_tracker()
     try:
-        cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
-                               local_directory=scratch, preload=[worker_module.__name__])
+        with dask.config.set({"temporary-directory": scratch}):
+            cluster = LocalCluster(n_workers=n, threads_per_worker=1, processes=True, dashboard_address=":0",
+                                   local_directory=scratch, preload=[worker_module.__name__])
     except BaseException:
         shutil.rmtree(scratch, ignore_errors=True)
         raise
