@@ -24,7 +24,7 @@ class Limit:
 
 
 LIMITS: Dict[str, Limit] = {limit.name: limit for limit in (
-    Limit("max_runs", 1_000_000, "runs of one campaign (campaign.runs, or the product of its sweeps)"),
+    Limit("max_runs", 1_000_000, "runs of one campaign (campaign.runs times its sweep points)"),
     Limit("max_vector_elements", 100_000, "elements of one vector dispersion (`elements = n`)"),
     Limit("max_spec_bytes", 10 * 2**20, "size of a campaign spec or a mission summary file"),
     Limit("max_archive_members", 100_000, "members of one .ssp or .fmu archive"),
