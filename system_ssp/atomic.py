@@ -82,7 +82,7 @@ def check_output_place(path: PathLike, what: str = "output file", formats: Seque
     device other than a stream (see is_stream), a name longer than the file system takes, no file
     creatable in the folder (tried). Every command checks its output files with this."""
     path = Path(path)
-    shown = repr(str(path)) if any(c in str(path) for c in "\n\r\t") else str(path)
+    shown = _shown(path)
     folder = path.parent if str(path.parent) else Path(".")
     if formats and path.suffix.lower() not in formats:
         raise SSPError(f"{what} {shown}: unknown format {path.suffix!r} (expected {' or '.join(formats)})")
@@ -98,20 +98,30 @@ def check_output_place(path: PathLike, what: str = "output file", formats: Seque
     if path.exists() and not path.is_file():
         raise SSPError(f"{what} {shown}: is a device or another special file; write to a regular file, a FIFO, a "
                        f"terminal or {os.devnull}")
+    _probe(folder, f"{what} {shown}")
+    return path
+
+
+def _shown(path: Path) -> str:
+    """A path for a one-line message: quoted when it holds a line break or a tab."""
+    return repr(str(path)) if any(c in str(path) for c in "\n\r\t") else str(path)
+
+
+def _probe(folder: Path, where: str) -> None:
+    """Refuse (naming `where`) a folder in which no file can be created: tried, not guessed."""
     try:
-        fd, probe = tempfile.mkstemp(prefix=_temporary_prefix(path), suffix=".probe", dir=folder)
+        fd, probe = tempfile.mkstemp(prefix=".probe.", dir=folder)
         os.close(fd)
         os.unlink(probe)
     except OSError as exc:
-        raise SSPError(f"{what} {shown}: cannot write in {folder} ({exc.strerror or exc})") from None
-    return path
+        raise SSPError(f"{where}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
 def check_output_folder(path: PathLike, what: str = "results folder") -> Path:
     """Refuse, before any work, a folder a command could not create or write into: a file
     there, a name too long, no writable folder above it (tried with a probe file)."""
     path = Path(path)
-    shown = repr(str(path)) if any(c in str(path) for c in "\n\r\t") else str(path)
+    shown = _shown(path)
     _check_name_length(path, path.parent, what)
     if path.exists() and not path.is_dir():
         raise SSPError(f"{what} {shown}: exists and is not a folder")
@@ -120,12 +130,7 @@ def check_output_folder(path: PathLike, what: str = "results folder") -> Path:
         existing = existing.parent
     if not existing.is_dir():
         raise SSPError(f"{what} {shown}: {existing} is not a folder")
-    try:
-        fd, probe = tempfile.mkstemp(prefix=".probe.", dir=existing)
-        os.close(fd)
-        os.unlink(probe)
-    except OSError as exc:
-        raise SSPError(f"{what} {shown}: cannot write in {existing} ({exc.strerror or exc})") from None
+    _probe(existing, f"{what} {shown}")
     return path
 
 

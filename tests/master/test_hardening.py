@@ -316,13 +316,29 @@ def test_two_commands_committing_the_same_results_folder_take_turns(tmp_path):
 
 
 # ---- 7. signals at start-up ------------------------------------------------------------------
-@pytest.mark.parametrize("delay", [0.05, 0.15, 0.3])
+def _catches_sighup(pid):
+    """True once the process catches SIGHUP: system_ssp.launch's first act (Python itself does not)."""
+    try:
+        status = Path(f"/proc/{pid}/status").read_text()
+    except OSError:
+        return False
+    caught = int(next(line.split()[1] for line in status.splitlines() if line.startswith("SigCgt:")), 16)
+    return bool(caught & (1 << (signal.SIGHUP - 1)))
+
+
+@pytest.mark.parametrize("delay", [0.0, 0.05, 0.15, 0.3])
 def test_ctrl_c_during_startup_is_one_line_and_exit_130(ssp_paths, tmp_path, delay):
+    """Ctrl-C `delay` s after the command's first code ran, while it imports numpy, fmpy, lxml and
+    the models (about a second). Before the interpreter reaches that code no program can help it."""
     tmpdir = tmp_path / "tmp"
     tmpdir.mkdir()
     proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "run", str(ssp_paths["detumble"]), "--stop-time",
                              "1", "--no-progress"], stdout=subprocess.PIPE, stderr=subprocess.PIPE, text=True,
                             env=_env(tmpdir))
+    deadline = time.monotonic() + 30
+    while not (started := _catches_sighup(proc.pid)) and proc.poll() is None and time.monotonic() < deadline:
+        time.sleep(0.001)
+    assert started, "the command did not install its signal handlers as its first code"
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)

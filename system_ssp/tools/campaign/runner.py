@@ -593,8 +593,6 @@ def main(argv=None):
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
-    if args.workers is not None and args.workers < 1:
-        raise SSPError(f"--workers {args.workers}: expected a number >= 1")
     if args.scheduler is not None:
         check_scheduler_address(args.scheduler)
     spec = load_spec(args.spec)
