@@ -22,7 +22,7 @@ from . import __version__
 from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, flatten, plot, replace
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
-                            add_console_arguments, console_settings, parse_sets)
+                            add_console_arguments, console_settings, parse_sets, system_path)
 from .errors import RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
@@ -45,7 +45,8 @@ def _parser():
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a system (.ssp or .ssd), or one FMU alone (.fmu)")
-    r.add_argument("path", help="the system (.ssp, or an .ssd in its folder) or one FMU (.fmu)")
+    r.add_argument("path", help="the system (.ssp, or an .ssd in its folder; or a built system's name, e.g. "
+                   "detumble) or one FMU (.fmu)")
     r.add_argument("--stop-time", type=finite_float, help="seconds (default: the SSD's DefaultExperiment)")
     r.add_argument("--step-size", type=positive_float,
                    help="communication step in s (default: the SSD's master annotation; an nc:Schedule sets its own)")
@@ -77,7 +78,7 @@ def _parser():
     add_console_arguments(r)
     i = sub.add_parser("info", help="describe a system (.ssp/.ssd) or an FMU: every variable, where parameters "
                        "are bound")
-    i.add_argument("path", help="a system (.ssp, .ssd) or an FMU (.fmu)")
+    i.add_argument("path", help="a system (.ssp, .ssd, or a built system's name) or an FMU (.fmu)")
     i.add_argument("--json", action="store_true", help="the same as JSON, for tools")
     i.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
@@ -187,6 +188,7 @@ def _say_partial(exc):
 
 def _run_or_info(argv):
     args = _parser().parse_args(argv)
+    args.path = system_path(args.path)
     if args.command == "info" and args.path.lower().endswith(".fmu"):
         fmu = FmuInterface.read(args.path)
         print(json.dumps(fmu.as_dict(), indent=1) if args.json else describe_fmu(fmu))

@@ -19,6 +19,20 @@ DEFAULT_SSP_DIR = Path(__file__).resolve().parents[2] / "build" / "ssp"
 LOG_LEVELS = ("error", "warning", "info", "debug")
 
 
+def system_path(name: str) -> str:
+    """A system named on the command line: a path as given when one exists there, else a bare
+    name (no folder, no suffix) of a built system, DEFAULT_SSP_DIR/<name>.ssp; SSPError listing
+    the built ones when it is neither."""
+    if Path(name).exists() or Path(name).suffix or "/" in name or not name:
+        return name
+    built = DEFAULT_SSP_DIR / f"{name}.ssp"
+    if built.is_file():
+        return str(built)
+    have = sorted(p.stem for p in DEFAULT_SSP_DIR.glob("*.ssp"))
+    raise SSPError(f"{name}: no such file, and no built system of that name in {DEFAULT_SSP_DIR} "
+                   + (f"(built: {', '.join(have)})" if have else "(build them: python build_fmus.py)"))
+
+
 def finite_float(text: str) -> float:
     """An option's number: finite (NaN, inf refused as the option is read)."""
     try:

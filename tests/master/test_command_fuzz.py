@@ -37,7 +37,8 @@ def files(ssp_paths, fmu_paths, tmp_path_factory):
     root = tmp_path_factory.mktemp("fuzz_inputs")
     f = {"ssp": ssp_paths["detumble"], "slew_ssp": ssp_paths["slew"], "fmu": fmu_paths["Gyro"],
          "fmu2": fmu_paths["RigidBody"], "missing": root / "missing.ssp", "folder": root / "folder",
-         "proc": Path("/proc/self/status"), "null": root / "null"}
+         "proc": Path("/proc/self/status"), "null": root / "null",
+         "by_name": Path("detumble"), "unknown_name": Path("nosuch")}  # built systems by name
     f["folder"].mkdir()
     os.mknod(f["null"], stat.S_IFCHR | 0o666, os.makedev(1, 3))
     for name, data in {"empty.ssp": b"", "garbage.ssp": RANDOM.randbytes(2000), "garbage.fmu": RANDOM.randbytes(2000),
@@ -102,8 +103,8 @@ def _options(data, table, label):
     return argv
 
 
-SYSTEMS = ("ssp", "slew_ssp", "fmu", "missing", "folder", "empty.ssp", "garbage.ssp", "garbage.ssd", "damaged.ssp",
-           "proc", "null", "text.csv")
+SYSTEMS = ("ssp", "slew_ssp", "by_name", "unknown_name", "fmu", "missing", "folder", "empty.ssp", "garbage.ssp",
+           "garbage.ssd", "damaged.ssp", "proc", "null", "text.csv")
 
 
 def command_line(data, files, out):

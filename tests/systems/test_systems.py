@@ -204,3 +204,17 @@ def test_sun_avoidance_guidance_refuses_a_start_away_from_the_dynamics(ssp_paths
             system.run(parameters={"dynamics.q0[1]": 0.3}, stop_time=1.0)
         r = system.run(stop_time=1.0)
         assert r.stop_reason == "reached stop time"
+
+
+def test_built_systems_are_found_by_name(ssp_paths, tmp_path, capsys, monkeypatch):
+    """Issue 31 (part): `run detumble` / `info slew` from any folder; an unknown name lists the built ones."""
+    from system_ssp import cli
+
+    monkeypatch.chdir(tmp_path)
+    assert cli.main(["run", "detumble", "--stop-time", "0.03", "--quiet"]) == 0
+    assert "steps:       2 (h = 0.015 s" in capsys.readouterr().out
+    assert cli.main(["info", "slew"]) == 0
+    assert "slew.ssp" in capsys.readouterr().out
+    assert cli.main(["info", "nosuch"]) == 2
+    err = capsys.readouterr().err
+    assert "nosuch: no such file, and no built system of that name" in err and "detumble, " in err
