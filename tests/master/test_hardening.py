@@ -104,6 +104,14 @@ def test_probability_over_a_text_metric_or_a_bad_number_is_refused_before_any_ru
     assert not (tmp_path / "out").exists()
 
 
+def test_choice_of_mixed_types_is_refused_at_load(tmp_path, capsys):
+    # before: the runs ran, then writing their rows failed (ArrowTypeError, exit 3)
+    tail = '[dispersions."dynamics.omega0[1]"]\ndistribution = "choice"\nvalues = [1, "x", true]\n'
+    line = refused(capsys, "campaign", _spec(tmp_path, tail=tail), "--out", tmp_path / "out")
+    assert "values = [1, 'x', True]: expected numbers only, true/false only or strings only" in line
+    assert not (tmp_path / "out").exists()
+
+
 def test_scheduler_address_garbage_or_nobody_there_is_refused(ssp_paths, tmp_path, capsys):
     spec = _spec(tmp_path)
     line = refused(capsys, "campaign", spec, "--out", tmp_path / "out", "--scheduler", "garb age::")

@@ -274,6 +274,15 @@ def _dispersions(path, name, d, helper):
     return [_dispersion(path, f"{name}[{i}]", rest, helper) for i in range(1, n + 1)]
 
 
+def _value_kind(value):
+    """'number', 'boolean' or 'string' (None for a table or a list, which no parameter takes)."""
+    if isinstance(value, bool):
+        return "boolean"
+    if isinstance(value, (int, float)):
+        return "number"
+    return "string" if isinstance(value, str) else None
+
+
 def _dispersion(path, name, d, helper):
     key = f"dispersions.{name!r}"
     if not isinstance(d, dict) or "distribution" not in d:
@@ -293,6 +302,10 @@ def _dispersion(path, name, d, helper):
     if kind == "choice":
         if not isinstance(d["values"], list) or not d["values"]:
             raise SSPError(f"{path}: {key}.values: expected a non-empty list")
+        kinds = {_value_kind(v) for v in d["values"]}
+        if len(kinds) != 1 or None in kinds:  # one column of the results, one type of the parameter
+            raise SSPError(f"{path}: {key}.values = {d['values']!r:.100}: expected numbers only, true/false only or "
+                           "strings only")
         args = {"values": list(d["values"])}
     else:
         args = {k: _number(path, f"{key}.{k}", d[k], integer=kind == "integers") for k in need}
