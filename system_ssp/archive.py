@@ -43,12 +43,13 @@ def _bad_name(name: str) -> str:
 def check_members(z: zipfile.ZipFile, display: str) -> List[zipfile.ZipInfo]:
     """The members of `z` once their names, kinds and sizes are checked (nothing read yet)."""
     members = z.infolist()
-    if len(members) > limit("max_archive_members"):
+    most_members, most_bytes, ratio = (limit(name) for name in ("max_archive_members", "max_archive_bytes",
+                                                                 "max_compression_ratio"))
+    if len(members) > most_members:
         raise SSPError(f"{display}: {len(members):,} archive members, over the limit of "
-                       f"{limit('max_archive_members'):,} (set {LIMITS['max_archive_members'].variable} to allow more)")
+                       f"{most_members:,} (set {LIMITS['max_archive_members'].variable} to allow more)")
     seen = set()
     total = 0
-    ratio = limit("max_compression_ratio")
     for m in members:
         why = _bad_name(m.filename)
         if why:
@@ -66,8 +67,8 @@ def check_members(z: zipfile.ZipFile, display: str) -> List[zipfile.ZipInfo]:
             raise SSPError(f"{display}: archive member {m.filename!r} unpacks {m.compress_size:,} bytes to "
                            f"{m.file_size:,}, a ratio over the limit of {ratio:,} (a zip bomb?; set "
                            f"{LIMITS['max_compression_ratio'].variable} to allow more)")
-    if total > limit("max_archive_bytes"):
-        raise SSPError(f"{display}: unpacks to {total:,} bytes, over the limit of {limit('max_archive_bytes'):,} "
+    if total > most_bytes:
+        raise SSPError(f"{display}: unpacks to {total:,} bytes, over the limit of {most_bytes:,} "
                        f"(set {LIMITS['max_archive_bytes'].variable} to allow more)")
     return members
 

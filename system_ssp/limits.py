@@ -7,6 +7,7 @@ variable that raises (or lowers) it, e.g. `NEIGHBOR_COSIM_MAX_RUNS=50000000 neig
 The README's Errors section lists them (a test keeps it equal to LIMITS)."""
 from dataclasses import dataclass
 import os
+from pathlib import Path
 from typing import Dict
 
 from .errors import SSPError
@@ -57,6 +58,20 @@ def refuse_over(name: str, value: float, what: str) -> None:
         shown = f"{value:,}" if isinstance(value, int) else f"{value:,.0f}"
         raise SSPError(f"{what}: {shown} is over the limit of {most:,} {LIMITS[name].what.split(' (')[0]} "
                        f"(set {LIMITS[name].variable} to allow more)")
+
+
+def read_text_input(path: Path, where: str, kind: str, hint: str) -> str:
+    """The UTF-8 text of a small input file (a campaign spec, a mission summary), its size bounded
+    by max_spec_bytes; SSPError beginning with `where` (the file, or the option and the file):
+    cannot read `kind`, too big, or not UTF-8 (with the line and the byte, then `hint`)."""
+    try:
+        refuse_over("max_spec_bytes", path.stat().st_size, f"{where}: {kind}'s size in bytes")
+        return path.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise SSPError(f"{where}: cannot read {kind} ({exc.strerror or exc})") from None
+    except UnicodeDecodeError as exc:
+        line = exc.object[:exc.start].count(b"\n") + 1
+        raise SSPError(f"{where}:{line}: not UTF-8 text (byte {exc.object[exc.start]:#04x}); {hint}") from None
 
 
 def markdown_table() -> str:

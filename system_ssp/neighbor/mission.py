@@ -38,7 +38,7 @@ from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS
 
 from ..atomic import atomic_write, check_output_place, write_text_atomic
 from ..errors import SSPError
-from ..limits import refuse_over
+from ..limits import read_text_input
 from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
@@ -535,15 +535,10 @@ PROPELLANT_KEYS = {"burn_propellant_kg": 1.0, "detumble_propellant_g": 1e-3, "sl
 def read_mission_summary(path: Path, scenario: str) -> dict:
     """A mission's summary.json, checked: a JSON object of `scenario`, its propellant numbers
     finite, >= 0 and below the spacecraft's mass (SSPError naming the file and key otherwise)."""
+    text = read_text_input(path, f"--mission {path}", "the mission summary",
+                           "expected the summary.json of a mission run")
     try:
-        size = path.stat().st_size
-        refuse_over("max_spec_bytes", size, f"--mission {path} (bytes)")
-        summary = json.loads(path.read_text(encoding="utf-8"))
-    except OSError as err:
-        raise SSPError(f"--mission {path}: cannot read it ({err.strerror or err})") from None
-    except UnicodeDecodeError as err:
-        raise SSPError(f"--mission {path}: not UTF-8 text (byte {err.object[err.start]:#04x} at {err.start}): "
-                       "expected the summary.json of a mission run") from None
+        summary = json.loads(text)
     except ValueError as err:
         raise SSPError(f"--mission {path}: not JSON ({err}): expected the summary.json of a mission run") from None
     if not isinstance(summary, dict):

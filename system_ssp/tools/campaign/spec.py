@@ -13,7 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
-from ...limits import refuse_over
+from ...limits import read_text_input, refuse_over
 from ..console import DEFAULT_SSP_DIR
 
 if sys.version_info >= (3, 11):
@@ -155,15 +155,8 @@ def _runs(path, value):
 def load_spec(path):
     """Read and check a campaign spec; SSPError naming the file, the key and what is allowed."""
     path = Path(path)
-    try:
-        refuse_over("max_spec_bytes", path.stat().st_size, f"{path}: the campaign spec's size in bytes")
-        text = path.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise SSPError(f"{path}: cannot read the campaign spec ({exc.strerror or exc})") from None
-    except UnicodeDecodeError as exc:
-        line = exc.object[:exc.start].count(b"\n") + 1
-        raise SSPError(f"{path}:{line}: not UTF-8 text (byte {exc.object[exc.start]:#04x}); a campaign spec is TOML, "
-                       "which is UTF-8: save it as UTF-8") from None
+    text = read_text_input(path, str(path), "the campaign spec",
+                           "a campaign spec is TOML, which is UTF-8: save it as UTF-8")
     try:
         doc = tomllib.loads(text)
     except tomllib.TOMLDecodeError as exc:
