@@ -117,13 +117,22 @@ def _probe(folder: Path, where: str) -> None:
         raise SSPError(f"{where}: cannot write in {folder} ({exc.strerror or exc})") from None
 
 
+def _exists_as_non_folder(path: Path) -> bool:
+    """One stat, not exists() then is_dir(): another command committing the same folder renames
+    it away and back in between, which two calls could see as 'exists and is not a folder'."""
+    try:
+        return not stat.S_ISDIR(os.stat(path).st_mode)
+    except OSError:  # missing (or under a file): the later steps say what is wrong
+        return False
+
+
 def check_output_folder(path: PathLike, what: str = "results folder") -> Path:
     """Refuse, before any work, a folder a command could not create or write into: a file
     there, a name too long, no writable folder above it (tried with a probe file)."""
     path = Path(path)
     shown = _shown(path)
     _check_name_length(path, path.parent, what)
-    if path.exists() and not path.is_dir():
+    if _exists_as_non_folder(path):
         raise SSPError(f"{what} {shown}: exists and is not a folder")
     existing = path
     while not existing.exists():  # the folder that will hold the new ones
@@ -183,7 +192,7 @@ class StagedFolder:
     def __init__(self, target: PathLike, what: str = "results folder") -> None:
         self.target = Path(target)
         _check_name_length(self.target, self.target.parent, what)
-        if self.target.exists() and not self.target.is_dir():
+        if _exists_as_non_folder(self.target):
             raise SSPError(f"{what} {self.target}: exists and is not a folder")
         try:
             self.target.parent.mkdir(parents=True, exist_ok=True)
