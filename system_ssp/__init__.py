@@ -1,6 +1,6 @@
 """system_ssp: a co-simulation master for flat SSP 1.0 systems of FMI 2.0 co-simulation FMUs.
 
-    result = system_ssp.simulate("build/ssp/detumble.ssp", stop_time=20.0)
+    result = system_ssp.simulate("detumble", stop_time=20.0)   # a shipped system by name, or a path
     options = system_ssp.RunOptions(parameter_sets=["parameters/slew_case2.ssv"], outputs=["dynamics.q_BN[4]"])
     with system_ssp.System("build/ssp/slew.ssp") as system:   # load once, run many times
         r = system.run(options, observers=[my_observer])        # keywords: a shorthand for RunOptions fields

@@ -1,16 +1,15 @@
-"""Build every FMU under fmus/ and pack every system under system_ssp/systems/.
+"""The builder: every FMU under fmus/ and every system under system_ssp/systems/, built into the
+build folder (system_ssp.locations: build/ in a checkout, else the user's data folder).
 
-    python build_fmus.py            # rebuild what changed
-    python build_fmus.py --clean    # rebuild everything
-    python build_fmus.py --check    # also run fmpy's validation on every FMU
-    python build_fmus.py --compat   # also write the compatibility bundle (build/compat/<Model>/)
+    neighbor-cosim build [--clean] [--check] [--compat]   # python build_fmus.py in a checkout
 
-FMUs: each `fmus/neighbor_*.py` wrapper becomes `build/fmus/<ClassName>.fmu`:
+FMUs: each `fmus/neighbor_*.py` wrapper becomes `<build>/fmus/<ClassName>.fmu`:
 - modelDescription.xml: pythonfmu's, from the wrapper's declarations, completed here from what
   pythonfmu cannot write (`NeighborSlave.fmu_meta`): `unit` on every Real that has one, with
   `UnitDefinitions` in SI base-unit exponents; `ModelStructure/Outputs` with each output's real
   `dependencies` and `InitialUnknowns`; `canGetAndSetFMUstate` where the wrapper captures the
-  model's full state. The GUID is derived from the code, so the same code gives the same FMU.
+  model's full state. The GUID is derived from the product version and the code, so the same
+  code of the same version gives the same FMU; `version` is the product's.
 - binaries/<platform>/<ClassName>.so|.dll: the runtime (fmus/runtime/neighbor_fmi2.c),
   compiled here with gcc (linux64) and, when it is installed, mingw-w64 (win64).
 - resources/neighbor_runtime.py and .txt: the loader the binary runs and what it needs to know
@@ -21,18 +20,19 @@ FMUs: each `fmus/neighbor_*.py` wrapper becomes `build/fmus/<ClassName>.fmu`:
   authoring classes. The target needs Python and numpy only (docs/interoperability.md).
 A built FMU must pass `fmpy.validation.validate_fmu` or the build fails.
 
-SSPs: each `system_ssp/systems/<name>.ssd` becomes `build/ssp/<name>.ssp` with the SSD as
+SSPs: each `system_ssp/systems/<name>.ssd` becomes `<build>/ssp/<name>.ssp` with the SSD as
 SystemStructure.ssd (a component's several parameter bindings merged into one, which libcosim
 needs), every .ssv/.ssm it references, the scenario parameter sets named
 `parameters/<name>_*.ssv`, and the FMUs its components use under resources/.
 
 Only what changed is rebuilt: an FMU is rebuilt when its wrapper, a support module, the runtime,
-anything in components/ or this script changes; an SSP when its SSD, parameter files or FMUs
+anything in components/ or this module changes; an SSP when its SSD, parameter files or FMUs
 change. Outputs are written to a temporary file and renamed, so an interrupted build never
-leaves a truncated FMU or SSP behind.
+leaves a truncated FMU or SSP behind; two processes building into one folder take turns.
 """
-import argparse
 import ast
+from contextlib import contextmanager
+import fcntl
 import hashlib
 import importlib
 import inspect
@@ -54,17 +54,14 @@ from fmpy.validation import validate_fmu
 from lxml import etree
 import pythonfmu
 
-from system_ssp import __version__
-from system_ssp.atomic import atomic_write, write_text_atomic
-from system_ssp.ssp.reader import NS_SSD, NS_SSV
-from system_ssp.ssp.units import BUILTIN, base_unit_attributes
+from .atomic import atomic_write, write_text_atomic
+from .errors import SSPError
+from .locations import BUILD, COMPONENTS, FMU_SOURCES, ROOT, SYSTEM_SOURCES as SYSTEMS, system_names
+from .ssp.reader import NS_SSD, NS_SSV
+from .ssp.units import BUILTIN, base_unit_attributes
+from .version import __version__
 
-ROOT = Path(__file__).resolve().parent
-FMU_SOURCES = ROOT / "fmus"
 RUNTIME = FMU_SOURCES / "runtime"
-COMPONENTS = ROOT / "components"
-SYSTEMS = ROOT / "system_ssp" / "systems"
-BUILD = ROOT / "build"
 STATE_FILE = BUILD / "build-state.json"
 
 
@@ -72,10 +69,18 @@ class BuildError(RuntimeError):
     pass
 
 
+def _shown(path):
+    """A path as the digests and messages name it: relative to the sources or the build folder."""
+    for base in (ROOT, BUILD):
+        if path.is_relative_to(base):
+            return path.relative_to(base).as_posix()
+    return str(path)
+
+
 def _digest(paths):
     h = hashlib.sha256()
     for p in sorted(paths):
-        h.update(str(p.relative_to(ROOT)).encode())
+        h.update(_shown(p).encode())
         h.update(p.read_bytes())
     return h.hexdigest()
 
@@ -185,7 +190,7 @@ PLATFORMS = {  # FMI platform folder: (compiler, file suffix, extra flags)
     "linux64": ("gcc", ".so", ["-fPIC", "-fvisibility=hidden", "-ldl"]),
     "win64": ("x86_64-w64-mingw32-gcc", ".dll", ["-static-libgcc"]),
 }
-_compiled = {}
+_compiled: dict = {}  # {runtime digest: {platform: binary path}}
 
 
 def compile_runtime(out_dir=None):
@@ -369,7 +374,7 @@ def build_fmu(script, dest_dir):
     code_digest.update(RUNTIME_LOADER.read_bytes())
     package = f"nc_{cls.__name__.lower()}_{code_digest.hexdigest()[:12]}"
     files["__init__.py"] = f'"""{cls.__name__}: this FMU build\'s private package."""\n'.encode()
-    guid = str(uuid.uuid5(uuid.NAMESPACE_URL, f"https://neighbor-cosim.org/fmu/{package}"))
+    guid = str(uuid.uuid5(uuid.NAMESPACE_URL, f"https://neighbor-cosim.org/fmu/{__version__}/{package}"))
     instance.guid = guid
     options = {"needsExecutionTool": "false", "canGetAndSetFMUstate": cls.can_get_and_set_state}
     xml = ET.tostring(instance.to_xml(options), encoding="utf-8")
@@ -485,7 +490,21 @@ def _save_state(state):
 
 
 def build_all(clean=False, verbose=True):
-    """Build what changed; returns (fmu paths, ssp paths)."""
+    """Build what changed; returns (fmu paths, ssp paths). Two processes building at once (two
+    commands that each found the systems missing) take turns on a lock in the build folder."""
+    BUILD.mkdir(parents=True, exist_ok=True)
+    with _build_lock():
+        return _build_all(clean, verbose)
+
+
+@contextmanager
+def _build_lock():
+    with open(BUILD / ".build.lock", "a+") as lock:
+        fcntl.flock(lock.fileno(), fcntl.LOCK_EX)
+        yield
+
+
+def _build_all(clean, verbose):
     state = {} if clean else _load_state()
 
     def refresh(key, digest, target, make, verb):
@@ -493,7 +512,7 @@ def build_all(clean=False, verbose=True):
         if state.get(key) == digest and target.is_file():
             return target
         if verbose:
-            print(f"{verb} {target.relative_to(ROOT)}", flush=True)
+            print(f"{verb} {_shown(target)}", flush=True)
         made = make()
         state[key] = digest
         _save_state(state)
@@ -522,37 +541,28 @@ def build_all(clean=False, verbose=True):
     return fmus, ssps
 
 
-def main(argv=None):
-    parser = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
-    parser.add_argument("--clean", action="store_true", help="rebuild every FMU and SSP")
-    parser.add_argument("--check", action="store_true", help="run fmpy validation on every FMU after building")
-    parser.add_argument("--compat", action="store_true",
-                        help="write each FMU's compatibility information (the FMI cross-check's layout: the FMU, "
-                             "its reference result and options, a README) into build/compat/<Model>/")
-    args = parser.parse_args(argv)
+def resolve_system(name):
+    """The file of a system named by the user: the path as given when it exists; a bare name (no
+    folder, no suffix) of a shipped system, <build>/ssp/<name>.ssp. A shipped system's packed file
+    in the build folder that is missing is built first, with one line on stderr: a wheel
+    installed without a build builds them on the first command that needs them, once per version.
+    Anything else missing: SSPError (for a bare name, listing the systems there are)."""
+    path = Path(name)
+    if path.exists():
+        return path
+    bare = bool(name) and not path.suffix and "/" not in str(name) and os.sep not in str(name)
+    if bare:
+        if str(name) not in system_names():
+            raise SSPError(f"{name}: no such file, and no system of that name (systems: {', '.join(system_names())})")
+        path = BUILD / "ssp" / f"{name}.ssp"
+        if path.is_file():
+            return path
+    elif path.suffix != ".ssp" or path.stem not in system_names() or path.parent.resolve() != (BUILD / "ssp").resolve():
+        raise SSPError(f"{path}: file not found")
+    print(f"neighbor-cosim: the FMUs and systems are not built yet; building them into {BUILD} "
+          "(once per version, under a minute; `neighbor-cosim build` does it ahead)", file=sys.stderr, flush=True)
     try:
-        fmus, ssps = build_all(clean=args.clean)
+        build_all(verbose=False)
     except BuildError as exc:
-        print(f"build_fmus: error: {exc}", file=sys.stderr)
-        return 1
-    if args.check:
-        from fmpy.validation import validate_fmu
-
-        bad = {f.name: validate_fmu(str(f)) for f in fmus}
-        bad = {k: v for k, v in bad.items() if v}
-        for name, problems in bad.items():
-            print(f"{name}: {'; '.join(problems)}", file=sys.stderr)
-        if bad:
-            return 1
-    print(f"{len(fmus)} FMUs in {BUILD / 'fmus'}, {len(ssps)} systems in {BUILD / 'ssp'}")
-    if args.compat:
-        from system_ssp.tools.compat import write_bundle
-
-        for fmu in fmus:
-            write_bundle(fmu, BUILD / "compat")
-        print(f"compatibility information for {len(fmus)} FMUs in {BUILD / 'compat'}")
-    return 0
-
-
-if __name__ == "__main__":
-    sys.exit(main())
+        raise SSPError(f"building the systems into {BUILD} failed: {exc}") from None
+    return path

@@ -1,6 +1,6 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `replace`, `compare`, `flatten`, `campaign`, `thesis`, `deorbit-study`, `mission`, `propulsion` and
-`validation`, and `--version`.
+`info`, `replace`, `compare`, `flatten`, `campaign`, `thesis`, `deorbit-study`, `mission`, `propulsion`,
+`validation`, `build` and `export`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
@@ -20,7 +20,7 @@ import fmpy
 
 from . import __version__
 from .neighbor import deorbit_study, mission, thesis, validation
-from .tools import campaign, flatten, plot, replace
+from .tools import campaign, flatten, plot, release, replace
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
                             add_console_arguments, console_settings, parse_sets, system_path)
 from .errors import RunInterrupted, SimulationError, SSPError
@@ -36,7 +36,8 @@ from .ssp.writer import single_fmu_system
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
         "replace": replace.main_replace, "compare": replace.main_compare, "flatten": flatten.main,
         "campaign": campaign.main, "plot": plot.main,
-        "propulsion": mission.main_propulsion, "validation": validation.main}
+        "propulsion": mission.main_propulsion, "validation": validation.main, "build": release.build_main,
+        "export": release.export_main}
 
 
 def _parser():
@@ -102,6 +103,11 @@ def _parser():
     sub.add_parser("validation", add_help=False,
                    help="every published thesis number the product reproduces: published, ours, difference, "
                    "tolerance, and the test that guards it")
+    sub.add_parser("build", add_help=False,
+                   help="build every FMU and pack every system into the build folder (the first command that "
+                   "needs them does it too)")
+    sub.add_parser("export", add_help=False,
+                   help="every FMU, system, compatibility information and reference page as one versioned archive")
     return ap
 
 

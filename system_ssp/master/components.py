@@ -46,7 +46,8 @@ def load_components(desc, extract_root, namer, validate):
         if not decl.fmu_path.is_file():
             raise SSPError(f"{decl.origin}: component {decl.name!r}: FMU file not found "
                            f"(source={decl.source!r}, tried {namer(decl.fmu_path)}); the product's "
-                           "systems are packed with their FMUs by `python build_fmus.py` into build/ssp/")
+                           "systems are packed with their FMUs into the build folder by `neighbor-cosim build` (python "
+                           "build_fmus.py in a checkout); name one by its name, e.g. `detumble`")
         unzipdir = str(archive.extract(decl.fmu_path, extract_root / f"{i}_{decl.name}",
                                        f"component {decl.name!r}: {namer(decl.fmu_path)}"))
         try:

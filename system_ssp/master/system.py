@@ -8,7 +8,7 @@ import tempfile
 import time
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
-from .. import archive
+from .. import archive, builder
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
@@ -31,7 +31,9 @@ class System:
     """A loaded SSP system. Call `run()` any number of times; each run uses fresh FMU instances.
 
     `path` is a `.ssp` archive (SystemStructure.ssd at its root), a `.ssd` file (references
-    resolved relative to its folder) or a folder holding SystemStructure.ssd. Loading checks the
+    resolved relative to its folder), a folder holding SystemStructure.ssd, or the name of a
+    shipped system (`"slew"`: the packed one in the build folder, built first if it is not
+    there, see system_ssp.locations). Loading checks the
     SSD, SSV and SSM files against the SSP 1.0 schemas (`validate`), reads every FMU's model
     description, extracts the FMUs, resolves the connections with their unit conversions and
     the direct-feedthrough graph. Use as a context manager (or call `close()`) to delete the
@@ -42,7 +44,7 @@ class System:
         tmp = Path(tempfile.mkdtemp(prefix="system_ssp_", dir=scratch))
         self._tmp: Optional[Path] = tmp
         try:
-            self._load(Path(path), validate, tmp)
+            self._load(builder.resolve_system(str(path)), validate, tmp)
         except BaseException:
             self.close()
             raise
@@ -51,8 +53,6 @@ class System:
         self.path = path
         self.validate = validate
         self.archive_root = None
-        if not path.exists():
-            raise SSPError(f"{path}: file not found")
         if path.is_dir():
             ssd_path = path / "SystemStructure.ssd"
             self.namer = reader.FileNamer()

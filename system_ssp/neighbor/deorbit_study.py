@@ -31,6 +31,7 @@ from components.core.constants import YEAR
 from components.mission.neighbor import DEORBIT_RECORD, DEORBIT_SYSTEMS, SCENARIOS, scenario_set
 
 from ..atomic import atomic_write, write_text_atomic
+from ..builder import resolve_system
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import System, report, write_result
 from ..master.plotting import read_result
@@ -68,9 +69,7 @@ def run_study(model="averaged", density="jacchia_roberts", scenarios=None, ssp_d
         raise SSPError(f"--density {density!r}: expected one of {', '.join(atmosphere.MODELS)}")
     if space_weather_file not in ("", "thesis") and not Path(space_weather_file).is_file():
         raise SSPError(f"--space-weather {space_weather_file}: no such file (a CSSI space-weather file, or thesis)")
-    ssp = Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"
-    if not ssp.is_file():
-        raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
+    ssp = resolve_system(str(Path(ssp_dir) / f"{SYSTEMS[model]}.ssp"))  # built first if it is a missing default
     with staged_results(out, lambda err: f"{err.run}.partial.csv") as staged, \
             tempfile.TemporaryDirectory(prefix="neighbor_sw_") as tmp:
         if space_weather_file == "thesis":  # written beside the results, so the run can be repeated

@@ -37,6 +37,7 @@ from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS
                                          SCENARIOS as DEFINED_SCENARIOS, SPACECRAFT, scenario_set)
 
 from ..atomic import atomic_write, check_output_place, write_text_atomic
+from ..builder import resolve_system
 from ..errors import SSPError
 from ..limits import read_text_input
 from ..master import System, report, write_result
@@ -88,9 +89,7 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         raise SSPError(f"unknown orbit model {orbit!r} (expected one of: {', '.join(SYSTEMS)})")
     if scenario not in SCENARIOS:
         raise SSPError(f"unknown scenario {scenario!r} (expected one of: {', '.join(SCENARIOS)})")
-    ssp = Path(ssp_dir) / f"{SYSTEMS[orbit]}.ssp"
-    if not ssp.is_file():
-        raise SSPError(f"{ssp} not found: build it first with `python build_fmus.py`")
+    ssp = resolve_system(str(Path(ssp_dir) / f"{SYSTEMS[orbit]}.ssp"))  # built first if it is a missing default
     if not (max_years > 0 and np.isfinite(max_years)):
         raise SSPError(f"--max-years {max_years:g}: must be a positive number of years (the longest the mission "
                        "may run before re-entry)")

@@ -141,7 +141,7 @@ def run_cases(ssp_dir=DEFAULT_SSP_DIR, integrator="euler", slew_stop_time=None, 
     ssp_dir = Path(ssp_dir)
     wanted = set(cases or ("detumble_case1", "detumble_case2", "slew_case1", "slew_case2", "slew_case3"))
     out = {}
-    with System(ssp_dir / "detumble.ssp") as detumble, System(ssp_dir / "slew.ssp") as slew:
+    with System(ssp_dir / "detumble.ssp") as detumble, System(ssp_dir / "slew.ssp") as slew:  # built if missing
         ends = {}
         for k in (1, 2):
             if {f"detumble_case{k}", f"slew_case{k}"} & wanted or (k == 1 and "slew_case3" in wanted):

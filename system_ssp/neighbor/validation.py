@@ -22,6 +22,7 @@ from typing import Any, Dict
 from components.mission.neighbor import DEFAULT_SCENARIO
 
 from ..atomic import write_text_atomic
+from ..builder import resolve_system
 from ..errors import SSPError
 from ..master.result import check_output_file
 from ..tools.console import ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings
@@ -313,8 +314,7 @@ def main(argv=None):
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
-    if not (Path(args.ssp_dir) / "detumble.ssp").is_file():
-        raise SSPError(f"{args.ssp_dir}/detumble.ssp not found: build the systems first with `python build_fmus.py`")
+    resolve_system(str(Path(args.ssp_dir) / "detumble.ssp"))  # built first if it is a missing default
     # the places the results go, checked before the two-minute run (they used to fail after it)
     if args.markdown:
         check_output_file(args.markdown, "--markdown", (".md", ".markdown"))

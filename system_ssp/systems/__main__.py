@@ -14,11 +14,10 @@ from pathlib import Path
 import sys
 import tempfile
 
+from ..locations import FMU_DIR as DEFAULT_FMU_DIR
 from ..ssp.writer import GeneratorError, SystemWriter
 from . import SYSTEMS_DIR
 from .generators import GENERATORS, generate_all
-
-DEFAULT_FMU_DIR = SYSTEMS_DIR.parents[1] / "build" / "fmus"
 
 
 def committed_files(directory):

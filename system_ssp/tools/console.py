@@ -1,36 +1,30 @@
 """What every command shares, the generic tools and the NEIGHBOR application alike: the console
 options (--progress/--quiet, --log-level), a results folder written as one unit, --set parsing,
-and where `python build_fmus.py` packs the systems."""
+and where the built systems are."""
 import argparse
 from contextlib import contextmanager
 import logging
 import math
-from pathlib import Path
 import sys
 
 from ..atomic import StagedFolder
+from ..builder import resolve_system
+from ..locations import SSP_DIR
 from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..master import write_result
 
-# Where `python build_fmus.py` packs the systems, in a source checkout (the documented install).
-DEFAULT_SSP_DIR = Path(__file__).resolve().parents[2] / "build" / "ssp"
+# Where the builder packs the systems (build/ssp in a checkout; see system_ssp.locations).
+DEFAULT_SSP_DIR = SSP_DIR
 
 
 LOG_LEVELS = ("error", "warning", "info", "debug")
 
 
 def system_path(name: str) -> str:
-    """A system named on the command line: a path as given when one exists there, else a bare
-    name (no folder, no suffix) of a built system, DEFAULT_SSP_DIR/<name>.ssp; SSPError listing
-    the built ones when it is neither."""
-    if Path(name).exists() or Path(name).suffix or "/" in name or not name:
-        return name
-    built = DEFAULT_SSP_DIR / f"{name}.ssp"
-    if built.is_file():
-        return str(built)
-    have = sorted(p.stem for p in DEFAULT_SSP_DIR.glob("*.ssp"))
-    raise SSPError(f"{name}: no such file, and no built system of that name in {DEFAULT_SSP_DIR} "
-                   + (f"(built: {', '.join(have)})" if have else "(build them: python build_fmus.py)"))
+    """A system named on the command line: a path as given, or the name of a shipped system (its
+    packed file in the build folder, built first when missing); SSPError listing the systems
+    when it is neither (system_ssp.builder.resolve_system)."""
+    return str(resolve_system(name))
 
 
 def finite_float(text: str) -> float:

@@ -17,14 +17,12 @@ from fmpy import read_model_description
 from lxml import etree
 
 from ..atomic import write_text_atomic
+from ..locations import FMU_DIR as BUILD_FMUS, FMU_SOURCES, ROOT
 from ..ssp.interface import FmuInterface
 from ..ssp.reader import NS
 from ..systems import SYSTEMS_DIR
 
-REPO = Path(__file__).resolve().parents[2]
-FMU_SOURCES = REPO / "fmus"
-BUILD_FMUS = REPO / "build" / "fmus"
-DOCS = REPO / "docs" / "fmus"
+DOCS = ROOT / "docs" / "fmus"  # in a checkout
 
 
 def wrappers():
@@ -48,7 +46,7 @@ def users():
     return out
 
 
-def _cell(text):
+def table_cell(text):
     return (text or "").replace("|", "\\|").replace("\n", " ")
 
 
@@ -81,7 +79,8 @@ def page(fmu_path, wrapper, used_in):
             if v.min is not None or v.max is not None:
                 rng = f"[{v.min if v.min is not None else '-inf'}, {v.max if v.max is not None else 'inf'}]"
             cells = {"name": f"`{v.name}`", "type": v.type, "unit": v.unit or "", "start": v.start or "",
-                     "range": rng, "description": _cell(v.description), "depends directly on": deps.get(v.name, "")}
+                     "range": rng, "description": table_cell(v.description),
+                     "depends directly on": deps.get(v.name, "")}
             lines.append("| " + " | ".join(cells[h] for h in header) + " |")
         lines.append("")
     return "\n".join(lines)
@@ -101,7 +100,7 @@ def generate(fmu_dir=BUILD_FMUS):
         name = path.stem
         pages[f"{name}.md"] = page(path, wrap.get(name), used.get(path.name, []))
         desc = read_model_description(str(path), validate=False).description or ""
-        index.append(f"| [{name}]({name}.md) | {_cell(desc)} | {len(used.get(path.name, []))} systems |")
+        index.append(f"| [{name}]({name}.md) | {table_cell(desc)} | {len(used.get(path.name, []))} systems |")
     pages["README.md"] = "\n".join(index + [""])
     return {k: v if v.endswith("\n") else v + "\n" for k, v in pages.items()}
 

@@ -207,7 +207,7 @@ def test_sun_avoidance_guidance_refuses_a_start_away_from_the_dynamics(ssp_paths
 
 
 def test_built_systems_are_found_by_name(ssp_paths, tmp_path, capsys, monkeypatch):
-    """Issue 31 (part): `run detumble` / `info slew` from any folder; an unknown name lists the built ones."""
+    """Issue 31: `run detumble` / `info slew` from any folder; an unknown name lists the systems."""
     from system_ssp import cli
 
     monkeypatch.chdir(tmp_path)
@@ -217,4 +217,4 @@ def test_built_systems_are_found_by_name(ssp_paths, tmp_path, capsys, monkeypatc
     assert "slew.ssp" in capsys.readouterr().out
     assert cli.main(["info", "nosuch"]) == 2
     err = capsys.readouterr().err
-    assert "nosuch: no such file, and no built system of that name" in err and "detumble, " in err
+    assert "nosuch: no such file, and no system of that name (systems: " in err and "detumble, " in err

@@ -14,7 +14,8 @@ import numpy as np
 
 from ...errors import SSPError
 from ...limits import read_text_input, refuse_over
-from ..console import DEFAULT_SSP_DIR
+from ... import builder
+from ...locations import system_names
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -336,11 +337,13 @@ def _metric(path, name, m):
 
 
 def resolve_system(name, spec_path):
-    """A campaign's system: a path (relative to the spec's folder or the working directory), or
-    the name of a built system (build/ssp/<name>.ssp)."""
-    for candidate in (Path(name), Path(spec_path).parent / name, DEFAULT_SSP_DIR / f"{name}.ssp",
-                      DEFAULT_SSP_DIR / name):
+    """A campaign's system: a path (relative to the working directory or the spec's folder), or
+    the name of a shipped system (its packed file in the build folder, built first if missing)."""
+    for candidate in (Path(name), Path(spec_path).parent / name):
         if candidate.exists():
             return candidate.resolve()
-    raise SSPError(f"{spec_path}: campaign.system = {name!r}: no such file here, beside the spec or in "
-                   f"{DEFAULT_SSP_DIR} (build the systems with python build_fmus.py)")
+    try:
+        return builder.resolve_system(Path(name).stem if Path(name).suffix == ".ssp" else name).resolve()
+    except SSPError:
+        raise SSPError(f"{spec_path}: campaign.system = {name!r}: no such file here or beside the spec, and no "
+                       f"system of that name (systems: {', '.join(system_names())})") from None
