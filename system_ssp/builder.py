@@ -171,7 +171,7 @@ def complete_model_description(xml_bytes, meta, can_get_set_state, starts):
     return b'<?xml version="1.0" encoding="UTF-8"?>\n' + ET.tostring(root, encoding="utf-8")
 
 
-def _atomic_zip(dest, entries):
+def write_zip(dest, entries):
     """Write {archive name: bytes} as a zip through a temporary file. Fixed dates, so that the same
     inputs give the same archive, and normal permissions: 0644, 0755 for binaries."""
     dest.parent.mkdir(parents=True, exist_ok=True)
@@ -387,7 +387,7 @@ def build_fmu(script, dest_dir):
     for platform, binary in compile_runtime().items():
         entries[f"binaries/{platform}/{cls.__name__}{binary.suffix}"] = binary.read_bytes()
     dest = dest_dir / f"{cls.__name__}.fmu"
-    _atomic_zip(dest, entries)
+    write_zip(dest, entries)
     problems = validate_fmu(str(dest))
     if problems:
         dest.unlink()
@@ -473,7 +473,7 @@ def pack_ssp(ssd, fmu_dir, dest_dir):
         entries[ref] = (ssd.parent / ref).read_bytes()
     for f in fmus:
         entries[f"resources/{f}"] = (fmu_dir / f).read_bytes()
-    _atomic_zip(dest, entries)
+    write_zip(dest, entries)
     return dest
 
 

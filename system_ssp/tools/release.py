@@ -22,7 +22,7 @@ import fmpy
 from fmpy.validation import validate_fmu
 
 from .. import builder
-from ..atomic import atomic_write, check_output_folder
+from ..atomic import check_output_folder
 from ..errors import SSPError
 from ..locations import BUILD, COMPAT_DIR, ROOT, is_checkout
 from ..version import __version__
@@ -160,14 +160,8 @@ def export(out_dir, progress=None):
         fmu_table=_fmu_table(fmus), platforms=" and ".join(sorted(platforms))).encode("utf-8")
     files["SHA256SUMS"] = "".join(f"{hashlib.sha256(data).hexdigest()}  {name}\n"
                                   for name, data in sorted(files.items())).encode()
-    out_dir.mkdir(parents=True, exist_ok=True)
     target = out_dir / f"{top}.zip"
-    with atomic_write(target, "wb") as f, zipfile.ZipFile(f, "w", zipfile.ZIP_DEFLATED) as z:
-        for name in sorted(files):
-            member = zipfile.ZipInfo(f"{top}/{name}", date_time=(2026, 1, 1, 0, 0, 0))
-            member.compress_type = zipfile.ZIP_DEFLATED
-            member.external_attr = 0o644 << 16
-            z.writestr(member, files[name])
+    builder.write_zip(target, {f"{top}/{name}": data for name, data in files.items()})
     return target
 
 
