@@ -563,6 +563,14 @@ def resolve_system(name):
           "(once per version, under a minute; `neighbor-cosim build` does it ahead)", file=sys.stderr, flush=True)
     try:
         build_all(verbose=False)
-    except BuildError as exc:
-        raise SSPError(f"building the systems into {BUILD} failed: {exc}") from None
+    except (BuildError, OSError) as exc:
+        raise SSPError(f"building the systems into {BUILD} failed: {build_failure(exc)}") from None
     return path
+
+
+def build_failure(exc):
+    """A build failure in words; a folder it cannot write says how to choose another."""
+    if isinstance(exc, OSError):
+        return (f"{exc.filename or BUILD}: {exc.strerror or exc} (NEIGHBOR_COSIM_BUILD=DIR builds into another "
+                "folder)")
+    return str(exc)

@@ -93,8 +93,8 @@ def build_main(argv=None):
     args = parser.parse_args(argv)
     try:
         fmus, ssps = builder.build_all(clean=args.clean)
-    except builder.BuildError as exc:
-        print(f"error: build: {exc}", file=sys.stderr)
+    except (builder.BuildError, OSError) as exc:
+        print(f"error: build: {builder.build_failure(exc)}", file=sys.stderr)
         return 1
     if args.check:
         bad = {f.name: validate_fmu(str(f)) for f in fmus}
@@ -175,8 +175,8 @@ def export_main(argv=None):
     args = parser.parse_args(argv)
     try:
         target = export(args.out, progress=lambda text: print(text, file=sys.stderr, flush=True))
-    except builder.BuildError as exc:
-        raise SSPError(f"building the FMUs and systems failed: {exc}") from None
+    except (builder.BuildError, OSError) as exc:
+        raise SSPError(f"building the FMUs and systems failed: {builder.build_failure(exc)}") from None
     with zipfile.ZipFile(target) as z:
         count = sum(1 for n in z.namelist() if n.endswith(".fmu") and "/fmus/" in n)
         systems = sum(1 for n in z.namelist() if n.endswith(".ssp"))

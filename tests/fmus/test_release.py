@@ -4,6 +4,7 @@ bundle (`neighbor-cosim export`). The wheel itself is installed and run outside 
 .ci/wheel."""
 import hashlib
 import os
+from pathlib import Path
 import shutil
 import subprocess
 import sys
@@ -28,7 +29,8 @@ def command(*args, env=None, cwd=None):
 
 def test_build_folder_is_the_checkouts_or_the_one_named():
     """build/ in a checkout; NEIGHBOR_COSIM_BUILD wins everywhere."""
-    assert locations.is_checkout() and locations.BUILD == REPO / "build"
+    chosen = os.environ.get("NEIGHBOR_COSIM_BUILD")
+    assert locations.is_checkout() and locations.BUILD == (Path(chosen).resolve() if chosen else REPO / "build")
     probe = "from system_ssp import locations; print(locations.BUILD)"
     out = subprocess.run([sys.executable, "-c", probe], capture_output=True, text=True,
                          env={**os.environ, "NEIGHBOR_COSIM_BUILD": "/tmp/somewhere/else"}).stdout
@@ -64,6 +66,20 @@ def test_a_missing_system_is_built_on_first_use(built, tmp_path):
     assert sorted(p.stem for p in (folder / "ssp").glob("*.ssp")) == locations.system_names()
     again = command("info", "slew", env=env, cwd=tmp_path)
     assert again.returncode == 0 and again.stderr == ""
+
+
+def test_a_build_folder_that_cannot_be_written_is_one_line(tmp_path):
+    """The build folder under a file: the command that would build says so in one line (exit 2;
+    `build` exits 1 like a failed build) and names the way out."""
+    blocker = tmp_path / "file"
+    blocker.write_text("")
+    env = {"NEIGHBOR_COSIM_BUILD": str(blocker / "build")}
+    for args, code in ((("run", "detumble"), 2), (("build",), 1)):
+        proc = command(*args, env=env, cwd=tmp_path)
+        last = proc.stderr.strip().splitlines()[-1]
+        assert proc.returncode == code, proc.stderr
+        assert str(blocker / "build") in last and "NEIGHBOR_COSIM_BUILD=DIR builds into another folder" in last
+    assert blocker.read_text() == ""
 
 
 def test_guid_and_version_carry_the_product_version(build_one, tmp_path, monkeypatch):
