@@ -2,12 +2,14 @@
 name (built on first use), the FMUs' GUID and version from the product version, and the release
 bundle (`neighbor-cosim export`). The wheel itself is installed and run outside the checkout by
 .ci/wheel."""
+import fcntl
 import hashlib
 import os
 from pathlib import Path
 import shutil
 import subprocess
 import sys
+import time
 import zipfile
 
 import fmpy
@@ -48,14 +50,20 @@ def test_systems_by_name_in_the_api(ssp_paths):
         builder.resolve_system("nowhere/slew.ssp")
 
 
-def test_a_missing_system_is_built_on_first_use(built, tmp_path):
-    """A build folder whose FMUs are there but whose systems are not: the first command that
-    needs one builds what is missing, says so in one line, and runs; the next says nothing."""
+def _fmus_built_systems_not(tmp_path):
+    """A build folder with this session's FMUs (and build state) but no packed systems."""
     folder = tmp_path / "build"
     folder.mkdir()
     for part in ("fmus", "runtime"):
         shutil.copytree(locations.BUILD / part, folder / part)
     shutil.copy(locations.BUILD / "build-state.json", folder)
+    return folder
+
+
+def test_a_missing_system_is_built_on_first_use(built, tmp_path):
+    """A build folder whose FMUs are there but whose systems are not: the first command that
+    needs one builds what is missing, says so in one line, and runs; the next says nothing."""
+    folder = _fmus_built_systems_not(tmp_path)
     env = {"NEIGHBOR_COSIM_BUILD": str(folder)}
     first = command("run", "detumble", "--stop-time", "0.03", "--quiet", env=env, cwd=tmp_path)
     assert first.returncode == 0, first.stderr
@@ -66,6 +74,26 @@ def test_a_missing_system_is_built_on_first_use(built, tmp_path):
     assert sorted(p.stem for p in (folder / "ssp").glob("*.ssp")) == locations.system_names()
     again = command("info", "slew", env=env, cwd=tmp_path)
     assert again.returncode == 0 and again.stderr == ""
+
+
+def test_a_command_that_finds_a_build_under_way_waits_for_it(built, tmp_path):
+    """Two commands that find the systems missing at once (two terminals, two campaign clients)
+    take turns on the build folder's lock: while another holds it, nothing is packed; once it is
+    released the waiting command builds, runs, and every packed system is whole."""
+    folder = _fmus_built_systems_not(tmp_path)
+    env = {**os.environ, "NEIGHBOR_COSIM_BUILD": str(folder)}
+    with open(folder / ".build.lock", "a+") as lock:
+        fcntl.flock(lock.fileno(), fcntl.LOCK_EX)  # another build under way
+        proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "info", "slew"], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.PIPE, text=True, env=env, cwd=tmp_path)
+        assert "not built yet" in proc.stderr.readline()  # it is about to build
+        time.sleep(5.0)  # unlocked, it would have packed systems by now (about one a second here)
+        assert proc.poll() is None and not list(folder.glob("ssp/*.ssp"))
+    assert proc.wait(timeout=300) == 0, proc.stderr.read()
+    assert sorted(p.name for p in (folder / "ssp").iterdir()) == [f"{n}.ssp" for n in locations.system_names()]
+    for ssp in folder.glob("ssp/*.ssp"):
+        with zipfile.ZipFile(ssp) as z:
+            assert z.testzip() is None and "SystemStructure.ssd" in z.namelist()
 
 
 def test_a_build_folder_that_cannot_be_written_is_one_line(tmp_path):
