@@ -11,6 +11,8 @@ from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallCl
 from .observers import Observer, ProgressBar, Profiler, Recorder, RunView, StepInfo, StopConditions
 from .result import Result
 
+DISCARD = 2  # fmi2Discard: a co-simulation FMU that could not complete the step (or ended the simulation)
+
 
 def execute(system, plan, progress=False, timeout=None, observers=()):
     """Run `plan` on `system` with fresh FMU instances; returns a Result (wall_time 0: the
@@ -25,6 +27,9 @@ def execute(system, plan, progress=False, timeout=None, observers=()):
             table.initialize()
             return run.loop(progress, watch, timeout, observers)
         except StepFailed as f:
+            ended = table.terminated_at(f.ci) if (f.call, f.status) == ("fmi2DoStep", DISCARD) else None
+            if ended is not None:
+                return run.ended_by(f.ci, ended)
             err = table.error(f.ci, f.call, status=f.status, names=f.names)
             err.result = run.partial(f"failed at t={table.t:g} s")
             raise err from None
@@ -52,7 +57,7 @@ class _Run:
 
     def __init__(self, system, plan, table):
         self.system, self.plan, self.table = system, plan, table
-        self.recorder = self.info = None
+        self.recorder = self.info = self.algorithm = None
 
     def loop(self, progress: bool, watch: SignalWatch, timeout: Optional[float] = None,
              callers: Sequence[Observer] = ()) -> Result:
@@ -78,7 +83,7 @@ class _Run:
             observers.append(WallClockLimit(timeout))
         observers.append(Interruption(watch))  # last: the row of this step is recorded first
         info = StepInfo(plan.start, plan.record_every)
-        self.recorder, self.info = recorder, info
+        self.recorder, self.info, self.algorithm = recorder, info, algorithm
         algorithm.start(info)
         try:
             for obs in observers:
@@ -93,6 +98,19 @@ class _Run:
         reason = f"stop condition {info.fired} at t={info.t:g} s" if info.fired is not None else "reached stop time"
         return self.result(recorder.data(), info.t, reason, final=table.final(), modes=algorithm.statistics(),
                            profile=profiler.report() if profiler else None)
+
+    def ended_by(self, ci, t_end):
+        """The run as a component ended it (fmi2Discard, then fmi2Terminated): a last row at the
+        time it reached, with its outputs read there (FMI 2.0 allows fmi2Get* after the discard);
+        the other components' values are those of the last communication point."""
+        table, info = self.table, self.info
+        table.get(ci)
+        table.t = info.t = t_end
+        self.recorder.record(t_end)
+        reason = (f"component {self.system.comps[ci].name!r} ended the simulation at t={t_end:g} s "
+                  "(fmi2Discard, fmi2Terminated)")
+        return self.result(self.recorder.data(), t_end, reason, final=table.final(),
+                           modes=self.algorithm.statistics(), profile=None)
 
     def record_last(self):
         """Record the communication point reached (the FMUs are healthy: an interruption)."""

@@ -14,8 +14,9 @@ import os
 import weakref
 
 from fmpy import calloc, free
-from fmpy.fmi2 import (FMU2Slave, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE, fmi2CallbackFunctions,
-                       fmi2CallbackLoggerTYPE)
+from fmpy.fmi2 import (FMU2Slave, fmi2Boolean, fmi2CallbackAllocateMemoryTYPE, fmi2CallbackFreeMemoryTYPE,
+                       fmi2CallbackFunctions, fmi2CallbackLoggerTYPE, fmi2False, fmi2LastSuccessfulTime, fmi2Real,
+                       fmi2Terminated)
 from fmpy.logging import addLoggerProxy
 import numpy as np
 
@@ -300,6 +301,24 @@ class InstanceTable:
             shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
             call = f"{call} of {shown}"
         return SimulationError(f"component {inst.name!r}: {call} {what} at t={self.t:g} s{detail}")
+
+    def terminated_at(self, ci):
+        """After ci's fmi2DoStep returned fmi2Discard, ask it (FMI 2.0 section 4.2.3) whether it
+        ended the simulation (fmi2Terminated): the time it reached (fmi2LastSuccessfulTime, or
+        the communication point the step started from when it does not say), else None."""
+        fmu = self.instances[ci].fmu
+        ended, reached = fmi2Boolean(fmi2False), fmi2Real(self.t)
+        try:
+            if fmu.fmi2GetBooleanStatus(fmu.component, fmi2Terminated, ctypes.byref(ended)) > 1 or not ended.value:
+                return None
+        except Exception:  # FMPy raises for a status it does not accept: not an answer
+            return None
+        try:
+            if fmu.fmi2GetRealStatus(fmu.component, fmi2LastSuccessfulTime, ctypes.byref(reached)) > 1:
+                return self.t
+        except Exception:
+            return self.t
+        return float(reached.value) if np.isfinite(reached.value) and reached.value >= self.t else self.t
 
     def call(self, ci, call, fn, *args, names=()):
         """Call an fmpy method; wrap failures with the component's logged messages."""
