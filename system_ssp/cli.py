@@ -213,11 +213,9 @@ def _run_or_info(argv):
             experiment = fmpy.read_model_description(args.path).defaultExperiment
             if args.stop_time is None and (experiment is None or experiment.stopTime is None):
                 raise SSPError(f"{args.path}: no stop time: pass --stop-time (the FMU has no DefaultExperiment)")
-            if args.step_size is None:
-                if experiment is None or experiment.stepSize is None:
-                    raise SSPError(f"{args.path}: no step size: pass --step-size (the FMU has no DefaultExperiment "
-                                   "stepSize)")
-                args.step_size = float(experiment.stepSize)
+            if args.step_size is None and (experiment is None or experiment.stepSize is None):
+                raise SSPError(f"{args.path}: no step size: pass --step-size (the FMU has no DefaultExperiment "
+                               "stepSize)")
         return _run(args, path)
 
 
@@ -236,6 +234,8 @@ def _run(args, path):
     print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
     h = f"h = {result.step_size:g} s" if result.step_size is not None else "steps per nc:Schedule mode"
     print(f"steps:       {result.steps} ({h}, {result.algorithm}, order {' '.join(result.order)})")
+    if result.step_size_source and result.step_size_source != "as requested":
+        print(f"step size:   {result.step_size:g} s from {result.step_size_source}")
     if result.modes:
         for name, m in result.modes.items():
             print(f"  mode {name}: {m['steps']} steps, {m['simulated_time']:g} s simulated")

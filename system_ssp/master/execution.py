@@ -133,7 +133,8 @@ class _Run:
                       wall_time=0.0, start_time=plan.start,
                       step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
                       order=[self.system.comps[i].name for i in plan.order], messages=self.table.messages(),
-                      units=self.units(), **extra)
+                      units=self.units(), step_size_source=None if plan.schedule is not None
+                      else plan.step_size_source, **extra)
 
     def units(self):
         comps = self.system.comps

@@ -6,6 +6,7 @@ import dataclasses
 
 from ..errors import SSPError
 from ..ssp.interface import FmuInterface, variable_line
+from .planning import step_size_of
 
 
 def describe_system(system):
@@ -17,6 +18,11 @@ def describe_system(system):
     if m.origin:
         lines.append(f"master annotation ({m.origin}): stepSize={m.step_size} algorithm={m.algorithm} "
                      f"order={m.order} stepMultiples={m.step_multiples} stopConditions={m.stop_conditions}")
+    try:
+        h, source = step_size_of(system)
+        lines.append(f"step size: {h:g} s from {source}")
+    except SSPError as exc:
+        lines.append(f"step size: none ({exc})")
     if m.schedule:
         lines.append(f"schedule ({m.schedule.origin}): first matching mode wins")
         for mode in m.schedule.modes:
@@ -88,8 +94,12 @@ def system_info(system):
             variables.append(item)
         comps.append({"name": c.name, "source": c.decl.source, "model": c.md.modelName, "guid": c.md.guid,
                       "variables": variables})
+    try:
+        step = dict(zip(("size", "from"), step_size_of(system)))
+    except SSPError:
+        step = {"size": None, "from": None}
     return {"name": d.name, "file": d.display, "start_time": d.start_time, "stop_time": d.stop_time,
-            "master": {"step_size": m.step_size, "algorithm": m.algorithm, "order": m.order,
+            "step": step, "master": {"step_size": m.step_size, "algorithm": m.algorithm, "order": m.order,
                        "stop_conditions": [list(s) if isinstance(s, tuple) else s for s in m.stop_conditions]},
             "components": comps,
             "connections": [{"from": f"{system.comps[lk.src].name}.{lk.src_var}",

@@ -82,6 +82,7 @@ class RunPlan:
     record_every: int
     profile: bool = False
     schedule: Optional[SchedulePlan] = None
+    step_size_source: str = "as requested"  # where step_size comes from (the caller, a file and line, the FMUs)
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", MappingProxyType(dict(self.params)))

@@ -96,6 +96,35 @@ def _recorded(system, outputs):
     return rec
 
 
+def step_size_of(system, requested=None):
+    """The communication step and where it comes from, first found of: the caller's, our
+    annotation's (nc:Master stepSize), OSP's (libcosim's baseStepSize), the FMUs' DefaultExperiment
+    stepSize (the smallest, when they differ: no FMU is stepped coarser than it asks)."""
+    d, m = system.desc, system.desc.master
+    if requested is not None:
+        return requested, "as requested"
+    if m.step_size is not None:
+        return m.step_size, f"nc:Master stepSize at {m.step_size_origin}"
+    if m.osp_step_size is not None:
+        return m.osp_step_size, f"osp:FixedStepAlgorithm baseStepSize at {m.osp_step_size_origin}"
+    asked = {}
+    for c in system.comps:
+        experiment = c.md.defaultExperiment
+        if experiment is not None and experiment.stepSize is not None:
+            try:
+                asked[c.name] = float(experiment.stepSize)
+            except ValueError:
+                continue
+    asked = {name: x for name, x in asked.items() if x > 0 and math.isfinite(x)}
+    if asked:
+        name = min(asked, key=asked.__getitem__)
+        which = "the smallest " if len(set(asked.values())) > 1 else ""
+        return asked[name], f"{which}DefaultExperiment stepSize of the FMUs ({name})"
+    raise SSPError(f"{d.display}: no step size: pass step_size (CLI --step-size), give one in the "
+                   f"{ANNOTATION_TYPE} annotation (nc:Master stepSize) or OSP's (osp:FixedStepAlgorithm "
+                   "baseStepSize), or use FMUs whose DefaultExperiment has a stepSize")
+
+
 def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
     """The RunPlan of `options` on `system` (a loaded `System`; a field left at None: the SSD's
     own setting)."""
@@ -103,13 +132,10 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
     d, m = system.desc, system.desc.master
     start = o.start_time if o.start_time is not None else (d.start_time if d.start_time is not None else 0.0)
     stop = o.stop_time if o.stop_time is not None else d.stop_time
-    h = o.step_size if o.step_size is not None else m.step_size
+    h, h_source = step_size_of(system, o.step_size)
     if stop is None:
         raise SSPError(f"{d.display}: no stop time: pass stop_time (CLI --stop-time) or set "
                        "ssd:DefaultExperiment stopTime")
-    if h is None:
-        raise SSPError(f"{d.display}: no step size: pass step_size (CLI --step-size) or give one in the "
-                       f"{ANNOTATION_TYPE} annotation (nc:Master stepSize)")
     for label, x in (("start time", start), ("stop time", stop), ("step size", h)):
         if isinstance(x, bool) or not isinstance(x, numbers.Real) or not math.isfinite(x):
             raise SSPError(f"{label} must be a finite number, got {x!r}")
@@ -118,7 +144,7 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
         raise SSPError(f"step size must be positive, got {h}")
     if stop < start:
         raise SSPError(f"stop time {stop} is before start time {start}")
-    algo = o.algorithm or m.algorithm or "gauss-seidel"
+    algo = o.algorithm or m.algorithm or m.osp_algorithm or "gauss-seidel"
     if algo not in ALGORITHMS:
         raise SSPError(f"unknown algorithm {algo!r} (expected one of: {', '.join(ALGORITHMS)})")
     order_idx = _order(system, o.order, algo)
@@ -142,8 +168,8 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
         raise SSPError(f"{stop - start:g} s in steps of {h:g} s are {n_steps:,} communication steps, more than the "
                        f"{MAX_STEPS:,} a run may take (about {n_steps * 50e-6 / 86400:,.0f} days at 50 us per "
                        "step): use a larger step size or a shorter run")
-    return RunPlan(start=start, stop=stop, step_size=h, n_steps=n_steps, algorithm=algo, order=tuple(order_idx),
-                   multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
+    return RunPlan(start=start, stop=stop, step_size=h, step_size_source=h_source, n_steps=n_steps, algorithm=algo,
+                   order=tuple(order_idx), multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
                    record_every=int(o.record_every), profile=bool(o.profile), schedule=sched)
 
 

@@ -29,13 +29,15 @@ class Result:
     units:       {column: unit or None} ("time": "s"; the unit of the FMU's value, None when the
                  FMU and the SSD declare none).
     partial:     True for the rows of a run that failed or was interrupted (err.result).
+    step_size_source: where step_size came from ("as requested", "nc:Master stepSize, file:line",
+                 OSP's baseStepSize, the FMUs' DefaultExperiment); None for a scheduled run.
     """
 
     def __init__(self, data: np.ndarray, stop_time: float, stop_reason: str, steps: int, final: Dict[str, Any],
                  wall_time: float, start_time: float, step_size: Optional[float], algorithm: str, order: List[str],
                  messages: Dict[str, List[str]], modes: Optional[Dict[str, Dict[str, float]]] = None,
                  profile: Optional[Dict[str, Any]] = None, units: Optional[Units] = None,
-                 partial: bool = False) -> None:
+                 partial: bool = False, step_size_source: Optional[str] = None) -> None:
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -51,6 +53,7 @@ class Result:
         self.profile = profile
         self.units = units or {}
         self.partial = partial
+        self.step_size_source = step_size_source
 
     @property
     def names(self) -> List[str]:

@@ -28,6 +28,10 @@ NS_SSV = "http://ssp-standard.org/SSP1/SystemStructureParameterValues"
 NS_SSM = "http://ssp-standard.org/SSP1/SystemStructureParameterMapping"
 NS_NC = "https://neighbor-cosim.org/ssp/master"
 ANNOTATION_TYPE = "org.neighbor-cosim.master"
+# The Open Simulation Platform's annotation (libcosim): the step of a fixed-step run, read as the
+# system's step when ours gives none (osp:Algorithm/osp:FixedStepAlgorithm baseStepSize).
+NS_OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
+OSP_ANNOTATION_TYPE = "com.opensimulationplatform"
 # What an nc:When condition of our master annotation may test: an output, or a parameter (a
 # choice fixed for the run, e.g. by a parameter set).
 CONDITION_CAUSALITIES = ("output", "parameter")
@@ -108,8 +112,13 @@ class Connection:
 
 @dataclass
 class MasterSettings:
-    """Contents of the `org.neighbor-cosim.master` annotation(s)."""
+    """Contents of the `org.neighbor-cosim.master` annotation(s), and the step another tool's
+    annotation gives (`osp_step_size`: OSP's baseStepSize)."""
     step_size: Optional[float] = None
+    step_size_origin: str = ""  # file:line of the nc:Master that set step_size
+    osp_step_size: Optional[float] = None
+    osp_step_size_origin: str = ""
+    osp_algorithm: Optional[str] = None  # "jacobi" for OSP's fixed-step algorithm
     algorithm: Optional[str] = None
     order: Optional[list] = None
     order_origin: str = ""  # file:line of nc:Order
@@ -426,6 +435,7 @@ def parse_master_annotation(el, namer, settings):
             if not (h > 0 and math.isfinite(h)):
                 raise SSPError(f"{origin}: nc:Master stepSize must be a positive number, got {m.get('stepSize')!r}")
             settings.step_size = h
+            settings.step_size_origin = origin
         if m.get("algorithm") is not None:
             settings.algorithm = m.get("algorithm")
         for child in m:
@@ -454,6 +464,26 @@ def parse_master_annotation(el, namer, settings):
             else:
                 raise SSPError(f"{corigin}: unknown element {child.tag} in nc:Master "
                                "(expected nc:Order, nc:StepMultiple, nc:StopCondition, nc:Schedule)")
+
+
+def parse_osp_annotation(el, namer, settings):
+    """The step of OSP's fixed-step algorithm (libcosim's `com.opensimulationplatform` annotation
+    under `el`) into `settings.osp_step_size`; the annotation's other content is libcosim's own."""
+    anns = el.find("ssd:Annotations", NS)
+    if anns is None:
+        return
+    for ann in anns.findall("ssc:Annotation", NS):
+        if ann.get("type") != OSP_ANNOTATION_TYPE:
+            continue
+        for fixed in ann.iterfind(f"{{{NS_OSP}}}Algorithm/{{{NS_OSP}}}FixedStepAlgorithm"):
+            origin = _where(fixed, namer)
+            h = _float_attr(fixed, "baseStepSize", origin)
+            if h is None or h <= 0:
+                raise SSPError(f"{origin}: osp:FixedStepAlgorithm baseStepSize must be a positive number, "
+                               f"got {fixed.get('baseStepSize')!r}")
+            settings.osp_step_size, settings.osp_step_size_origin = h, origin
+            # libcosim's fixed-step algorithm steps every component from the values at t (Jacobi)
+            settings.osp_algorithm = "jacobi"
 
 
 def _where(e, namer):
@@ -597,6 +627,7 @@ def parse_ssd(ssd_path, namer, validate=True):
         desc.start_time = _float_attr(de, "startTime", origin)
         desc.stop_time = _float_attr(de, "stopTime", origin)
         parse_master_annotation(de, namer, desc.master)
+        parse_osp_annotation(de, namer, desc.master)
     return desc
 
 

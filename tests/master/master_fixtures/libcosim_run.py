@@ -1,6 +1,7 @@
 """Run an SSP with libcosim's fixed-step algorithm and write the trajectories as JSON.
 
-Usage: python libcosim_run.py SSP_DIR STEP_SIZE_S N_STEPS OUT_JSON comp.var [comp.var ...]
+Usage: python libcosim_run.py SSP STEP_SIZE_S N_STEPS OUT_JSON comp.var [comp.var ...]
+(SSP: a folder or .ssp file; STEP_SIZE_S "file": the step the system gives, as libcosim reads it)
 Run in its own process (a process holding both libcosim and fmpy instances once aborted at exit).
 """
 import json
@@ -14,9 +15,10 @@ log_output_level(CosimLogLevel.WARNING)
 
 
 def main():
-    ssp, h, n, out = sys.argv[1], float(sys.argv[2]), int(sys.argv[3]), sys.argv[4]
+    ssp, h, n, out = sys.argv[1], sys.argv[2], int(sys.argv[3]), sys.argv[4]
     names = sys.argv[5:]
-    ex = CosimExecution.from_ssp_file(ssp, step_size=int(round(h * 1e9)))
+    step = None if h == "file" else int(round(float(h) * 1e9))
+    ex = CosimExecution.from_ssp_file(ssp, step_size=step)
     obs = CosimObserver.create_last_value()
     ex.add_observer(obs)
     refs = []
