@@ -322,13 +322,23 @@ def parse_ssv(root, namer):
 
 
 def parse_ssm(root, namer):
-    """An ssm:ParameterMapping element -> {source name: (target name, transform, suppress)}."""
+    """An ssm:ParameterMapping element -> {source name: [(target name, transform, suppress, origin)]}.
+
+    One source may feed several targets (an entry each). An entry with an empty source maps
+    nothing: no parameter has an empty name (OMSimulator writes such entries as a template, one per
+    parameter of the component, for the user to fill in)."""
     display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
-    mapping = {}
+    mapping: Dict[str, list] = {}
     for e in root.findall("ssm:MappingEntry", NS):
         origin = f"{display}:{e.sourceline}"
-        mapping[_required(e, "source", origin)] = (_required(e, "target", origin), _parse_transform(e, origin),
-                                    e.get("suppressUnitConversion", "false") == "true", origin)
+        if e.get("source") is None:  # required by the schema; a file read without validation
+            raise SSPError(f"{origin}: <MappingEntry> needs a source attribute (the parameter it maps)")
+        target = _required(e, "target", origin)
+        source = e.get("source").strip()
+        if not source:
+            continue
+        mapping.setdefault(source, []).append((target, _parse_transform(e, origin),
+                                               e.get("suppressUnitConversion", "false") == "true", origin))
     return mapping
 
 
@@ -381,14 +391,13 @@ def parse_bindings(el, namer, base_dir, validate, component_dir=None):
         prefix = b.get("prefix", "")
         for v in values:
             name = prefix + v.name
-            if name in mapping:
-                target, transform, _suppress, morigin = mapping[name]
+            if name not in mapping:
+                out.append(v._replace(name=name))
+                continue
+            for target, transform, _suppress, morigin in mapping[name]:
                 value = _apply_transform(transform, v.value, v.type, morigin, name)
                 kind = "Real" if (transform and transform[0] == "linear") else v.type
-                v = v._replace(name=target, value=value, type=kind, origin=f"{v.origin} (mapped by {morigin})")
-            else:
-                v = v._replace(name=name)
-            out.append(v)
+                out.append(v._replace(name=target, value=value, type=kind, origin=f"{v.origin} (mapped by {morigin})"))
     return out
 
 
