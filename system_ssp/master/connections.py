@@ -92,20 +92,32 @@ def check_connector_units(comps, units):
             units.convert(conn.unit, fmu_unit, comp, comp, f"{conn.origin}: connector {comp.name}.{name}")
 
 
+def valued_system_connectors(desc):
+    """The root system's connectors whose value is given, not computed: those of kind parameter,
+    and those of kind input that no component drives (at the top level nothing outside can: a
+    parameter binding or --set gives their value, as OMSimulator's do). An input connector that a
+    component output drives is a pass-through, as before."""
+    driven = {c.end_connector for c in desc.connections if c.end_element is None and c.start_element is not None}
+    return {name: sc for name, sc in desc.system_connectors.items()
+            if sc.kind == "parameter" or (sc.kind == "input" and name not in driven)}
+
+
 def is_parameter_connection(desc, c):
-    """A connection from a system connector of kind parameter (SSP 1.0: a parameter of the
-    system that the connection hands to a component's parameter)."""
+    """A connection from a valued system connector (a parameter of the system, or an input that
+    nothing drives) that hands its value to a component's variable before the run."""
+    valued = valued_system_connectors(desc)
     for element, connector in ((c.start_element, c.start_connector), (c.end_element, c.end_connector)):
-        sc = desc.system_connectors.get(connector) if element is None else None
-        if sc is not None and sc.kind == "parameter":
+        if element is None and connector in valued:
             return True
     return False
 
 
 def parameter_connections(desc, by_name):
-    """{system parameter connector: [(component info, variable, origin)]}: where each system
-    parameter's value goes. Every target must be a parameter of its component."""
-    out = {name: [] for name, sc in desc.system_connectors.items() if sc.kind == "parameter"}
+    """{valued system connector: [(component info, variable, origin)]}: where each system
+    parameter's (or undriven system input's) value goes. A parameter's targets must be parameters
+    of their components; an input's, inputs or parameters."""
+    valued = valued_system_connectors(desc)
+    out = {name: [] for name in valued}
     for c in desc.connections:
         if not is_parameter_connection(desc, c):
             continue
@@ -121,9 +133,11 @@ def parameter_connections(desc, by_name):
         v = comp.vars.get(var)
         if v is None:
             raise SSPError(f"{where}: component {element!r} has no variable {var!r}{near(var, comp.vars)}")
-        if v.causality != "parameter":
-            raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system parameter can only set "
-                           "parameters")
+        kind = valued[name].kind
+        allowed = ("parameter",) if kind == "parameter" else ("input", "parameter")
+        if v.causality not in allowed:
+            raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system {kind} can only set "
+                           f"{' or '.join(a + 's' for a in allowed)}")
         if c.transform is not None:
             raise SSPError(f"{where}: transformations on parameter connections are not supported")
         out[name].append((comp, var, c.origin))

@@ -152,8 +152,9 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
                                                    pv.origin, f"{comp.name}.{var}")
 
     def put_system(name, value, vtype=None, unit=None, units=None, origin=""):
-        """A system parameter (an SSD system connector of kind parameter): its value goes to every
-        component parameter it is connected to, converted to each one's unit."""
+        """A system parameter (an SSD system connector of kind parameter, or of kind input that
+        nothing drives): its value goes to every component variable it is connected to, converted
+        to each one's unit."""
         connector = system.desc.system_connectors[name]
         for comp, var, _ in fan_out[name]:
             out[(comp.index, var)] = resolve_parameter(
@@ -165,7 +166,8 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
         if name in fan_out:
             return None
         if isinstance(name, str) and "." not in name and fan_out:
-            raise SSPError(f"{where} {name!r}: not a system parameter{near(name, fan_out)} (system parameters: "
+            raise SSPError(f"{where} {name!r}: not a system parameter{near(name, fan_out)} (system parameters and "
+                           "undriven system inputs: "
                            f"{', '.join(fan_out)}) and not 'component.variable'")
         return split_name(system.comps, name, where)
 

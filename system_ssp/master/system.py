@@ -76,6 +76,12 @@ class System:
         check_connector_units(self.comps, self.units)
         self.links = resolve_connections(self.desc, self.comps, self.by_name, self.units)
         self.parameter_links = parameter_connections(self.desc, self.by_name)
+        fed = {(lk.dst, lk.dst_var) for lk in self.links}
+        for name, targets in self.parameter_links.items():
+            for comp, var, origin in targets:
+                if (comp.index, var) in fed:
+                    raise SSPError(f"{origin}: {comp.name}.{var} gets the value of system input {name!r} and is "
+                                   "also connected to an output: an input is fed by one connection")
         self.graph = FeedthroughGraph(self.comps, self.links)
 
     # ---- queries ------------------------------------------------------------------------

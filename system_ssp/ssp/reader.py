@@ -49,15 +49,27 @@ ROOT_TAGS = {
     "ssm": f"{{{NS_SSM}}}ParameterMapping",
 }
 TYPE_TAGS = ("Real", "Integer", "Boolean", "String", "Enumeration", "Binary")
+# SSP 2.0's sized types (FMI 3.0's), as the FMI 2.0 type a scalar of them is exchanged as
+SSP2_TYPES = {"Float64": "Real", "Float32": "Real", **{f"{u}Int{n}": "Integer" for u in ("", "U")
+                                                         for n in (8, 16, 32, 64)}}
+# what SSP 2.0 adds that needs FMI 3.0 FMUs: refused by name (the master runs FMI 2.0 FMUs)
+NEEDS_FMI3 = "it needs FMI 3.0 components; this master runs FMI 2.0 FMUs"
 
-_schemas: Dict[str, Any] = {}
+_schemas: Dict[tuple, Any] = {}
 
 
-def _schema(kind):
-    if kind not in _schemas:
-        path = Path(fmpy.__file__).parent / "ssp" / "schema" / SCHEMA_FILES[kind]
-        _schemas[kind] = etree.XMLSchema(etree.parse(str(path)))
-    return _schemas[kind]
+# SSP 2.0 (2025) keeps SSP 1.0's namespaces and says version="2.0"; its schemas are vendored.
+SSP2_SCHEMA_DIR = Path(__file__).parent / "schema_ssp2"
+
+
+def _schema(kind, version="1.0"):
+    """The XML schema of an SSP file of `kind` ("ssd", "ssv", "ssm") in the standard's `version`
+    (the root's version attribute): SSP 2.0's for "2.x", else SSP 1.0's (FMPy ships them)."""
+    standard = "2" if version.strip().startswith("2") else "1"
+    if (kind, standard) not in _schemas:
+        folder = SSP2_SCHEMA_DIR if standard == "2" else Path(fmpy.__file__).parent / "ssp" / "schema"
+        _schemas[(kind, standard)] = etree.XMLSchema(etree.parse(str(folder / SCHEMA_FILES[kind])))
+    return _schemas[(kind, standard)]
 
 
 def _q(prefix, tag):
@@ -178,8 +190,11 @@ def load_xml(path, kind, namer, validate=True):
         line = exc.lineno if exc.lineno is not None else "?"
         raise SSPError(f"{display}:{line}: malformed XML: {exc.msg}") from None
     root = doc.getroot()
+    version = (root.get("version") or "").strip()
+    if version and not version.startswith(("1.", "2.")):
+        raise SSPError(f"{display}:{root.sourceline}: SSP version {version!r}: this reader knows SSP 1.x and 2.0")
     if validate:
-        schema = _schema(kind)
+        schema = _schema(kind, version)
         if not schema.validate(doc):
             errors = [f"{display}:{e.line}: schema violation: {e.message}" for e in schema.error_log]
             more = f"\n(and {len(errors) - 5} more)" if len(errors) > 5 else ""
@@ -242,12 +257,26 @@ def _required(el, attr, origin):
     return value
 
 
-def _type_child(el):
-    """The ssc type element (Real, Integer, ...) under a connector, or None."""
+def _type_child(el, namer):
+    """The ssc type element (Real, Integer, ..., SSP 2.0's Float64, Int32, ...) under a
+    connector, or None. SSP 2.0's clocks and arrays (ssc:Clock, ssc:Dimension) are refused."""
+    found = None
     for child in el:
-        if etree.QName(child).namespace == NS_SSC and _local(child) in TYPE_TAGS:
-            return child
-    return None
+        if not isinstance(child.tag, str) or etree.QName(child).namespace != NS_SSC:
+            continue
+        tag = _local(child)
+        if tag in ("Clock", "Dimension"):
+            what = "a clock connector (ssc:Clock)" if tag == "Clock" else "an array connector (ssc:Dimension)"
+            raise SSPError(f"{_where(child, namer)}: connector {el.get('name')!r} is {what} of SSP 2.0: "
+                           f"{NEEDS_FMI3}")
+        if tag in TYPE_TAGS or tag in SSP2_TYPES:
+            found = child
+    return found
+
+
+def _type_name(el):
+    """The FMI 2.0 type name of an ssc/ssv type element (SSP 2.0's Float64 -> Real, ...)."""
+    return SSP2_TYPES.get(_local(el), _local(el))
 
 
 def _parse_transform(parent, origin):
@@ -295,13 +324,21 @@ def parse_ssv(root, namer):
         seen[name] = p.sourceline
         tv = None
         for child in p:
-            if isinstance(child.tag, str) and etree.QName(child).namespace == NS_SSV and _local(child) in TYPE_TAGS:
+            if not isinstance(child.tag, str) or etree.QName(child).namespace not in (NS_SSV, NS_SSC):
+                continue
+            if _local(child) == "Dimension":  # SSP 2.0: an array value
+                raise SSPError(f"{origin}: parameter {name!r} is an array (ssc:Dimension, SSP 2.0): {NEEDS_FMI3}")
+            if etree.QName(child).namespace == NS_SSV and (_local(child) in TYPE_TAGS or _local(child) in SSP2_TYPES):
                 tv = child
                 break
         if tv is None:
             raise SSPError(f"{origin}: parameter {name!r} has no value")
-        kind = _local(tv)
+        kind = _type_name(tv)
         raw = tv.get("value")
+        if raw is not None and len(raw.split()) > 1 and kind != "String":  # SSP 2.0 lists array values
+            raise SSPError(f"{origin}: parameter {name!r}: {raw!r} is an array value (SSP 2.0): {NEEDS_FMI3}")
+        if raw is None and tv.find("ssv:Value", NS) is not None:  # SSP 2.0: String/Enumeration/Binary arrays
+            raise SSPError(f"{origin}: parameter {name!r} has ssv:Value elements (an SSP 2.0 array): {NEEDS_FMI3}")
         try:
             if kind == "Real":
                 value = float(raw)
@@ -407,13 +444,13 @@ def _parse_connectors(el, namer):
     if conns is None:
         return out
     for c in conns.findall("ssd:Connector", NS):
-        t = _type_child(c)
+        t = _type_child(c, namer)
         corigin = f"{namer(c.getroottree().docinfo.URL)}:{c.sourceline}"
         name = _required(c, "name", corigin)
         out[name] = Connector(
             name=name, kind=_required(c, "kind", corigin),
-            type=_local(t) if t is not None else None,
-            unit=t.get("unit") if (t is not None and _local(t) == "Real") else None,
+            type=_type_name(t) if t is not None else None,
+            unit=t.get("unit") if (t is not None and _type_name(t) == "Real") else None,
             origin=corigin)
     return out
 

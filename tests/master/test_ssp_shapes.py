@@ -71,3 +71,95 @@ def test_an_ssm_entry_without_a_source_attribute_is_refused_by_line(tmp_path):
         system_ssp.System(ssd)
     with pytest.raises(SSPError, match=r"mapping.ssm:3: <MappingEntry> needs a source attribute"):
         system_ssp.System(ssd, validate=False)
+
+
+@pytest.fixture(scope="module")
+def fixture_fmus(tmp_path_factory):
+    return h.build_fixture_fmus(tmp_path_factory.mktemp("shapes_fmus"))
+
+
+def top_level_connectors_system(tmp_path, fmus, extra_connection=""):
+    """As OMSimulator builds one (its import_export_parameters test): the root system has an input
+    connector and a parameter connector, both given values by a parameter set bound to the system;
+    the input feeds a gain's input, the parameter its gain. y = k u + b with b = 1 m."""
+    conns = ('<ssd:Connectors><ssd:Connector name="Input_cref" kind="input"><ssc:Real unit="m"/></ssd:Connector>'
+             '<ssd:Connector name="k_cref" kind="parameter"><ssc:Real/></ssd:Connector></ssd:Connectors>')
+    ssv = h.ssv_text([("Input_cref", "Real", "-20", None), ("k_cref", "Real", "3", None),
+                      ("gain.b", "Real", "1", None)])
+    bind = '<ssd:ParameterBindings><ssd:ParameterBinding source="root.ssv"/></ssd:ParameterBindings>'
+    el = (h.component("gain", "gain.fmu", '<ssd:Connector name="u" kind="input"><ssc:Real/></ssd:Connector>'
+                      '<ssd:Connector name="k" kind="parameter"><ssc:Real/></ssd:Connector>'
+                      '<ssd:Connector name="y" kind="output"><ssc:Real/></ssd:Connector>')
+          + h.component("integ", "integ.fmu", '<ssd:Connector name="u" kind="input"><ssc:Real/></ssd:Connector>'
+                        '<ssd:Connector name="x" kind="output"><ssc:Real/></ssd:Connector>'))
+    co = ('<ssd:Connection startConnector="Input_cref" endElement="gain" endConnector="u"/>\n'
+          '<ssd:Connection startConnector="k_cref" endElement="gain" endConnector="k"/>\n'
+          + h.connection("gain.y", "integ.u") + extra_connection)
+    return h.write_system(tmp_path, fmus, {"gain.fmu": "gain", "integ.fmu": "integrator"},
+                          h.ssd_text(el, co, system_head=conns + bind), extra_files={"root.ssv": ssv})
+
+
+def test_top_level_input_and_parameter_connectors_bound_by_a_parameter_set(fixture_fmus, tmp_path):
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus)
+    r = system_ssp.simulate(ssd, step_size=0.5, stop_time=2.0)
+    # by hand: u = -20 m held, k = 3, b = 1 m: y = -59 m; the integrator: x(2 s) = -59 * 2 = -118
+    assert set(r.data["gain.u"]) == {-20.0} and set(r.data["gain.y"]) == {-59.0}
+    assert r.final["integ.x"] == pytest.approx(-118.0)
+    r = system_ssp.simulate(ssd, step_size=0.5, stop_time=2.0, parameters={"Input_cref": 4.0})  # as --set does
+    assert r.final["gain.y"] == 13.0
+
+
+def test_a_top_level_input_also_fed_by_an_output_is_refused(fixture_fmus, tmp_path):
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus, h.connection("integ.x", "gain.u"))
+    with pytest.raises(SSPError, match=r"SystemStructure.ssd:\d+: gain.u gets the value of system input "
+                                       r"'Input_cref' and is also connected to an output"):
+        system_ssp.System(ssd)
+
+
+def as_ssp2(text):
+    """An SSP 1.0 file's text as SSP 2.0 writes it: version 2.0, scalars in the sized types."""
+    return (text.replace('version="1.0"', 'version="2.0"').replace('<?xml version="2.0"', '<?xml version="1.0"')
+            .replace("<ssc:Real", "<ssc:Float64")
+            .replace("<ssv:Real ", "<ssv:Float64 ").replace("<ssv:Integer ", "<ssv:Int32 "))
+
+
+def test_an_ssp2_system_runs_as_its_ssp1_twin(fixture_fmus, tmp_path):
+    """SSP 2.0 files (checked against SSP 2.0's schemas, vendored in system_ssp/ssp/schema_ssp2)
+    with Float64 connectors and Float64/Int32 values run as the same system in SSP 1.0 does."""
+    one = top_level_connectors_system(tmp_path / "one", fixture_fmus)
+    two_dir = tmp_path / "two"
+    shutil.copytree(one.parent, two_dir)
+    for name in ("SystemStructure.ssd", "root.ssv"):
+        path = two_dir / name
+        path.write_text(as_ssp2(path.read_text()))
+    assert 'version="2.0"' in (two_dir / "root.ssv").read_text() and "<ssc:Float64" in (two_dir / one.name).read_text()
+    a = system_ssp.simulate(one, step_size=0.5, stop_time=2.0)
+    b = system_ssp.simulate(two_dir / one.name, step_size=0.5, stop_time=2.0)
+    assert a.names == b.names and b.final["integ.x"] == pytest.approx(-118.0)
+    for name in a.names:
+        np.testing.assert_array_equal(a.data[name], b.data[name])
+
+
+@pytest.mark.parametrize("change, message", [
+    (('<ssc:Float64 unit="m"/>', '<ssc:Clock/>'), r"connector 'Input_cref' is a clock connector \(ssc:Clock\) of "
+                                                 r"SSP 2.0: it needs FMI 3.0 components"),
+    (('<ssc:Float64 unit="m"/>', '<ssc:Float64 unit="m"/><ssc:Dimension size="3"/>'),
+     r"connector 'Input_cref' is an array connector \(ssc:Dimension\) of SSP 2.0"),
+    (('version="2.0"', 'version="3.0"'), r"ssd:\d+: SSP version '3.0': this reader knows SSP 1.x and 2.0"),
+    (("<ssd:Connectors>", "<ssd:Connectors><ssd:Unknown/>"), r":\d+: schema violation: .*Unknown"),
+])
+def test_what_ssp2_adds_for_fmi3_is_refused_by_name(fixture_fmus, tmp_path, change, message):
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus)
+    ssd.write_text(as_ssp2(ssd.read_text()).replace(*change, 1))
+    with pytest.raises(SSPError, match=message):
+        system_ssp.System(ssd)
+
+
+def test_an_ssp2_array_value_is_refused_by_name(fixture_fmus, tmp_path):
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus)
+    ssd.write_text(as_ssp2(ssd.read_text()))
+    ssv = tmp_path / "root.ssv"
+    ssv.write_text(as_ssp2(ssv.read_text()).replace('value="-20"', 'value="-20 -21 -22"'))
+    with pytest.raises(SSPError, match=r"root.ssv:\d+: parameter 'Input_cref': '-20 -21 -22' is an array value "
+                                       r"\(SSP 2.0\): it needs FMI 3.0 components"):
+        system_ssp.System(ssd)
