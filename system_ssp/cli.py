@@ -29,6 +29,7 @@ from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.report import run_report
 from .master.result import check_output_file
 from .atomic import check_output_place, write_text_atomic
+from .master.components import unsupported_fmu
 from .master.info import system_info
 from .ssp.interface import FmuInterface, describe_fmu
 from .ssp.writer import single_fmu_system
@@ -210,7 +211,11 @@ def _run_or_info(argv):
         path = args.path
         if args.command == "run" and suffix == ".fmu":  # the FMU alone, as a system of one
             path = str(single_fmu_system(path, tmp))
-            experiment = fmpy.read_model_description(args.path).defaultExperiment
+            md = fmpy.read_model_description(args.path)
+            refusal = unsupported_fmu(md)
+            if refusal:
+                raise SSPError(f"{args.path} {refusal}")
+            experiment = md.defaultExperiment
             if args.stop_time is None and (experiment is None or experiment.stopTime is None):
                 raise SSPError(f"{args.path}: no stop time: pass --stop-time (the FMU has no DefaultExperiment)")
             if args.step_size is None and (experiment is None or experiment.stepSize is None):

@@ -38,6 +38,25 @@ class ComponentInfo:
         return bool(d & connected_inputs) if connected_inputs is not None else bool(d)
 
 
+def unsupported_fmu(md):
+    """Why this master cannot run the FMU of model description `md` (FMPy's), or None.
+
+    FMI 1.0 is refused rather than imported: it was superseded by FMI 2.0 in 2014, the tools our
+    users export from (Dymola, OpenModelica, Simulink, 20-sim) all write FMI 2.0 or 3.0, and its
+    co-simulation API differs in every call (instantiate, initialize, no state, no dependencies)."""
+    kind = "co-simulation" if md.coSimulation is not None else "model-exchange"
+    if md.fmiVersion == "2.0":
+        if md.coSimulation is None:
+            return ("is an FMI 2.0 model-exchange FMU; this master runs co-simulation FMUs (export it for "
+                    "co-simulation, with its own solver)")
+        return None
+    if md.fmiVersion.startswith("1."):
+        return (f"is an FMI {md.fmiVersion} {kind} FMU; this master runs FMI 2.0 co-simulation FMUs and does not "
+                "import FMI 1.0 (superseded in 2014): export it as FMI 2.0")
+    return (f"is an FMI {md.fmiVersion} {kind} FMU; this master runs FMI 2.0 co-simulation FMUs (export it as "
+            "FMI 2.0)")
+
+
 def load_components(desc, extract_root, namer, validate):
     """[ComponentInfo] for the SSD's components: model descriptions read (and schema-checked
     when `validate`), FMUs extracted under `extract_root`, connectors checked against the FMUs."""
@@ -55,9 +74,9 @@ def load_components(desc, extract_root, namer, validate):
         except Exception as exc:  # fmpy raises various exceptions for broken FMUs
             raise SSPError(f"component {decl.name!r}: cannot read the model description of "
                            f"{namer(decl.fmu_path)}: {exc}") from None
-        if md.fmiVersion != "2.0" or md.coSimulation is None:
-            raise SSPError(f"component {decl.name!r}: {namer(decl.fmu_path)} is not an FMI 2.0 "
-                           "co-simulation FMU")
+        refusal = unsupported_fmu(md)
+        if refusal:
+            raise SSPError(f"component {decl.name!r}: {namer(decl.fmu_path)} {refusal}")
         info = ComponentInfo(i, decl, md, unzipdir)
         for cname, conn in decl.connectors.items():
             v = info.vars.get(cname)
