@@ -93,127 +93,179 @@ def check_connector_units(comps, units):
 
 
 def valued_system_connectors(desc):
-    """The root system's connectors whose value is given, not computed: those of kind parameter,
-    and those of kind input that no component drives (at the top level nothing outside can: a
-    parameter binding or --set gives their value, as OMSimulator's do). An input connector that a
-    component output drives is a pass-through, as before."""
-    driven = {c.end_connector for c in desc.connections if c.end_element is None and c.start_element is not None}
+    """The system connectors (root or nested) whose value is given, not computed: of kind
+    parameter or input, and fed by no connection (at the top level nothing outside can feed an
+    input: a binding or --set gives its value, as OMSimulator's do). A connector that a
+    component output or another connector feeds is a pass-through, as before."""
+    fed = {c.end_connector for c in desc.connections if c.end_element is None}
     return {name: sc for name, sc in desc.system_connectors.items()
-            if sc.kind == "parameter" or (sc.kind == "input" and name not in driven)}
+            if sc.kind in ("parameter", "input") and name not in fed}
+
+
+def _downstream(desc, name, seen=None):
+    """[(connection, ...)] chains from system connector `name` through system connectors (as
+    written, start -> end) to each connection that leaves the chain at a component."""
+    seen = set() if seen is None else seen
+    if name in seen:
+        raise SSPError(f"system connector {name!r} is part of a loop of system connectors")
+    seen = seen | {name}
+    chains = []
+    for c in desc.connections:
+        if c.start_element is None and c.start_connector == name:
+            if c.end_element is None:
+                chains += [[c] + rest for rest in _downstream(desc, c.end_connector, seen)]
+            else:
+                chains.append([c])
+        elif c.end_element is None and c.end_connector == name and c.start_element is not None:
+            chains.append([c])  # component end written first: its causality orients it later
+    return chains
 
 
 def is_parameter_connection(desc, c):
-    """A connection from a valued system connector (a parameter of the system, or an input that
-    nothing drives) that hands its value to a component's variable before the run."""
-    valued = valued_system_connectors(desc)
-    for element, connector in ((c.start_element, c.start_connector), (c.end_element, c.end_connector)):
-        if element is None and connector in valued:
-            return True
-    return False
+    """A connection on the way from a valued system connector (a parameter of the system, or an
+    input that nothing feeds) to the component variables it gives its value to before the run."""
+    return id(c) in _parameter_connection_ids(desc)
+
+
+def _parameter_connection_ids(desc):
+    ids = set()
+    for name in valued_system_connectors(desc):
+        for chain in _downstream(desc, name):
+            ids.update(id(c) for c in chain)
+    return ids
 
 
 def parameter_connections(desc, by_name):
     """{valued system connector: [(component info, variable, origin)]}: where each system
-    parameter's (or undriven system input's) value goes. A parameter's targets must be parameters
-    of their components; an input's, inputs or parameters."""
+    parameter's (or unfed system input's) value goes, through nested systems' connectors. A
+    parameter's targets must be parameters of their components; an input's, inputs or parameters."""
     valued = valued_system_connectors(desc)
     out = {name: [] for name in valued}
-    for c in desc.connections:
-        if not is_parameter_connection(desc, c):
-            continue
-        where = f"{c.origin}: connection {c.label()}"
-        if c.start_element is None and c.end_element is None:
-            raise SSPError(f"{where}: joins two system connectors; a system parameter must go to a component's "
-                           "parameter")
-        name, element, var = ((c.start_connector, c.end_element, c.end_connector) if c.start_element is None
-                              else (c.end_connector, c.start_element, c.start_connector))
-        comp = by_name.get(element)
-        if comp is None:
-            raise SSPError(f"{where}: no component named {element!r}{near(element, by_name)}")
-        v = comp.vars.get(var)
-        if v is None:
-            raise SSPError(f"{where}: component {element!r} has no variable {var!r}{near(var, comp.vars)}")
-        kind = valued[name].kind
-        allowed = ("parameter",) if kind == "parameter" else ("input", "parameter")
-        if v.causality not in allowed:
-            raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system {kind} can only set "
-                           f"{' or '.join(a + 's' for a in allowed)}")
-        if c.transform is not None:
-            raise SSPError(f"{where}: transformations on parameter connections are not supported")
-        out[name].append((comp, var, c.origin))
+    for name, sc in valued.items():
+        for chain in _downstream(desc, name):
+            c = chain[-1]
+            where = f"{c.origin}: connection {c.label()}"
+            if c.end_element is None and c.start_element is None:
+                continue  # ends at a system connector that feeds nothing further
+            element, var = (c.end_element, c.end_connector) if c.end_element is not None else \
+                (c.start_element, c.start_connector)
+            comp = by_name.get(element)
+            if comp is None:
+                raise SSPError(f"{where}: no component named {element!r}{near(element, by_name)}")
+            v = comp.vars.get(var)
+            if v is None:
+                raise SSPError(f"{where}: component {element!r} has no variable {var!r}{near(var, comp.vars)}")
+            allowed = ("parameter",) if sc.kind == "parameter" else ("input", "parameter")
+            if v.causality not in allowed:
+                raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system {sc.kind} can only "
+                               f"set {' or '.join(a + 's' for a in allowed)}")
+            if any(link.transform is not None for link in chain):
+                raise SSPError(f"{where}: transformations on parameter connections are not supported")
+            out[name].append((comp, var, c.origin))
     return out
 
 
+SOURCE_CAUSALITIES = ("output", "calculatedParameter", "parameter")
+
+
+def _end(desc, by_name, element, connector, c):
+    """('comp', info, var) or ('sys', None, name) for one end of a connection."""
+    if element is None:
+        if connector not in desc.system_connectors:
+            raise SSPError(f"{c.origin}: connection {c.label()}: the system has no connector {connector!r}"
+                           f"{near(connector, desc.system_connectors)}")
+        return ("sys", None, connector)
+    comp = by_name.get(element)
+    if comp is None:
+        raise SSPError(f"{c.origin}: connection {c.label()}: no component named {element!r}"
+                       f"{near(element, by_name)}")
+    if connector not in comp.vars:
+        raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} has no variable "
+                       f"{connector!r}{near(connector, comp.vars)}")
+    declared = comp.decl.connectors
+    if declared and connector not in declared:
+        # a component that lists its connectors lists all it is connected through (SSP 1.0);
+        # one that lists none is taken to expose its FMU's variables
+        raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} declares connectors but not "
+                       f"{connector!r}{near(connector, declared)} (add an ssd:Connector for it)")
+    return ("comp", comp, connector)
+
+
+def _role(e):
+    """'sys', 'src' (an output or parameter), 'dst' (an input) or the causality of another end."""
+    if e[0] == "sys":
+        return "sys"
+    caus = e[1].vars[e[2]].causality
+    return "src" if caus in SOURCE_CAUSALITIES else ("dst" if caus == "input" else caus)
+
+
+def _said(r):
+    return r if r not in ("src", "dst") else ("output" if r == "src" else "input")
+
+
 def resolve_connections(desc, comps, by_name, units):
-    """[Link] for the SSD's connections: each joins an output to an input (system connectors
-    resolved as pass-throughs), every input fed at most once."""
-    src_causal = ("output", "calculatedParameter", "parameter")
-
-    def end(element, connector, c):
-        """('comp', info, var) or ('sys', None, name) for one end of a connection."""
-        if element is None:
-            if connector not in desc.system_connectors:
-                raise SSPError(f"{c.origin}: connection {c.label()}: the system has no connector {connector!r}"
-                               f"{near(connector, desc.system_connectors)}")
-            return ("sys", None, connector)
-        comp = by_name.get(element)
-        if comp is None:
-            raise SSPError(f"{c.origin}: connection {c.label()}: no component named {element!r}"
-                           f"{near(element, by_name)}")
-        if connector not in comp.vars:
-            raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} has no variable "
-                           f"{connector!r}{near(connector, comp.vars)}")
-        declared = comp.decl.connectors
-        if declared and connector not in declared:
-            # a component that lists its connectors lists all it is connected through (SSP 1.0);
-            # one that lists none is taken to expose its FMU's variables
-            raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} declares connectors but not "
-                           f"{connector!r}{near(connector, declared)} (add an ssd:Connector for it)")
-        return ("comp", comp, connector)
-
-    def role(e):
-        if e[0] == "sys":
-            return "sys"
-        caus = e[1].vars[e[2]].causality
-        return "src" if caus in src_causal else ("dst" if caus == "input" else caus)
-
-    def said(r):
-        return r if r not in ("src", "dst") else ("output" if r == "src" else "input")
-
+    """[Link] for the SSD's connections: each joins an output to an input, directly or through
+    system connectors (the root's, nested systems'), every input fed at most once."""
     half = []  # (src_end, dst_end, transform, suppress, connection)
-    # a system parameter's connections fan its value out before the run (parameter_connections)
-    for c in [c for c in desc.connections if not is_parameter_connection(desc, c)]:
-        a = end(c.start_element, c.start_connector, c)
-        b = end(c.end_element, c.end_connector, c)
-        ra, rb = role(a), role(b)
+    # a valued system connector's connections fan its value out before the run (parameter_connections)
+    parameter_ids = _parameter_connection_ids(desc)
+    for c in [c for c in desc.connections if id(c) not in parameter_ids]:
+        a = _end(desc, by_name, c.start_element, c.start_connector, c)
+        b = _end(desc, by_name, c.end_element, c.end_connector, c)
+        ra, rb = _role(a), _role(b)
         transform = c.transform
-        if ra in ("src", "sys") and rb in ("dst", "sys") and not (ra == "sys" and rb == "sys"):
+        if ra == "sys" and rb == "sys":
+            src, dst = a, b  # between system connectors: as written
+        elif ra in ("src", "sys") and rb in ("dst", "sys"):
             src, dst = a, b
-        elif rb in ("src", "sys") and ra in ("dst", "sys") and not (ra == "sys" and rb == "sys"):
+        elif rb in ("src", "sys") and ra in ("dst", "sys"):
             src, dst = b, a
             transform = _invert(transform, c)
         else:
             raise SSPError(f"{c.origin}: connection {c.label()} must join an output to an input "
-                           f"(found {said(ra)} and {said(rb)})")
+                           f"(found {_said(ra)} and {_said(rb)})")
         half.append((src, dst, transform, c.suppress_unit_conversion, c))
 
-    links = []
-    for src, dst, tr, sup, c in half:
-        if src[0] == "comp" and dst[0] == "comp":
-            links.append(_make_link(units, desc, src, dst, [(tr, sup, c)], c.label(), c.origin))
-        elif dst[0] == "sys":
-            # component output -> system connector -> component inputs
-            for src2, dst2, tr2, sup2, c2 in half:
-                if src2[0] == "sys" and src2[2] == dst[2] and dst2[0] == "comp":
-                    label = f"{c.label()} ; {c2.label()}"
-                    links.append(_make_link(units, desc, src, dst2, [(tr, sup, c), (tr2, sup2, c2)], label,
-                                            c2.origin, via=dst[2]))
+    links = _links(desc, units, half)
     seen = {}
     for lk in links:
         key = (lk.dst, lk.dst_var)
         if key in seen:
             raise SSPError(f"input {comps[lk.dst].name}.{lk.dst_var} is connected twice: {seen[key]} and {lk.label}")
         seen[key] = lk.label
+    return links
+
+
+def _links(desc, units, half):
+    """[Link] for the oriented connections `half`: component to component, and component through
+    system connectors (root or nested, any number) to every component input they reach."""
+    from_sys = {}  # system connector -> the half connections that leave it
+    for h in half:
+        if h[0][0] == "sys":
+            from_sys.setdefault(h[0][2], []).append(h)
+
+    def reach(name, chain, vias, seen):
+        """(component end, chain, connectors passed) for every component input that system
+        connector `name` feeds, directly or through further system connectors."""
+        if name in seen:
+            raise SSPError(f"{chain[-1][2].origin}: connection {chain[-1][2].label()}: system connectors form a "
+                           f"loop through {name!r}")
+        for _src, dst, tr, sup, c in from_sys.get(name, []):
+            step = chain + [(tr, sup, c)]
+            if dst[0] == "comp":
+                yield dst, step, vias + [name]
+            else:
+                yield from reach(dst[2], step, vias + [name], seen | {name})
+
+    links = []
+    for src, dst, tr, sup, c in half:
+        if src[0] == "comp" and dst[0] == "comp":
+            links.append(_make_link(units, desc, src, dst, [(tr, sup, c)], c.label(), c.origin))
+        elif src[0] == "comp":
+            # component output -> system connector(s) -> component inputs
+            for dst2, chain, vias in reach(dst[2], [(tr, sup, c)], [], frozenset()):
+                label = " ; ".join(step[2].label() for step in chain)
+                links.append(_make_link(units, desc, src, dst2, chain, label, chain[-1][2].origin, via=vias))
     return links
 
 
@@ -232,8 +284,8 @@ def _make_link(units, desc, src, dst, chain, label, origin, via=None):
         s_fmu, s_conn = units.end_units(sc, sv)
         d_fmu, d_conn = units.end_units(dc, dv)
         steps = [(s_fmu, s_conn, sc, sc)]
-        if via is not None:
-            vu = desc.system_connectors[via].unit
+        for name in via or ():  # the system connectors passed, each in its own unit if it declares one
+            vu = desc.system_connectors[name].unit
             steps.append((s_conn, vu or s_conn, sc, None))
             s_conn = vu or s_conn
         steps.append((s_conn, d_conn, sc, dc))

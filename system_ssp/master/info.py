@@ -6,6 +6,7 @@ import dataclasses
 
 from ..errors import SSPError
 from ..ssp.interface import FmuInterface, variable_line
+from .names import split_name
 from .planning import step_size_of
 
 
@@ -70,8 +71,15 @@ def bindings(system):
         for pv in c.decl.parameters:
             out[(c.name, pv.name)] = (pv.value, pv.origin)
     for pv in system.desc.parameters:
-        comp, _, var = pv.name.partition(".")
-        out[(comp, var)] = (pv.value, pv.origin)
+        if pv.name in system.parameter_links:  # a system parameter: to the variables it is connected to
+            for comp, var, _ in system.parameter_links[pv.name]:
+                out[(comp.name, var)] = (pv.value, f"{pv.origin} through system connector {pv.name}")
+            continue
+        try:
+            comp, var = split_name(system.comps, pv.name)  # component names may hold dots (nested systems)
+        except SSPError:
+            continue  # run refuses it, naming it
+        out[(comp.name, var)] = (pv.value, pv.origin)
     return out
 
 

@@ -10,6 +10,7 @@ that component, for a binding on the root system they are `component.variable`.
 """
 from collections import namedtuple
 from dataclasses import dataclass, field
+import difflib
 import math
 from typing import Any, Dict, Optional
 from pathlib import Path
@@ -614,6 +615,73 @@ def _parse_mode(child, o, namer, names):
                         record_every=every, conditions=tuple(conditions), every=multiples, origin=o)
 
 
+def _parse_system(system, path, desc, namer, base_dir, validate):
+    """The elements, bindings and connections of `system` into the flat `desc`: the root when
+    `path` is "", else a nested system at dotted `path` ("outer.inner"). Its components are named
+    `path.name`; a nested system's connectors join desc.system_connectors as `path.connector`, and
+    a connection that ends at one names it with element None, as one at a root connector does.
+    Bindings of a nested system name what is inside it; they are read before the enclosing
+    system's, so that the outer level wins (the later binding wins)."""
+    display = namer(desc.path)
+    prefix = f"{path}." if path else ""
+    nested = {}  # local name of a nested system -> its connectors
+    elements = system.find("ssd:Elements", NS)
+    for el in ([] if elements is None else elements):
+        if not isinstance(el.tag, str):
+            continue
+        origin = f"{display}:{el.sourceline}"
+        tag = _local(el)
+        if tag == "SignalDictionaryReference":
+            raise SSPError(f"{origin}: signal dictionary references are not supported")
+        if tag not in ("Component", "System"):
+            continue
+        local = _required(el, "name", origin)
+        name = prefix + local
+        if local in nested or desc.component(name) is not None:
+            raise SSPError(f"{origin}: duplicate element name {local!r} in system "
+                           f"{path or desc.system_name!r}")
+        if tag == "System":
+            nested[local] = _parse_connectors(el, namer)
+            for cname, conn in nested[local].items():
+                desc.system_connectors[f"{name}.{cname}"] = conn
+            _parse_system(el, name, desc, namer, base_dir, validate)
+            continue
+        ctype = el.get("type", "application/x-fmu-sharedlibrary")
+        if ctype != "application/x-fmu-sharedlibrary":
+            raise SSPError(f"{origin}: component {name!r} has type {ctype!r}; only FMUs are supported")
+        source = _required(el, "source", origin)
+        comp = Component(name=name, source=source, fmu_path=resolve_uri(source, base_dir), type=ctype,
+                         connectors=_parse_connectors(el, namer), origin=origin)
+        comp.parameters = parse_bindings(el, namer, base_dir, validate, component_dir=None)
+        desc.components.append(comp)
+
+    desc.parameters.extend(v._replace(name=prefix + v.name)
+                           for v in parse_bindings(system, namer, base_dir, validate))
+
+    def end(element, connector, origin):
+        """(element, connector) of a connection end in the flat description."""
+        if element is None:  # this system's own connector
+            return None, prefix + connector
+        if element in nested:
+            if connector not in nested[element]:
+                close = difflib.get_close_matches(connector, list(nested[element]), n=3, cutoff=0.6)
+                hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+                raise SSPError(f"{origin}: nested system {prefix + element!r} has no connector {connector!r}{hint}")
+            return None, f"{prefix}{element}.{connector}"
+        return prefix + element, connector
+
+    conns = system.find("ssd:Connections", NS)
+    for c in ([] if conns is None else conns.findall("ssd:Connection", NS)):
+        origin = f"{display}:{c.sourceline}"
+        start = end(c.get("startElement") or None, _required(c, "startConnector", origin), origin)
+        stop = end(c.get("endElement") or None, _required(c, "endConnector", origin), origin)
+        desc.connections.append(Connection(
+            start_element=start[0], start_connector=start[1], end_element=stop[0], end_connector=stop[1],
+            transform=_parse_transform(c, origin),
+            suppress_unit_conversion=c.get("suppressUnitConversion", "false") in ("true", "1"),
+            origin=origin))
+
+
 def parse_ssd(ssd_path, namer, validate=True):
     """Read a .ssd file (and the .ssv/.ssm files it references) into a SystemDescription."""
     ssd_path = Path(ssd_path)
@@ -627,44 +695,7 @@ def parse_ssd(ssd_path, namer, validate=True):
                              system_name=system.get("name"))
     desc.units = parse_units(root.find("ssd:Units", NS), namer)
     desc.system_connectors = _parse_connectors(system, namer)
-
-    elements = system.find("ssd:Elements", NS)
-    for el in ([] if elements is None else elements):
-        if not isinstance(el.tag, str):
-            continue
-        origin = f"{display}:{el.sourceline}"
-        tag = _local(el)
-        if tag == "System":
-            raise SSPError(f"{origin}: nested system {el.get('name')!r} inside {desc.system_name!r}: only flat "
-                           "systems (components directly under the root system) are supported")
-        if tag == "SignalDictionaryReference":
-            raise SSPError(f"{origin}: signal dictionary references are not supported")
-        if tag != "Component":
-            continue
-        name = _required(el, "name", origin)
-        ctype = el.get("type", "application/x-fmu-sharedlibrary")
-        if ctype != "application/x-fmu-sharedlibrary":
-            raise SSPError(f"{origin}: component {name!r} has type {ctype!r}; only FMUs are supported")
-        if desc.component(name) is not None:
-            raise SSPError(f"{origin}: duplicate component name {name!r}")
-        source = _required(el, "source", origin)
-        fmu_path = resolve_uri(source, base_dir)
-        comp = Component(name=name, source=source, fmu_path=fmu_path, type=ctype,
-                         connectors=_parse_connectors(el, namer), origin=origin)
-        comp.parameters = parse_bindings(el, namer, base_dir, validate, component_dir=None)
-        desc.components.append(comp)
-
-    desc.parameters = parse_bindings(system, namer, base_dir, validate)
-
-    conns = system.find("ssd:Connections", NS)
-    for c in ([] if conns is None else conns.findall("ssd:Connection", NS)):
-        origin = f"{display}:{c.sourceline}"
-        desc.connections.append(Connection(
-            start_element=c.get("startElement") or None, start_connector=_required(c, "startConnector", origin),
-            end_element=c.get("endElement") or None, end_connector=_required(c, "endConnector", origin),
-            transform=_parse_transform(c, origin),
-            suppress_unit_conversion=c.get("suppressUnitConversion", "false") in ("true", "1"),
-            origin=origin))
+    _parse_system(system, "", desc, namer, base_dir, validate)
 
     parse_master_annotation(system, namer, desc.master)
     de = root.find("ssd:DefaultExperiment", NS)

@@ -202,6 +202,11 @@ class _Replacement:
         self.system = self.tree.getroot().find("ssd:System", NS)
         self.comps = {c.get("name"): c for c in self.system.findall("ssd:Elements/ssd:Component", NS)}
         if component not in self.comps:
+            nested = [s.get("name") for s in self.system.findall("ssd:Elements/ssd:System", NS)]
+            inside = next((n for n in nested if component.startswith(f"{n}.")), None)
+            if inside is not None:  # its connections cross the nested system's connectors
+                raise SSPError(f"{source}: component {component!r} is inside nested system {inside!r}; replace "
+                               "works on the root system's components")
             raise SSPError(f"{source}: no component {component!r} (components: {', '.join(self.comps)})")
         self.comp_el = self.comps[component]
         self.old_path = reader.resolve_uri(self.comp_el.get("source"), root)

@@ -288,13 +288,6 @@ def test_missing_fmu(fmus, tmp_path):
         system_ssp.System(ssd)
 
 
-def test_nested_system_refused(fmus, tmp_path):
-    el = h.component("integ", "integ.fmu") + '<ssd:System name="sub"/>'
-    ssd = h.write_system(tmp_path, fmus, USES, h.ssd_text(el))
-    with pytest.raises(SSPError, match="nested system 'sub'"):
-        system_ssp.System(ssd)
-
-
 def test_ssp_archive_and_csv(fmus, tmp_path):
     folder = tmp_path / "sys"
     loop_system(folder, fmus)

@@ -10,6 +10,7 @@ import pytest
 from master_fixtures import helpers as h
 from paths import DATA
 import system_ssp
+from system_ssp import cli
 from system_ssp.errors import SSPError
 from system_ssp.master.planning import make_plan
 
@@ -163,3 +164,98 @@ def test_an_ssp2_array_value_is_refused_by_name(fixture_fmus, tmp_path):
     with pytest.raises(SSPError, match=r"root.ssv:\d+: parameter 'Input_cref': '-20 -21 -22' is an array value "
                                        r"\(SSP 2.0\): it needs FMI 3.0 components"):
         system_ssp.System(ssd)
+
+
+def _real(name, kind, unit=None):
+    u = f' unit="{unit}"' if unit else ""
+    return f'<ssd:Connector name="{name}" kind="{kind}"><ssc:Real{u}/></ssd:Connector>'
+
+
+def _sys_connection(start, end):
+    """A connection whose ends are 'element.connector' or a bare system connector name."""
+    def attrs(which, e):
+        element, _, connector = e.rpartition(".")
+        return (f'{which}Element="{element}" ' if element else "") + f'{which}Connector="{connector}"'
+    return f'<ssd:Connection {attrs("start", start)} {attrs("end", end)}/>\n'
+
+
+def nested_system(tmp_path, fmus, root_binding=""):
+    """gain (root) -> sub.u -> sub.deeper.a -> sub.deeper.g2 -> sub.deeper.b -> sub.integ -> sub.y ->
+    gain.u. The sub system binds deeper.g2.k = 2 and its parameter connector x0p = 0.5, which goes to
+    integ.x0; the root binds gain.b = 1 (and, in a variant, sub.deeper.g2.k = 3: the outer wins)."""
+    deeper = ('<ssd:System name="deeper"><ssd:Connectors>' + _real("a", "input") + _real("b", "output")
+              + "</ssd:Connectors><ssd:Elements>" + h.component("g2", "gain.fmu") + "</ssd:Elements>"
+              + "<ssd:Connections>" + _sys_connection("a", "g2.u") + _sys_connection("g2.y", "b")
+              + "</ssd:Connections></ssd:System>")
+    sub_bind = ('<ssd:ParameterBindings><ssd:ParameterBinding><ssd:ParameterValues>'
+                + h.ssv_text([("deeper.g2.k", "Real", "2", None), ("x0p", "Real", "0.5", None)])
+                .split("?>", 1)[1] + "</ssd:ParameterValues></ssd:ParameterBinding></ssd:ParameterBindings>")
+    sub = ('<ssd:System name="sub"><ssd:Connectors>' + _real("u", "input", "m") + _real("y", "output")
+           + _real("x0p", "parameter") + "</ssd:Connectors>" + sub_bind + "<ssd:Elements>"
+           + h.component("integ", "integ.fmu") + deeper + "</ssd:Elements><ssd:Connections>"
+           + _sys_connection("u", "deeper.a") + _sys_connection("deeper.b", "integ.u")
+           + _sys_connection("integ.x", "y") + _sys_connection("x0p", "integ.x0")
+           + "</ssd:Connections></ssd:System>")
+    root_values = [("gain.b", "Real", "1", None)] + ([("sub.deeper.g2.k", "Real", root_binding, None)]
+                                                      if root_binding else [])
+    (tmp_path / "root.ssv").parent.mkdir(parents=True, exist_ok=True)
+    bind = '<ssd:ParameterBindings><ssd:ParameterBinding source="root.ssv"/></ssd:ParameterBindings>'
+    text = h.ssd_text(h.component("gain", "gain.fmu") + sub,
+                      _sys_connection("gain.y", "sub.u") + _sys_connection("sub.y", "gain.u"), system_head=bind)
+    return h.write_system(tmp_path, fmus, {"gain.fmu": "gain", "integ.fmu": "integrator"}, text,
+                          extra_files={"root.ssv": h.ssv_text(root_values)})
+
+
+def flat_twin(tmp_path, fmus, k):
+    """The same components, flat, under their dotted names, with the values bound directly."""
+    comps = (h.component("gain", "gain.fmu") + h.component("sub.integ", "integ.fmu")
+             + h.component("sub.deeper.g2", "gain.fmu"))
+    conns = (_sys_connection("gain.y", "sub.deeper.g2.u") + _sys_connection("sub.deeper.g2.y", "sub.integ.u")
+             + _sys_connection("sub.integ.x", "gain.u"))
+    values = [("gain.b", "Real", "1", None), ("sub.deeper.g2.k", "Real", str(k), None),
+              ("sub.integ.x0", "Real", "0.5", None)]
+    bind = '<ssd:ParameterBindings><ssd:ParameterBinding source="root.ssv"/></ssd:ParameterBindings>'
+    return h.write_system(tmp_path, fmus, {"gain.fmu": "gain", "integ.fmu": "integrator"},
+                          h.ssd_text(comps, conns, system_head=bind), extra_files={"root.ssv": h.ssv_text(values)})
+
+
+@pytest.mark.parametrize("root_k, k", [("", 2.0), ("3", 3.0)])
+def test_a_nested_system_runs_as_its_flat_twin(fixture_fmus, tmp_path, root_k, k):
+    ssd = nested_system(tmp_path / "nested", fixture_fmus, root_k)
+    r = system_ssp.simulate(ssd, step_size=0.1, stop_time=0.3)
+    assert set(r.names) == {"gain.u", "gain.y", "sub.integ.u", "sub.integ.x", "sub.integ.steps", "sub.deeper.g2.u",
+                            "sub.deeper.g2.y"}
+    twin = system_ssp.simulate(flat_twin(tmp_path / "flat", fixture_fmus, k), step_size=0.1, stop_time=0.3)
+    for name in r.names:
+        np.testing.assert_array_equal(r.data[name], twin.data[name], err_msg=name)
+    # by hand: x(0) = 0.5 (sub's parameter connector), u = k (x + 1): explicit Euler, h = 0.1
+    x = [0.5]
+    for _ in range(3):
+        x.append(x[-1] + 0.1 * k * (x[-1] + 1))
+    np.testing.assert_allclose(r.data["sub.integ.x"], x, rtol=1e-12)
+    # dotted names everywhere: --set, outputs, stop conditions
+    r = system_ssp.simulate(ssd, step_size=0.1, stop_time=0.1, parameters={"sub.deeper.g2.k": 10.0},
+                            outputs=["sub.integ.x"])
+    assert r.names == ["sub.integ.x"] and r.final["sub.deeper.g2.y"] == pytest.approx(10 * (0.5 + 0.1 * 10 * 1.5 + 1))
+
+
+def test_a_nested_system_connector_that_does_not_exist_is_named(fixture_fmus, tmp_path):
+    ssd = nested_system(tmp_path, fixture_fmus)
+    ssd.write_text(ssd.read_text().replace('endElement="sub" endConnector="u"', 'endElement="sub" endConnector="uu"'))
+    with pytest.raises(SSPError, match=r"SystemStructure.ssd:\d+: nested system 'sub' has no connector 'uu' "
+                                       r"\(did you mean 'u'\?\)"):
+        system_ssp.System(ssd)
+
+
+def test_info_and_replace_on_a_nested_system(fixture_fmus, tmp_path, capsys):
+    ssd = nested_system(tmp_path, fixture_fmus, "3")
+    assert cli.main(["info", str(ssd)]) == 0
+    out = capsys.readouterr().out
+    assert "component sub.deeper.g2: resources/gain.fmu" in out
+    assert f"(bound: 3.0 at {tmp_path / 'root.ssv'}:4)" in out  # the root's binding wins over sub's
+    assert f"(bound: 0.5 at {ssd}:11 through system connector sub.x0p)" in out
+    assert cli.main(["replace", str(ssd), "sub.integ", str(fixture_fmus["integrator"]), "--out",
+                     str(tmp_path / "new.ssp")]) == 2
+    assert "component 'sub.integ' is inside nested system 'sub'; replace works on the root system's components" \
+        in capsys.readouterr().err
+    assert not (tmp_path / "new.ssp").exists()
