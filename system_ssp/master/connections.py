@@ -9,7 +9,9 @@ from .graph import toposort
 from .names import near
 
 NUMERIC = ("Real", "Integer", "Boolean", "Enumeration")
-KIND = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean"}
+# how a variable's value travels and is recorded: Enumerations as Integers
+KIND = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"}
+RECORDABLE = NUMERIC + ("String",)
 
 
 class Link(NamedTuple):
@@ -276,8 +278,10 @@ def _make_link(units, desc, src, dst, chain, label, origin, via=None):
     st, dt = sc.vars[sv].type, dc.vars[dv].type
     if KIND.get(st, st) != KIND.get(dt, dt):
         raise SSPError(f"{where}: type mismatch: {sc.name}.{sv} is {st}, {dc.name}.{dv} is {dt}")
-    if st not in NUMERIC:
+    if st not in RECORDABLE:
         raise SSPError(f"{where}: connections of type {st} are not supported")
+    if st == "String" and any(tr is not None for tr, _, _ in chain):
+        raise SSPError(f"{where}: a String connection cannot have a transformation")
     suppress = any(s for _, s, _ in chain)
     factor, offset, mapping = 1.0, 0.0, None
     if st == "Real":

@@ -24,10 +24,10 @@ from ..errors import SimulationError, SSPError
 from .connections import KIND
 from .graph import toposort
 
-CTYPE = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_int}
+CTYPE = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_int, "String": ctypes.c_char_p}
 NPTYPE = {"Real": np.float64, "Integer": np.int32, "Boolean": np.int32}
-GET = {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean"}
-SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean"}
+GET = {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean", "String": "fmi2GetString"}
+SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean", "String": "fmi2SetString"}
 STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
 # FMU messages also go to Python logging ("system_ssp.fmu"), at these levels per FMI status; with
 # INFO enabled there, the FMUs are instantiated with logging on.
@@ -204,6 +204,47 @@ class SetOp:
         self.run = run
 
 
+class StringGetOp:
+    """fmi2GetString of a block of one component's connected String outputs, copied at once into
+    the shared list `G` at `pos` (the FMU's char pointers are valid only until its next call)."""
+    __slots__ = ("ci", "call", "names", "run")
+
+    def __init__(self, fn, c, vr, n, G, pos, ci, names):
+        self.ci, self.call, self.names = ci, "fmi2GetString", names
+        buf = (ctypes.c_char_p * n)()
+
+        def run():
+            s = fn(c, vr, n, buf)
+            if s > 1:
+                raise StepFailed(ci, "fmi2GetString", s, names)
+            G[pos:pos + n] = buf[:n]
+
+        self.run = run
+
+
+class StringSetOp:
+    """fmi2SetString of one component's connected String inputs from the shared list `G` at
+    `idx`; not sent again when the texts equal the ones last sent."""
+    __slots__ = ("ci", "call", "names", "run")
+
+    def __init__(self, fn, c, vr, n, G, idx, ci, names):
+        self.ci, self.call, self.names = ci, "fmi2SetString", names
+        buf = (ctypes.c_char_p * n)()
+        last = [None]
+
+        def run():
+            texts = [G[i] for i in idx]
+            if texts == last[0]:
+                return
+            buf[:] = texts
+            s = fn(c, vr, n, buf)
+            if s > 1:
+                raise StepFailed(ci, "fmi2SetString", s, names)
+            last[0] = texts
+
+        self.run = run
+
+
 def _sequence(runs):
     """One function running `runs` in order (the common single-call case is the call itself)."""
     if len(runs) == 1:
@@ -233,7 +274,8 @@ class ReadOp:
         self.vr = (ctypes.c_uint * m)(*vrefs)
         self.n = m
         self.buf = (CTYPE[kind] * m)()
-        self.view = np.ctypeslib.as_array(self.buf)
+        # Strings: the texts, decoded (a list, copied at each read: the FMU owns the char pointers)
+        self.view = np.ctypeslib.as_array(self.buf) if kind != "String" else None
         self.ci = ci
         self.call = GET[kind]
         self.names = names  # "component.variable", the result's columns
@@ -244,6 +286,8 @@ class ReadOp:
         s = self.fn(self.c, self.vr, self.n, self.buf)
         if s > 1:
             raise StepFailed(self.ci, self.call, s, self.vars)
+        if self.view is None:
+            return [b.decode("utf-8", "replace") if b is not None else "" for b in self.buf]
         return self.view
 
 
@@ -378,12 +422,15 @@ class InstanceTable:
         sysm = self.system
         comps = sysm.comps
         n = len(comps)
-        slots = {"Real": {}, "Integer": {}, "Boolean": {}}  # (ci, var) -> position in the type's buffer
+        slots = {"Real": {}, "Integer": {}, "Boolean": {}, "String": {}}  # (ci, var) -> position in its buffer
         for lk in sysm.links:
             slots[lk.vtype].setdefault((lk.src, lk.src_var), None)
         self.G = {}
         self.gets = [[] for _ in range(n)]
+        self._prepare_strings(slots["String"])
         for kind, d in slots.items():
+            if kind == "String":
+                continue
             by_comp = {}
             for (ci, var) in d:
                 by_comp.setdefault(ci, []).append(var)
@@ -407,6 +454,13 @@ class InstanceTable:
             by_dst.setdefault((lk.dst, lk.vtype), []).append(lk)
         for (ci, kind), lks in sorted(by_dst.items()):
             m = len(lks)
+            if kind == "String":
+                inst = self.instances[ci]
+                vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
+                self.sets[ci].append(StringSetOp(inst.fn[SET[kind]], inst.fmu.component, vr, m, self.G[kind],
+                                                 [slots[kind][(lk.src, lk.src_var)] for lk in lks], ci,
+                                                 tuple(lk.dst_var for lk in lks)))
+                continue
             vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
             buf = (CTYPE[kind] * m)()
             idx = np.array([slots[kind][(lk.src, lk.src_var)] for lk in lks], dtype=np.intp)
@@ -425,6 +479,26 @@ class InstanceTable:
         self.steppers = [self._stepper(ci) for ci in range(n)]
         # components whose connected outputs change when their inputs are set
         self.has_ft = [bool(sysm.graph.feedthrough_outputs[ci]) and bool(self.gets[ci]) for ci in range(n)]
+
+    def _prepare_strings(self, slots):
+        """The shared list of String outputs that are connected (a text per slot, bytes as the
+        FMU gave them) and their StringGetOps; fills `slots` with each one's position."""
+        comps = self.system.comps
+        by_comp = {}
+        for (ci, var) in slots:
+            by_comp.setdefault(ci, []).append(var)
+        G = self.G["String"] = [b""] * sum(len(v) for v in by_comp.values())
+        pos = 0
+        for ci in sorted(by_comp):
+            vars_ = by_comp[ci]
+            m = len(vars_)
+            for j, var in enumerate(vars_):
+                slots[(ci, var)] = pos + j
+            vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
+            inst = self.instances[ci]
+            self.gets[ci].append(StringGetOp(inst.fn[GET["String"]], inst.fmu.component, vr, m, G, pos, ci,
+                                             tuple(vars_)))
+            pos += m
 
     def _do_step(self, ci):
         """do_step(t, dt) of component ci: fmi2DoStep only."""
@@ -494,13 +568,23 @@ class InstanceTable:
                     groups.setdefault(KIND[v.type], []).append(v)
             for kind, vs in groups.items():
                 getter = {"Real": inst.fmu.getReal, "Integer": inst.fmu.getInteger,
-                          "Boolean": inst.fmu.getBoolean}[kind]
+                          "Boolean": inst.fmu.getBoolean, "String": inst.fmu.getString}[kind]
                 vals = self.call(ci, GET[kind], getter, [v.valueReference for v in vs],
                                  names=tuple(v.name for v in vs))
                 for v, x in zip(vs, vals):
-                    final[f"{inst.name}.{v.name}"] = bool(x) if kind == "Boolean" else (
-                        int(x) if kind == "Integer" else float(x))
+                    final[f"{inst.name}.{v.name}"] = _python_value(kind, x)
         return final
+
+
+def _python_value(kind, x):
+    """A value FMPy read, as the Python value results hold (FMPy gives Strings as bytes)."""
+    if kind == "Boolean":
+        return bool(x)
+    if kind == "Integer":
+        return int(x)
+    if kind == "String":
+        return x.decode("utf-8", "replace") if isinstance(x, bytes) else ("" if x is None else str(x))
+    return float(x)
 
 
 def _mapper(kind, links):

@@ -19,7 +19,7 @@ from .plotting import TIME_UNITS
 DAY = 86400.0  # s
 YEAR = 365.25 * DAY  # s, Julian year
 
-RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_}
+RESULT_DTYPE = {"Real": np.float64, "Integer": np.int64, "Boolean": np.bool_, "String": object}
 
 
 class StepInfo:
@@ -117,11 +117,17 @@ class Recorder(Observer):
 
     def __init__(self, table, record, refresh, capacity=1024):
         self.record_names = [f"{table.system.comps[ci].name}.{var}" for ci, var in record]
-        self.ops, columns = read_ops(table, record)
+        ops, columns = read_ops(table, record)
         self.columns = dict(columns)
-        self.col_of = {name: j for j, (name, _) in enumerate(columns)}
+        # numbers go into a float matrix, texts (String variables) into a list per row
+        self.ops = [op for op in ops if op.view is not None]
+        self.text_ops = [op for op in ops if op.view is None]
+        numbers = [c for c in columns if c[1] != "String"]
+        self.col_of = {name: j for j, (name, _) in enumerate(numbers)}
+        self.text_col_of = {name: j for j, (name, _) in enumerate(c for c in columns if c[1] == "String")}
+        self.texts = []
         self.refresh = refresh  # brings the values to record up to date (the algorithm's)
-        self.rows = np.zeros((max(capacity, 2), len(columns)))
+        self.rows = np.zeros((max(capacity, 2), len(numbers)))
         self.times = np.zeros(len(self.rows))
         self.count = 0
         self.since = 0
@@ -136,6 +142,8 @@ class Recorder(Observer):
         for op in self.ops:
             r[col:col + op.n] = op.read()
             col += op.n
+        if self.text_ops:
+            self.texts.append([text for op in self.text_ops for text in op.read()])
         self.times[self.count] = t
         self.count += 1
         self.since = 0
@@ -160,6 +168,10 @@ class Recorder(Observer):
         data = np.zeros(n, dtype=dtype)
         data["time"] = self.times[:n]
         for name in self.record_names:
+            if name in self.text_col_of:
+                j = self.text_col_of[name]
+                data[name] = [row[j] for row in self.texts[:n]]
+                continue
             col = self.rows[:n, self.col_of[name]]
             data[name] = col.astype(RESULT_DTYPE[self.columns[name]]) if self.columns[name] != "Boolean" else col != 0
         return data

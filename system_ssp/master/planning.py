@@ -5,7 +5,7 @@ from typing import Any, Optional
 
 from ..errors import SSPError
 from ..ssp.reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES
-from .connections import KIND, NUMERIC
+from .connections import KIND, RECORDABLE
 from .graph import toposort
 from .names import near, split_name
 from .parameters import collect_parameters
@@ -83,13 +83,13 @@ def _stops(system, stop_when):
 def _recorded(system, outputs):
     if outputs is None:
         return [(c.index, v.name) for c in system.comps for v in c.md.modelVariables
-                if v.causality in ("input", "output") and v.type in NUMERIC]
+                if v.causality in ("input", "output") and v.type in RECORDABLE]
     if isinstance(outputs, str):
         outputs = [o for o in outputs.split(",") if o]
     rec = []
     for o in outputs:
         comp, var = split_name(system.comps, o, "output")
-        if comp.vars[var].type not in NUMERIC:
+        if comp.vars[var].type not in RECORDABLE:
             raise SSPError(f"output {o!r}: variables of type {comp.vars[var].type} cannot be recorded")
         if (comp.index, var) not in rec:
             rec.append((comp.index, var))

@@ -70,14 +70,19 @@ def _read_csv(path: Path) -> Tuple[Dict[str, np.ndarray], Any]:
     bad = next((k for k, row in enumerate(rows[1:], 2) if row and len(row) != len(header)), None)
     if bad is not None:
         raise SSPError(f"{path}:{bad}: {len(rows[bad - 1])} values, the header has {len(header)} columns")
-    try:
-        values = np.array([[float(x) for x in row] for row in rows[1:] if row], dtype=float)
-    except ValueError as exc:
-        raise SSPError(f"{path}: not a result file of numbers ({exc})") from None
-    values = values.reshape(-1, len(header))
+    body = [row for row in rows[1:] if row]
+    columns = {}
+    for i, name in enumerate(header):
+        texts = [row[i] for row in body]
+        try:
+            columns[name] = np.array([float(x) for x in texts], dtype=float)
+        except ValueError as exc:
+            if name == "time":
+                raise SSPError(f"{path}: not a result file: its time column holds {exc}") from None
+            columns[name] = np.array(texts, dtype=object)  # a String variable's column
     sidecar = units_path(path)
     units = json.loads(sidecar.read_text(encoding="utf-8")) if sidecar.is_file() else {}
-    return {name: values[:, i] for i, name in enumerate(header)}, units
+    return columns, units
 
 
 def select(names: Sequence[str], patterns: Sequence[str], where: str = "") -> List[str]:
@@ -95,6 +100,11 @@ def select(names: Sequence[str], patterns: Sequence[str], where: str = "") -> Li
                            "'dynamics.q_BN*' match several; [[] matches a bracket)")
         chosen += [h for h in hits if h not in chosen]
     return [n for n in candidates if n in chosen]
+
+
+def drawable(columns: Any, names: Sequence[str]) -> List[str]:
+    """The `names` whose columns hold numbers: a text column (a String variable) has no axis."""
+    return [n for n in names if np.asarray(columns[n]).dtype.kind in "biuf"]
 
 
 def default_signals(names: Sequence[str], units: Units) -> Tuple[List[str], str]:
@@ -135,6 +145,9 @@ def plot(columns: Dict[str, np.ndarray], units: Units, signals: Sequence[str], o
     title = "".join(c if c.isprintable() else " " for c in title)  # no font draws a NUL or a line break
     if not signals:
         raise SSPError("nothing to plot: the result has no signal but time")
+    texts = [n for n in signals if n not in drawable(columns, signals)]
+    if texts:
+        raise SSPError(f"signal {texts[0]!r} holds text (a String variable): it has no axis to be drawn on")
     groups = panels(signals, units)
     if len(groups) > MAX_PANELS:
         raise SSPError(f"{len(signals)} signals in {len(groups)} different units: choose at most {MAX_PANELS} units' "

@@ -16,7 +16,7 @@ import fmpy
 import numpy as np
 
 from ..version import __version__
-from .plotting import Band, default_signals, interactive_figure, select
+from .plotting import Band, default_signals, drawable, interactive_figure, select
 
 STYLE = """
 body { font-family: system-ui, sans-serif; margin: 1.5em auto; max-width: 1200px; color: #222; }
@@ -138,7 +138,8 @@ def run_report(result: Any, title: str, settings: Mapping[str, Any], signals: Se
     """The report of one run: outcome, settings, versions and a figure of its recorded signals
     (`signals`: names or globs; none: as many units' worth as fit)."""
     names = list(result.data.dtype.names or ())
-    chosen = select(names, list(signals)) if signals else default_signals(names, result.units)[0]
+    chosen = select(names, list(signals)) if signals else default_signals(drawable(result.data, names),
+                                                                          result.units)[0]
     outcome = [("stop time", f"{result.stop_time:g} s"), ("stop reason", result.stop_reason),
                ("steps", result.steps), ("algorithm", result.algorithm), ("order", " ".join(result.order)),
                ("wall time", f"{result.wall_time:.3f} s")]

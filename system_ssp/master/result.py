@@ -9,7 +9,7 @@ import numpy as np
 
 from ..atomic import PathLike, atomic_write, check_output_place, is_stream
 from ..errors import SSPError
-from .plotting import default_signals, plot, select, units_path
+from .plotting import default_signals, drawable, plot, select, units_path
 
 Units = Dict[str, Optional[str]]  # {column: unit or None}
 
@@ -88,7 +88,8 @@ class Result:
         """Draw recorded signals (names or globs like "dynamics.q_BN*"; none: all) against time
         into `out`: .png or .svg, or .html for an interactive page in one file. Returns the path."""
         names = list(self.data.dtype.names or ())
-        chosen = select(names, list(signals)) if signals else default_signals(names, self.units)[0]
+        chosen = select(names, list(signals)) if signals else default_signals(drawable(self.data, names),
+                                                                              self.units)[0]
         return plot({n: self.data[n] for n in names}, dict(self.units), chosen, out, title)
 
 
@@ -156,9 +157,14 @@ def write_parquet_atomic(data: np.ndarray, path: PathLike, units: Optional[Units
     path = Path(path)
     units = units or {}
     names = data.dtype.names or ()
-    fields = [pa.field(n, pa.from_numpy_dtype(data.dtype[n]),
+
+    def arrow_type(n: str) -> Any:  # a String variable's column (numpy object) as Parquet text
+        return pa.string() if data.dtype[n].kind == "O" else pa.from_numpy_dtype(data.dtype[n])
+
+    fields = [pa.field(n, arrow_type(n),
                        metadata={b"unit": unit.encode()} if (unit := units.get(n)) else None) for n in names]
     meta = {b"neighbor-cosim.units": json.dumps({n: units.get(n) for n in names}).encode()}
-    table = pa.table([pa.array(data[n]) for n in names], schema=pa.schema(fields, metadata=meta))
+    table = pa.table([pa.array(data[n].tolist() if data.dtype[n].kind == "O" else data[n], type=arrow_type(n))
+                      for n in names], schema=pa.schema(fields, metadata=meta))
     with atomic_write(path, "wb") as f:
         pq.write_table(table, f)

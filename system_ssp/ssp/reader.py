@@ -366,7 +366,7 @@ def parse_ssm(root, namer):
     nothing: no parameter has an empty name (OMSimulator writes such entries as a template, one per
     parameter of the component, for the user to fill in)."""
     display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
-    mapping: Dict[str, list] = {}
+    mapping = {}  # source -> [(target, transform, suppress, origin)]
     for e in root.findall("ssm:MappingEntry", NS):
         origin = f"{display}:{e.sourceline}"
         if e.get("source") is None:  # required by the schema; a file read without validation

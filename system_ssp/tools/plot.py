@@ -11,7 +11,7 @@ import sys
 from typing import Optional, Sequence
 
 from ..atomic import check_output_place
-from ..master.plotting import FORMATS, default_signals, plot, read_result, select
+from ..master.plotting import FORMATS, default_signals, drawable, plot, read_result, select
 from .console import ArgumentParser
 
 
@@ -29,7 +29,7 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     if args.signals:
         signals = select(list(columns), args.signals, f"{args.result}: ")
     else:
-        signals, note = default_signals(list(columns), units)
+        signals, note = default_signals(drawable(columns, list(columns)), units)
     path = plot(columns, units, signals, out, args.title if args.title is not None else Path(args.result).name)
     print(f"{len(signals)} signal(s) of {args.result} in {path}" + (f" ({note})" if note else ""))
     return 0

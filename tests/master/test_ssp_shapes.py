@@ -259,3 +259,75 @@ def test_info_and_replace_on_a_nested_system(fixture_fmus, tmp_path, capsys):
     assert "component 'sub.integ' is inside nested system 'sub'; replace works on the root system's components" \
         in capsys.readouterr().err
     assert not (tmp_path / "new.ssp").exists()
+
+
+def text_system(tmp_path, fmus):
+    """a.text ("prefix" and a's step count) -> b.text_in; b says its length and shouts it."""
+    prefix = 'say "hi", '  # a comma and quotes: CSV must quote the field
+    bind = ('<ssd:ParameterBinding><ssd:ParameterValues>' + h.ssv_text([("prefix", "String", "PREFIX", None)])
+            .split("?>", 1)[1].replace("PREFIX", prefix.replace('"', "&quot;"))
+            + "</ssd:ParameterValues></ssd:ParameterBinding>")
+    text = h.ssd_text(h.component("a", "text.fmu", bindings=bind) + h.component("b", "text.fmu"),
+                      h.connection("a.text", "b.text_in"))
+    return h.write_system(tmp_path, fmus, {"text.fmu": "text"}, text), prefix
+
+
+def test_string_connections_recorded_written_and_printed(fixture_fmus, tmp_path, capsys):
+    ssd, prefix = text_system(tmp_path, fixture_fmus)
+    r = system_ssp.simulate(ssd, step_size=0.5, stop_time=1.5)
+    # by hand: after k steps a.text is prefix + k, b receives it at once (Gauss-Seidel, a before b)
+    expected = [f"{prefix}{k}" for k in range(4)]
+    assert list(r.data["a.text"]) == expected and list(r.data["b.text_in"]) == expected
+    assert list(r.data["b.shout"]) == [e.upper() for e in expected]
+    assert list(r.data["b.length"]) == [len(e) for e in expected]
+    assert r.final["b.shout"] == 'SAY "HI", 3'
+    # CSV: quoted as RFC 4180 says, read back as text
+    out = tmp_path / "texts.csv"
+    r.write(out)
+    import csv
+    rows = list(csv.reader(out.open(newline="")))
+    assert rows[-1][rows[0].index("b.shout")] == 'SAY "HI", 3'
+    assert '"SAY ""HI"", 3"' in out.read_text()
+    from system_ssp.master.plotting import read_result
+    columns, _ = read_result(out)
+    assert list(columns["a.text"]) == expected and list(columns["b.length"]) == [len(e) for e in expected]
+    # Parquet: string columns
+    import pyarrow.parquet as pq
+    r.write(tmp_path / "texts.parquet")
+    table = pq.read_table(tmp_path / "texts.parquet")
+    assert str(table.schema.field("b.shout").type) == "string"
+    assert table.column("a.text").to_pylist() == expected
+    # the CLI prints them; a plot of everything leaves the texts out, a plot of a text says why
+    assert cli.main(["run", str(ssd), "--step-size", "0.5", "--stop-time", "1.5", "--print-final",
+                     "--plot", str(tmp_path / "all.png")]) == 0
+    assert """  b.shout = 'SAY "HI", 3'""" in capsys.readouterr().out
+    with pytest.raises(SSPError, match=r"signal 'b.shout' holds text \(a String variable\)"):
+        r.plot(["b.shout"], out=tmp_path / "text.png")
+
+
+def test_a_string_connection_with_a_transformation_is_refused(fixture_fmus, tmp_path):
+    ssd, _ = text_system(tmp_path, fixture_fmus)
+    ssd.write_text(ssd.read_text().replace(
+        'endConnector="text_in"></ssd:Connection>',
+        'endConnector="text_in"><ssc:LinearTransformation factor="2"/></ssd:Connection>'))
+    with pytest.raises(SSPError, match=r"a String connection cannot have a transformation"):
+        system_ssp.System(ssd)
+
+
+def test_several_bindings_on_one_element_the_later_wins(tmp_path):
+    """SSP: bindings are applied in document order, so a later one overrides an earlier one; an
+    inline set and a file, the second with a prefix."""
+    (tmp_path / "resources").mkdir()
+    shutil.copy(FMUS / "BouncingBall.fmu", tmp_path / "resources" / "BouncingBall.fmu")
+    (tmp_path / "first.ssv").write_text(h.ssv_text([("g", "Real", "-1", None), ("e", "Real", "0.5", None)]))
+    (tmp_path / "second.ssv").write_text(h.ssv_text([("g", "Real", "-2", None)]))
+    inline = ('<ssd:ParameterBinding><ssd:ParameterValues>'
+              + h.ssv_text([("e", "Real", "0.25", None)]).split("?>", 1)[1]
+              + "</ssd:ParameterValues></ssd:ParameterBinding>")
+    binds = ('<ssd:ParameterBinding source="first.ssv"/>' + inline
+             + '<ssd:ParameterBinding source="second.ssv"/>')
+    (tmp_path / "SystemStructure.ssd").write_text(h.ssd_text(h.component("ball", "BouncingBall.fmu", bindings=binds)))
+    with system_ssp.System(tmp_path / "SystemStructure.ssd") as system:
+        params = {var: value for (_, var), value in make_plan(system, system_ssp.RunOptions(
+            stop_time=1, step_size=0.1)).params.items()}
+    assert params == {"g": -2.0, "e": 0.25}

@@ -10,7 +10,7 @@ HERE = Path(__file__).resolve().parent
 REPO = HERE.parents[2]
 PY = sys.executable
 SCRIPTS = {"gain": "mf_gain.py", "integrator": "mf_integrator.py", "threshold": "mf_threshold.py",
-           "timer": "mf_timer.py"}
+           "timer": "mf_timer.py", "text": "mf_text.py"}
 
 _BUILD_SCRIPT = r"""
 import json, sys
