@@ -98,8 +98,9 @@ def _recorded(system, outputs):
 
 def step_size_of(system, requested=None):
     """The communication step and where it comes from, first found of: the caller's, our
-    annotation's (nc:Master stepSize), OSP's (libcosim's baseStepSize), the FMUs' DefaultExperiment
-    stepSize (the smallest, when they differ: no FMU is stepped coarser than it asks)."""
+    annotation's (nc:Master stepSize), OSP's (libcosim's baseStepSize), OMSimulator's
+    (oms:FixedStepMaster stepSize), the FMUs' DefaultExperiment stepSize (the smallest, when they
+    differ: no FMU is stepped coarser than it asks)."""
     d, m = system.desc, system.desc.master
     if requested is not None:
         return requested, "as requested"
@@ -107,6 +108,8 @@ def step_size_of(system, requested=None):
         return m.step_size, f"nc:Master stepSize at {m.step_size_origin}"
     if m.osp_step_size is not None:
         return m.osp_step_size, f"osp:FixedStepAlgorithm baseStepSize at {m.osp_step_size_origin}"
+    if m.oms_step_size is not None:
+        return m.oms_step_size, f"oms:FixedStepMaster stepSize at {m.oms_step_size_origin}"
     asked = {}
     for c in system.comps:
         experiment = c.md.defaultExperiment
@@ -121,8 +124,9 @@ def step_size_of(system, requested=None):
         which = "the smallest " if len(set(asked.values())) > 1 else ""
         return asked[name], f"{which}DefaultExperiment stepSize of the FMUs ({name})"
     raise SSPError(f"{d.display}: no step size: pass step_size (CLI --step-size), give one in the "
-                   f"{ANNOTATION_TYPE} annotation (nc:Master stepSize) or OSP's (osp:FixedStepAlgorithm "
-                   "baseStepSize), or use FMUs whose DefaultExperiment has a stepSize")
+                   f"{ANNOTATION_TYPE} annotation (nc:Master stepSize), OSP's (osp:FixedStepAlgorithm "
+                   "baseStepSize) or OMSimulator's (oms:FixedStepMaster stepSize), or use FMUs whose "
+                   "DefaultExperiment has a stepSize")
 
 
 def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:

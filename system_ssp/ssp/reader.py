@@ -33,6 +33,9 @@ ANNOTATION_TYPE = "org.neighbor-cosim.master"
 # system's step when ours gives none (osp:Algorithm/osp:FixedStepAlgorithm baseStepSize).
 NS_OSP = "http://opensimulationplatform.com/SSP/OSPAnnotations"
 OSP_ANNOTATION_TYPE = "com.opensimulationplatform"
+# OMSimulator's annotation of a system: its fixed-step master's step
+# (oms:Annotations/oms:SimulationInformation/oms:FixedStepMaster stepSize)
+OMS_ANNOTATION_TYPE = "org.openmodelica"
 # What an nc:When condition of our master annotation may test: an output, or a parameter (a
 # choice fixed for the run, e.g. by a parameter set).
 CONDITION_CAUSALITIES = ("output", "parameter")
@@ -132,6 +135,8 @@ class MasterSettings:
     osp_step_size: Optional[float] = None
     osp_step_size_origin: str = ""
     osp_algorithm: Optional[str] = None  # "jacobi" for OSP's fixed-step algorithm
+    oms_step_size: Optional[float] = None
+    oms_step_size_origin: str = ""
     algorithm: Optional[str] = None
     order: Optional[list] = None
     order_origin: str = ""  # file:line of nc:Order
@@ -533,6 +538,25 @@ def parse_osp_annotation(el, namer, settings):
             settings.osp_algorithm = "jacobi"
 
 
+def parse_oms_annotation(el, namer, settings):
+    """The step of OMSimulator's fixed-step master (its `org.openmodelica` annotation of the root
+    system) into `settings.oms_step_size`; the rest of the annotation is OMSimulator's own."""
+    anns = el.find("ssd:Annotations", NS)
+    if anns is None:
+        return
+    for ann in anns.findall("ssc:Annotation", NS):
+        if ann.get("type") != OMS_ANNOTATION_TYPE:
+            continue
+        for fixed in ann.iter():
+            if isinstance(fixed.tag, str) and _local(fixed) == "FixedStepMaster" and fixed.get("stepSize"):
+                origin = _where(fixed, namer)
+                h = _float_attr(fixed, "stepSize", origin)
+                if h is None or h <= 0:
+                    raise SSPError(f"{origin}: oms:FixedStepMaster stepSize must be a positive number, "
+                                   f"got {fixed.get('stepSize')!r}")
+                settings.oms_step_size, settings.oms_step_size_origin = h, origin
+
+
 def _where(e, namer):
     return f"{namer(e.getroottree().docinfo.URL)}:{e.sourceline}"
 
@@ -698,6 +722,7 @@ def parse_ssd(ssd_path, namer, validate=True):
     _parse_system(system, "", desc, namer, base_dir, validate)
 
     parse_master_annotation(system, namer, desc.master)
+    parse_oms_annotation(system, namer, desc.master)
     de = root.find("ssd:DefaultExperiment", NS)
     if de is not None:
         origin = f"{display}:{de.sourceline}"

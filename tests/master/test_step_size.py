@@ -75,9 +75,10 @@ def test_our_annotation_over_osp_and_the_caller_over_both(tmp_path, capsys):
 def test_no_step_anywhere_names_every_place_one_may_be(tmp_path):
     ssd = system(tmp_path, ["Resource"])  # Resource's DefaultExperiment has no stepSize
     with pytest.raises(SSPError, match=r"no step size: pass step_size \(CLI --step-size\), give one in the "
-                                       r"org.neighbor-cosim.master annotation \(nc:Master stepSize\) or OSP's "
-                                       r"\(osp:FixedStepAlgorithm baseStepSize\), or use FMUs whose "
-                                       r"DefaultExperiment has a stepSize"):
+                                       r"org.neighbor-cosim.master annotation \(nc:Master stepSize\), OSP's "
+                                       r"\(osp:FixedStepAlgorithm baseStepSize\) or OMSimulator's "
+                                       r"\(oms:FixedStepMaster stepSize\), or use FMUs whose DefaultExperiment has "
+                                       r"a stepSize"):
         system_ssp.simulate(ssd)
 
 
@@ -86,3 +87,19 @@ def test_a_bad_osp_base_step_names_its_line(tmp_path, value):
     ssd = system(tmp_path, ["Dahlquist"], experiment_annotations=osp(value))
     with pytest.raises(SSPError, match=rf"^{ssd}:{line_of(ssd, 'osp:FixedStepAlgorithm')}: .*baseStepSize"):
         system_ssp.System(ssd)
+
+
+def test_omsimulator_fixed_step_master_after_osp(tmp_path, capsys):
+    """OMSimulator writes its master's step in its own annotation of the root system
+    (org.openmodelica: oms:SimulationInformation/oms:FixedStepMaster stepSize)."""
+    oms = ('<ssd:Annotations><ssc:Annotation type="org.openmodelica"><oms:Annotations xmlns:oms="https://raw.'
+           'githubusercontent.com/OpenModelica/OMSimulator/master/schema/oms.xsd"><oms:SimulationInformation>'
+           '<oms:FixedStepMaster description="oms-ma" stepSize="0.125000" relativeTolerance="0.000100"/>'
+           '</oms:SimulationInformation></oms:Annotations></ssc:Annotation></ssd:Annotations>')
+    ssd = system(tmp_path, ["Dahlquist"], system_annotations=oms)
+    r = system_ssp.simulate(ssd)
+    assert (r.step_size, r.steps, r.algorithm) == (0.125, 8, "gauss-seidel")
+    assert r.step_size_source == f"oms:FixedStepMaster stepSize at {ssd}:{line_of(ssd, 'oms:FixedStepMaster')}"
+    ssd.write_text(ssd.read_text().replace("<ssd:DefaultExperiment startTime=\"0\" stopTime=\"1\">",
+                                           "<ssd:DefaultExperiment startTime=\"0\" stopTime=\"1\">" + osp("0.25")))
+    assert system_ssp.simulate(ssd).step_size == 0.25  # a file written for both tools: OSP's, as documented
