@@ -320,6 +320,7 @@ def parse_ssv(root, namer):
     display = namer(root.getroottree().docinfo.URL) if root.getroottree().docinfo.URL else "(inline)"
     units = parse_units(root.find("ssv:Units", NS), namer)
     values = []
+    ssp2 = (root.get("version") or "").strip().startswith("2")
     seen = {}  # name -> line: a name twice in one set is refused (which one was meant?)
     params = root.find("ssv:Parameters", NS)
     for p in ([] if params is None else params.findall("ssv:Parameter", NS)):
@@ -341,7 +342,8 @@ def parse_ssv(root, namer):
             raise SSPError(f"{origin}: parameter {name!r} has no value")
         kind = _type_name(tv)
         raw = tv.get("value")
-        if raw is not None and len(raw.split()) > 1 and kind != "String":  # SSP 2.0 lists array values
+        if ssp2 and raw is not None and len(raw.split()) > 1 and kind not in ("String", "Enumeration"):
+            # SSP 2.0 lists array values (a String's, an Enumeration item's spaces are its own)
             raise SSPError(f"{origin}: parameter {name!r}: {raw!r} is an array value (SSP 2.0): {NEEDS_FMI3}")
         if raw is None and tv.find("ssv:Value", NS) is not None:  # SSP 2.0: String/Enumeration/Binary arrays
             raise SSPError(f"{origin}: parameter {name!r} has ssv:Value elements (an SSP 2.0 array): {NEEDS_FMI3}")
