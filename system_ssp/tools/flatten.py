@@ -42,6 +42,10 @@ def flatten_system_parameters(source, out):
         ssd = _unpack(source, root)
         tree = etree.parse(str(ssd))
         sys_el = tree.getroot().find("ssd:System", NS)
+        nested = sys_el.find("ssd:Elements/ssd:System", NS)
+        if nested is not None:  # its components and connectors are not the root's to fold into
+            raise SSPError(f"{source}: nested system {nested.get('name')!r}: flatten works on flat systems "
+                           "(components directly under the root system)")
         per_component = {}
         for comp, var in [(c, v) for targets in links.values() for c, v, _ in targets] + direct:
             per_component.setdefault(comp.name, {})[var] = values[(comp.index, var)]

@@ -111,8 +111,9 @@ def command_line(data, files, out):
     """(argv, long): a command and its arguments; `long` for the commands whose work must not start."""
     places = st.sampled_from(_places(out))
     num, count = st.sampled_from(NUMBERS), st.sampled_from(COUNTS)
-    command = data.draw(st.sampled_from(["run", "info", "replace", "compare", "flatten", "plot", "campaign", "thesis",
-                                         "deorbit-study", "mission", "propulsion", "validation"]), label="command")
+    command = data.draw(st.sampled_from(["run", "info", "replace", "compare", "flatten", "convert", "plot", "campaign",
+                                         "thesis", "deorbit-study", "mission", "propulsion", "validation"]),
+                        label="command")
     console = {"--quiet": None, "--log-level": st.sampled_from(["error", "debug", "loud"])}
     if command == "run":
         argv = [data.draw(_input(files, *SYSTEMS), label="system"), "--stop-time",
@@ -144,6 +145,10 @@ def command_line(data, files, out):
             data, {"--json": None}, "compare"), False
     if command == "flatten":
         return ["flatten", data.draw(_input(files, *SYSTEMS), label="system"), "--out",
+                data.draw(places, label="out")], False
+    if command == "convert":
+        return ["convert", data.draw(_input(files, *SYSTEMS), label="system"), "--ssp-version",
+                data.draw(st.sampled_from(["2.0", "1.0", "3.0", ""]), label="version"), "--out",
                 data.draw(places, label="out")], False
     if command == "plot":
         argv = ["plot", data.draw(_input(files, "result", "text.csv", "garbage.ssp", "missing", "folder", "null",
