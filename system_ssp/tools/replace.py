@@ -199,16 +199,10 @@ class _Replacement:
     def __init__(self, root, ssd, component, new, source):
         self.root, self.ssd, self.component, self.new, self.source = root, ssd, component, new, source
         self.tree = reader.load_xml(ssd, "ssd", reader.FileNamer(root, str(source))).getroottree()
-        self.system = self.tree.getroot().find("ssd:System", NS)
+        self.system, self.local, self.ancestors = self._find(self.tree.getroot().find("ssd:System", NS), component)
+        # the component's siblings: its connections name them by their names in its own system
         self.comps = {c.get("name"): c for c in self.system.findall("ssd:Elements/ssd:Component", NS)}
-        if component not in self.comps:
-            nested = [s.get("name") for s in self.system.findall("ssd:Elements/ssd:System", NS)]
-            inside = next((n for n in nested if component.startswith(f"{n}.")), None)
-            if inside is not None:  # its connections cross the nested system's connectors
-                raise SSPError(f"{source}: component {component!r} is inside nested system {inside!r}; replace "
-                               "works on the root system's components")
-            raise SSPError(f"{source}: no component {component!r} (components: {', '.join(self.comps)})")
-        self.comp_el = self.comps[component]
+        self.comp_el = self.comps[self.local]
         self.old_path = reader.resolve_uri(self.comp_el.get("source"), root)
         self.old = FmuInterface.read(self.old_path)
         self.fmus = {component: self.old}
@@ -216,6 +210,23 @@ class _Replacement:
         self.mismatches = []
         self.conversions = []  # (connection element, (factor, offset))
         self.kept, self.dropped, self.bound = [], [], []
+
+    def _find(self, root_system, component):
+        """(the system element holding `component`, its name there, [(system element, dotted
+        prefix)] from the root down to that system): a nested system's component is named by its
+        path, `sub.deeper.g2`."""
+        system, prefix, local, ancestors = root_system, "", component, []
+        while True:
+            ancestors.append((system, prefix))
+            if any(c.get("name") == local for c in system.findall("ssd:Elements/ssd:Component", NS)):
+                return system, local, ancestors
+            nested = {e.get("name"): e for e in system.findall("ssd:Elements/ssd:System", NS)}
+            head = next((n for n in nested if local.startswith(f"{n}.")), None)
+            if head is None:
+                names = [prefix + c.get("name") for s, prefix in _systems(root_system)
+                         for c in s.findall("ssd:Elements/ssd:Component", NS)]
+                raise SSPError(f"{self.source}: no component {component!r} (components: {', '.join(names)})")
+            system, prefix, local = nested[head], f"{prefix}{head}.", local[len(head) + 1:]
 
     def fmu_of(self, name):
         if name not in self.fmus:
@@ -229,7 +240,7 @@ class _Replacement:
     def check_connections(self):
         for c in self.system.findall("ssd:Connections/ssd:Connection", NS):
             for end, other_end in (("start", "end"), ("end", "start")):
-                if c.get(f"{end}Element") == self.component:
+                if c.get(f"{end}Element") == self.local:
                     self.report.connections += 1
                     self._check_connection(c, end, other_end)
 
@@ -309,11 +320,13 @@ class _Replacement:
                                         self.old.variables[pv.name].kind() if pv.name in self.old.variables
                                         else "a parameter", f"{nv.kind() if nv else 'no such variable'} ({reason}; "
                                         "--drop-unmatched leaves it out)"))
-        for pv in reader.parse_bindings(self.system, namer, self.root, False):
-            comp_name, _, var = pv.name.partition(".")
-            if comp_name == self.component and var not in self.new.variables:
-                self.mismatches.append((f"system-level parameter bound at {pv.origin}", pv.name, "a parameter",
-                                        "no such variable (edit that parameter set)"))
+        for system, prefix in self.ancestors:  # values the enclosing systems bind to it, by its path there
+            for pv in reader.parse_bindings(system, namer, self.root, False):
+                name = prefix + pv.name
+                var = name[len(self.component) + 1:] if name.startswith(f"{self.component}.") else None
+                if var is not None and var not in self.new.variables:
+                    self.mismatches.append((f"system-level parameter bound at {pv.origin}", pv.name, "a parameter",
+                                            "no such variable (edit that parameter set)"))
 
     def _parameter_misfit(self, pv):
         """Why a bound value cannot go to the new FMU (None: it can): no such settable variable,
@@ -357,7 +370,8 @@ class _Replacement:
         else:
             comp_el.insert(0, new_connectors)
         _add_units(self.tree.getroot(), new)
-        comp_el.set("source", _place_fmu(self.root, self.comps, comp_el, new, self.old_path))
+        every = {id(c): c for c in self.tree.getroot().iter(_q("ssd", "Component"))}  # at any depth
+        comp_el.set("source", _place_fmu(self.root, every, comp_el, new, self.old_path))
         self.tree.write(str(self.ssd), xml_declaration=True, encoding="UTF-8")
 
 
@@ -424,6 +438,13 @@ def _add_units(root_el, new):
     for name in missing:
         if name not in have:
             units.append(_unit_el(new.units[name]))
+
+
+def _systems(system, prefix=""):
+    """(system element, dotted prefix of its components) of `system` and every nested one."""
+    yield system, prefix
+    for nested in system.findall("ssd:Elements/ssd:System", NS):
+        yield from _systems(nested, f"{prefix}{nested.get('name')}.")
 
 
 def _place_fmu(root, comps, comp_el, new, old_path):

@@ -254,11 +254,18 @@ def test_info_and_replace_on_a_nested_system(fixture_fmus, tmp_path, capsys):
     assert "component sub.deeper.g2: resources/gain.fmu" in out
     assert f"(bound: 3.0 at {tmp_path / 'root.ssv'}:4)" in out  # the root's binding wins over sub's
     assert f"(bound: 0.5 at {ssd}:11 through system connector sub.x0p)" in out
-    assert cli.main(["replace", str(ssd), "sub.integ", str(fixture_fmus["integrator"]), "--out",
-                     str(tmp_path / "new.ssp")]) == 2
-    assert "component 'sub.integ' is inside nested system 'sub'; replace works on the root system's components" \
-        in capsys.readouterr().err
-    assert not (tmp_path / "new.ssp").exists()
+    # replace inside a nested system: its connections there are checked; the others keep their FMU
+    new = tmp_path / "new.ssp"
+    assert cli.main(["replace", str(ssd), "sub.deeper.g2", str(fixture_fmus["integrator"]), "--out", str(new)]) == 2
+    assert "connection g2.y -> (system).b: y: needs output Real [m]" in capsys.readouterr().err and not new.exists()
+    assert cli.main(["replace", str(ssd), "sub.deeper.g2", str(fixture_fmus["gain"]), "--out", str(new)]) == 0
+    assert "2 connection" in capsys.readouterr().out
+    a = system_ssp.simulate(ssd, step_size=0.1, stop_time=0.3)
+    b = system_ssp.simulate(new, step_size=0.1, stop_time=0.3)
+    for name in a.names:
+        np.testing.assert_array_equal(a.data[name], b.data[name], err_msg=name)
+    assert cli.main(["replace", str(ssd), "sub.nothing", str(fixture_fmus["gain"]), "--out", str(new)]) == 2
+    assert "no component 'sub.nothing' (components: gain, sub.integ, sub.deeper.g2)" in capsys.readouterr().err
 
 
 def text_system(tmp_path, fmus):
