@@ -86,3 +86,34 @@ def test_libcosim_demo_crane_runs_on_its_own_step_and_equals_libcosim(tmp_path):
     assert np.ptp(ref, axis=0).min() > 0  # every signal moves: the comparison is not of constants
     size = np.abs(ref).max(axis=0)
     assert (np.abs(ours - ref) / size).max() < 1e-9
+
+
+def test_reference_fmus_mixed_with_ours_equal_libcosim(fmus, tmp_path):
+    """A system of FMUs from three origins: the Reference FMUs VanDerPol and Feedthrough (C, from
+    the Modelica project) and our gain and integrator (Python, our runtime), chained:
+    vdp.x0 -> ft (passes it through) -> gain (y = -0.5 u + 0.2) -> integ. Jacobi, against libcosim."""
+    import shutil
+    folder = tmp_path / "sys"
+    h.write_system(folder, fmus, {"gain.fmu": "gain", "integ.fmu": "integrator"}, h.ssd_text(
+        h.component("vdp", "VanDerPol.fmu", _conn("x0", "output") + _conn("x1", "output"))
+        + h.component("ft", "Feedthrough.fmu", _conn("Float64_continuous_input", "input")
+                      + _conn("Float64_continuous_output", "output"))
+        + h.component("gain", "gain.fmu", _conn("u", "input") + _conn("y", "output"),
+                      '<ssd:ParameterBinding source="gain.ssv"/>')
+        + h.component("integ", "integ.fmu", _conn("u", "input") + _conn("x", "output")),
+        h.connection("vdp.x0", "ft.Float64_continuous_input") + h.connection("ft.Float64_continuous_output", "gain.u")
+        + h.connection("gain.y", "integ.u")),
+        extra_files={"gain.ssv": h.ssv_text([("k", "Real", "-0.5", None), ("b", "Real", "0.2", None)])})
+    for m in ("VanDerPol", "Feedthrough"):
+        shutil.copy(DATA / "reference_fmus" / "2.0" / f"{m}.fmu", folder / "resources" / f"{m}.fmu")
+    names = ["vdp.x0", "vdp.x1", "ft.Float64_continuous_output", "gain.y", "integ.x"]
+    step, n = 0.05, 100
+    out = tmp_path / "libcosim.json"
+    proc = subprocess.run([sys.executable, str(HELPER), str(folder), str(step), str(n), str(out), *names],
+                          capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    ref = np.array(json.loads(out.read_text()))
+    r = system_ssp.simulate(folder / "SystemStructure.ssd", step_size=step, stop_time=n * step, algorithm="jacobi")
+    ours = np.column_stack([r.data[name][1:] for name in names])
+    assert np.ptp(ours, axis=0).min() > 0.05  # every signal moves
+    np.testing.assert_allclose(ours, ref, rtol=0, atol=1e-12)
