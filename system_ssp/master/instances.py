@@ -245,6 +245,23 @@ class StringSetOp:
         self.run = run
 
 
+def _slot_blocks(slots):
+    """([(component, [variables], first position)], total): each component's connected outputs of
+    one type as one block of the type's shared buffer, in component order; fills `slots`
+    ((component, variable) -> position)."""
+    by_comp = {}
+    for (ci, var) in slots:
+        by_comp.setdefault(ci, []).append(var)
+    blocks, pos = [], 0
+    for ci in sorted(by_comp):
+        vars_ = by_comp[ci]
+        for j, var in enumerate(vars_):
+            slots[(ci, var)] = pos + j
+        blocks.append((ci, vars_, pos))
+        pos += len(vars_)
+    return blocks, pos
+
+
 def _sequence(runs):
     """One function running `runs` in order (the common single-call case is the call itself)."""
     if len(runs) == 1:
@@ -427,27 +444,25 @@ class InstanceTable:
             slots[lk.vtype].setdefault((lk.src, lk.src_var), None)
         self.G = {}
         self.gets = [[] for _ in range(n)]
-        self._prepare_strings(slots["String"])
         for kind, d in slots.items():
-            if kind == "String":
+            blocks, total = _slot_blocks(d)
+            if kind == "String":  # texts: a list, copied at each get (the FMU owns its char pointers)
+                G = self.G[kind] = [b""] * total
+                for ci, vars_, pos in blocks:
+                    vr = (ctypes.c_uint * len(vars_))(*[comps[ci].vars[v].valueReference for v in vars_])
+                    inst = self.instances[ci]
+                    self.gets[ci].append(StringGetOp(inst.fn[GET[kind]], inst.fmu.component, vr, len(vars_), G,
+                                                     pos, ci, tuple(vars_)))
                 continue
-            by_comp = {}
-            for (ci, var) in d:
-                by_comp.setdefault(ci, []).append(var)
-            G = np.zeros(max(sum(len(v) for v in by_comp.values()), 1), dtype=NPTYPE[kind])
+            G = np.zeros(max(total, 1), dtype=NPTYPE[kind])
             self.G[kind] = G
-            pos = 0
-            for ci in sorted(by_comp):
-                vars_ = by_comp[ci]
+            for ci, vars_, pos in blocks:
                 m = len(vars_)
-                for j, var in enumerate(vars_):
-                    d[(ci, var)] = pos + j
                 vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
                 buf = (CTYPE[kind] * m).from_address(G.ctypes.data + pos * G.itemsize)
                 inst = self.instances[ci]
                 self.gets[ci].append(GetOp(inst.fn[GET[kind]], inst.fmu.component, vr, m, buf, ci, GET[kind],
                                            tuple(vars_)))
-                pos += m
         self.sets = [[] for _ in range(n)]
         by_dst = {}
         for lk in sysm.links:
@@ -479,26 +494,6 @@ class InstanceTable:
         self.steppers = [self._stepper(ci) for ci in range(n)]
         # components whose connected outputs change when their inputs are set
         self.has_ft = [bool(sysm.graph.feedthrough_outputs[ci]) and bool(self.gets[ci]) for ci in range(n)]
-
-    def _prepare_strings(self, slots):
-        """The shared list of String outputs that are connected (a text per slot, bytes as the
-        FMU gave them) and their StringGetOps; fills `slots` with each one's position."""
-        comps = self.system.comps
-        by_comp = {}
-        for (ci, var) in slots:
-            by_comp.setdefault(ci, []).append(var)
-        G = self.G["String"] = [b""] * sum(len(v) for v in by_comp.values())
-        pos = 0
-        for ci in sorted(by_comp):
-            vars_ = by_comp[ci]
-            m = len(vars_)
-            for j, var in enumerate(vars_):
-                slots[(ci, var)] = pos + j
-            vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
-            inst = self.instances[ci]
-            self.gets[ci].append(StringGetOp(inst.fn[GET["String"]], inst.fmu.component, vr, m, G, pos, ci,
-                                             tuple(vars_)))
-            pos += m
 
     def _do_step(self, ci):
         """do_step(t, dt) of component ci: fmi2DoStep only."""
