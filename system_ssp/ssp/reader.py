@@ -463,17 +463,19 @@ def _parse_connectors(el, namer):
     return out
 
 
-def parse_master_annotation(el, namer, settings):
-    """Read `org.neighbor-cosim.master` annotations under `el` into `settings` (later wins)."""
-    # SSP 1.0: ssd:System and ssd:DefaultExperiment hold ssd:Annotations (of type ssc:TAnnotations)
+def _annotations(el, kind):
+    """The ssc:Annotation elements of type `kind` directly under `el` (SSP 1.0: ssd:System and
+    ssd:DefaultExperiment hold ssd:Annotations, of type ssc:TAnnotations; some tools write
+    ssc:Annotations)."""
     anns = el.find("ssd:Annotations", NS)
     if anns is None:
         anns = el.find("ssc:Annotations", NS)
-    if anns is None:
-        return
-    for ann in anns.findall("ssc:Annotation", NS):
-        if ann.get("type") != ANNOTATION_TYPE:
-            continue
+    return [] if anns is None else [a for a in anns.findall("ssc:Annotation", NS) if a.get("type") == kind]
+
+
+def parse_master_annotation(el, namer, settings):
+    """Read `org.neighbor-cosim.master` annotations under `el` into `settings` (later wins)."""
+    for ann in _annotations(el, ANNOTATION_TYPE):
         origin = f"{namer(ann.getroottree().docinfo.URL)}:{ann.sourceline}"
         masters = [c for c in ann if isinstance(c.tag, str)]
         if len(masters) != 1 or masters[0].tag != _q("nc", "Master"):
@@ -523,12 +525,7 @@ def parse_master_annotation(el, namer, settings):
 def parse_osp_annotation(el, namer, settings):
     """The step of OSP's fixed-step algorithm (libcosim's `com.opensimulationplatform` annotation
     under `el`) into `settings.osp_step_size`; the annotation's other content is libcosim's own."""
-    anns = el.find("ssd:Annotations", NS)
-    if anns is None:
-        return
-    for ann in anns.findall("ssc:Annotation", NS):
-        if ann.get("type") != OSP_ANNOTATION_TYPE:
-            continue
+    for ann in _annotations(el, OSP_ANNOTATION_TYPE):
         for fixed in ann.iterfind(f"{{{NS_OSP}}}Algorithm/{{{NS_OSP}}}FixedStepAlgorithm"):
             origin = _where(fixed, namer)
             h = _float_attr(fixed, "baseStepSize", origin)
@@ -543,12 +540,7 @@ def parse_osp_annotation(el, namer, settings):
 def parse_oms_annotation(el, namer, settings):
     """The step of OMSimulator's fixed-step master (its `org.openmodelica` annotation of the root
     system) into `settings.oms_step_size`; the rest of the annotation is OMSimulator's own."""
-    anns = el.find("ssd:Annotations", NS)
-    if anns is None:
-        return
-    for ann in anns.findall("ssc:Annotation", NS):
-        if ann.get("type") != OMS_ANNOTATION_TYPE:
-            continue
+    for ann in _annotations(el, OMS_ANNOTATION_TYPE):
         for fixed in ann.iter():
             if isinstance(fixed.tag, str) and _local(fixed) == "FixedStepMaster" and fixed.get("stepSize"):
                 origin = _where(fixed, namer)
