@@ -14,6 +14,16 @@ pytest.importorskip("libcosimpy")
 HELPER = MASTER_FIXTURES / "libcosim_run.py"
 
 
+def libcosim_rows(system, step, n, names, tmp_path):
+    """libcosim's values of `names` after each of `n` steps of `step` s ("file": the system's
+    own), run in a subprocess (see libcosim_run.py)."""
+    out = tmp_path / "libcosim.json"
+    proc = subprocess.run([sys.executable, str(HELPER), str(system), str(step), str(n), str(out), *names],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return np.array(json.loads(out.read_text()))
+
+
 @pytest.fixture(scope="session")
 def fmus(tmp_path_factory):
     return h.build_fixture_fmus(tmp_path_factory.mktemp("master_fmus"))
@@ -42,11 +52,7 @@ def test_jacobi_matches_libcosim(fmus, tmp_path):
                    extra_files=files)
     names = ["i1.x", "i1.u", "gain.y", "i2.x", "g2.y"]
     step, n = 0.05, 40
-    out = tmp_path / "libcosim.json"
-    proc = subprocess.run([sys.executable, str(HELPER), str(folder), str(step), str(n), str(out), *names],
-                          capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    ref = np.array(json.loads(out.read_text()))
+    ref = libcosim_rows(folder, step, n, names, tmp_path)
     r = system_ssp.simulate(folder / "SystemStructure.ssd", step_size=step, stop_time=n * step, algorithm="jacobi")
     ours = np.column_stack([r.data[name][1:] for name in names])
     assert ours.shape == ref.shape
@@ -70,11 +76,7 @@ def test_libcosim_demo_crane_runs_on_its_own_step_and_equals_libcosim(tmp_path):
                                                      ("KnuckleBoomCrane", "p_Crane.f"),
                                                      ("KnuckleBoomCrane", "Act_Limits")) for i in (1, 2, 3)]
     n = 500  # 0.05 s
-    out = tmp_path / "libcosim.json"
-    proc = subprocess.run([sys.executable, str(HELPER), str(ssp), "file", str(n), str(out), *names],
-                          capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    ref = np.array(json.loads(out.read_text()))
+    ref = libcosim_rows(ssp, "file", n, names, tmp_path)
     own = system_ssp.simulate(ssp, outputs=names)  # the file's own experiment: two steps
     assert own.steps == 2 and own.stop_time == 2e-4
     np.testing.assert_array_equal(np.column_stack([own.data[name][1:] for name in names]), ref[:2])
@@ -108,11 +110,7 @@ def test_reference_fmus_mixed_with_ours_equal_libcosim(fmus, tmp_path):
         shutil.copy(DATA / "reference_fmus" / "2.0" / f"{m}.fmu", folder / "resources" / f"{m}.fmu")
     names = ["vdp.x0", "vdp.x1", "ft.Float64_continuous_output", "gain.y", "integ.x"]
     step, n = 0.05, 100
-    out = tmp_path / "libcosim.json"
-    proc = subprocess.run([sys.executable, str(HELPER), str(folder), str(step), str(n), str(out), *names],
-                          capture_output=True, text=True, timeout=120)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    ref = np.array(json.loads(out.read_text()))
+    ref = libcosim_rows(folder, step, n, names, tmp_path)
     r = system_ssp.simulate(folder / "SystemStructure.ssd", step_size=step, stop_time=n * step, algorithm="jacobi")
     ours = np.column_stack([r.data[name][1:] for name in names])
     assert np.ptp(ours, axis=0).min() > 0.05  # every signal moves
