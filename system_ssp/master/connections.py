@@ -95,41 +95,35 @@ def check_connector_units(comps, units):
 
 
 def valued_system_connectors(desc):
-    """The system connectors (root or nested) whose value is given, not computed: of kind
-    parameter or input, and fed by no connection (at the top level nothing outside can feed an
-    input: a binding or --set gives its value, as OMSimulator's do). A connector that a
-    component output or another connector feeds is a pass-through, as before."""
+    """The system connectors (root or nested) whose value is given, not computed: those of kind
+    parameter, and those of kind input that no connection feeds (at the top level nothing outside
+    can: a binding or --set gives the value, as OMSimulator's do). An input connector that a
+    component output or another connector feeds is a pass-through."""
     fed = {c.end_connector for c in desc.connections if c.end_element is None}
     return {name: sc for name, sc in desc.system_connectors.items()
-            if sc.kind in ("parameter", "input") and name not in fed}
+            if sc.kind == "parameter" or (sc.kind == "input" and name not in fed)}
 
 
-def _downstream(desc, name, seen=None):
-    """[(connection, ...)] chains from system connector `name` through system connectors (as
-    written, start -> end) to each connection that leaves the chain at a component."""
-    seen = set() if seen is None else seen
-    if name in seen:
-        raise SSPError(f"system connector {name!r} is part of a loop of system connectors")
-    seen = seen | {name}
+def _downstream(desc, name, seen=frozenset()):
+    """[[connection, ...]]: the chains from system connector `name` through further system
+    connectors (as written, start -> end) to each connection that reaches a component."""
     chains = []
     for c in desc.connections:
         if c.start_element is None and c.start_connector == name:
-            if c.end_element is None:
-                chains += [[c] + rest for rest in _downstream(desc, c.end_connector, seen)]
-            else:
+            if c.end_element is not None:
                 chains.append([c])
+                continue
+            if c.end_connector in seen | {name}:
+                raise SSPError(f"{c.origin}: connection {c.label()} closes a loop of system connectors")
+            chains += [[c] + rest for rest in _downstream(desc, c.end_connector, seen | {name})]
         elif c.end_element is None and c.end_connector == name and c.start_element is not None:
-            chains.append([c])  # component end written first: its causality orients it later
+            chains.append([c])  # the component's end written first: its causality decides (parameter_connections)
     return chains
 
 
-def is_parameter_connection(desc, c):
-    """A connection on the way from a valued system connector (a parameter of the system, or an
-    input that nothing feeds) to the component variables it gives its value to before the run."""
-    return id(c) in _parameter_connection_ids(desc)
-
-
 def _parameter_connection_ids(desc):
+    """id() of every connection on the way from a valued system connector to the component
+    variables it gives its value to before the run (not links of the step loop)."""
     ids = set()
     for name in valued_system_connectors(desc):
         for chain in _downstream(desc, name):

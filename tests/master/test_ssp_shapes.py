@@ -338,3 +338,16 @@ def test_several_bindings_on_one_element_the_later_wins(tmp_path):
         params = {var: value for (_, var), value in make_plan(system, system_ssp.RunOptions(
             stop_time=1, step_size=0.1)).params.items()}
     assert params == {"g": -2.0, "e": 0.25}
+
+
+def test_a_loop_of_system_connectors_is_refused_by_line(fixture_fmus, tmp_path):
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus)
+    text = ssd.read_text().replace("<ssd:Connectors>", "<ssd:Connectors>" + _real("k2", "parameter"), 1)
+    text = text.replace('<ssd:Connection startConnector="k_cref"',
+                        '<ssd:Connection startConnector="k_cref" endConnector="k2"/>\n'
+                        '<ssd:Connection startConnector="k2" endConnector="k_cref"/>\n'
+                        '<ssd:Connection startConnector="k_cref"', 1)
+    ssd.write_text(text)
+    with pytest.raises(SSPError, match=r"SystemStructure.ssd:\d+: connection (k2 -> k_cref|k_cref -> k2) closes "
+                                       r"a loop of system connectors"):
+        system_ssp.System(ssd)
