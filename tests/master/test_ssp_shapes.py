@@ -351,3 +351,23 @@ def test_a_loop_of_system_connectors_is_refused_by_line(fixture_fmus, tmp_path):
     with pytest.raises(SSPError, match=r"SystemStructure.ssd:\d+: connection (k2 -> k_cref|k_cref -> k2) closes "
                                        r"a loop of system connectors"):
         system_ssp.System(ssd)
+
+
+def test_a_stop_condition_inside_a_nested_system(fixture_fmus, tmp_path):
+    """integ (x' = 1) -> sub.x -> sub.thr.x; sub.thr.done (x >= 0.35) stops the run, named by its
+    path, from the caller and from our annotation."""
+    sub = ('<ssd:System name="sub"><ssd:Connectors>' + _real("x", "input", "m") + "</ssd:Connectors><ssd:Elements>"
+           + h.component("thr", "thr.fmu") + "</ssd:Elements><ssd:Connections>" + _sys_connection("x", "thr.x")
+           + "</ssd:Connections></ssd:System>")
+    ann = ('<ssd:Annotations><ssc:Annotation type="org.neighbor-cosim.master"><nc:Master '
+           'xmlns:nc="https://neighbor-cosim.org/ssp/master"><nc:StopCondition component="sub.thr" connector="done"/>'
+           '</nc:Master></ssc:Annotation></ssd:Annotations>')
+    values = h.ssv_text([("integ.u", "Real", "1", None), ("sub.thr.threshold", "Real", "0.35", None)])
+    bind = '<ssd:ParameterBindings><ssd:ParameterBinding source="root.ssv"/></ssd:ParameterBindings>'
+    for name, extra in (("caller", ""), ("annotation", ann)):
+        ssd = h.write_system(tmp_path / name, fixture_fmus, {"integ.fmu": "integrator", "thr.fmu": "threshold"},
+                             h.ssd_text(h.component("integ", "integ.fmu") + sub, _sys_connection("integ.x", "sub.x"),
+                                        system_head=bind, system_extra=extra), extra_files={"root.ssv": values})
+        r = system_ssp.simulate(ssd, step_size=0.1, stop_time=2.0, stop_when=["sub.thr.done"] if not extra else None)
+        assert r.stop_reason.startswith("stop condition sub.thr.done at t=0.4 s"), r.stop_reason
+        assert r.final["sub.thr.x"] == pytest.approx(0.4)
