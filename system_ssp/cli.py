@@ -208,8 +208,9 @@ def _run_or_info(argv):
     if args.command == "run" and args.report:
         check_output_file(args.report, "--report", (".html",))
     suffix = Path(args.path).suffix.lower()
-    if args.command == "run" and suffix not in (".ssp", ".ssd", ".fmu"):
-        raise SSPError(f"{args.path}: expected a system (.ssp, .ssd) or an FMU (.fmu) to run")
+    if args.command == "run" and suffix not in (".ssp", ".ssd", ".fmu") and not Path(args.path).is_dir():
+        raise SSPError(f"{args.path}: expected a system (.ssp, .ssd, a folder with SystemStructure.ssd) or an FMU "
+                       "(.fmu) to run")
     with tempfile.TemporaryDirectory(prefix="neighbor_one_fmu_") as tmp:
         path = args.path
         if args.command == "run" and suffix == ".fmu":  # the FMU alone, as a system of one

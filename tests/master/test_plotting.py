@@ -92,7 +92,10 @@ def test_run_one_fmu_alone(fmu_paths, tmp_path, capsys):
     assert "Gyro.fmu: no stop time: pass --stop-time" in capsys.readouterr().err
     (tmp_path / "x.csv").write_text("time\n0\n")
     assert main(["run", str(tmp_path / "x.csv")]) == 2
-    assert "expected a system (.ssp, .ssd) or an FMU (.fmu)" in capsys.readouterr().err
+    assert "expected a system (.ssp, .ssd, a folder with SystemStructure.ssd) or an FMU (.fmu)" \
+        in capsys.readouterr().err
+    assert main(["run", str(tmp_path)]) == 2  # a folder without a system: the master says so
+    assert f"{tmp_path / 'SystemStructure.ssd'}: file not found" in capsys.readouterr().err
 
 
 def test_thesis_says_which_case_did_not_finish(ssp_paths, capsys):

@@ -54,7 +54,7 @@ def test_osp_base_step_over_the_fmus_and_its_algorithm(tmp_path, capsys):
     assert (r.step_size, r.steps, r.algorithm) == (0.05, 20, "jacobi")
     assert r.step_size_source == f"osp:FixedStepAlgorithm baseStepSize at {at}"
     assert system_ssp.simulate(ssd, algorithm="gauss-seidel").algorithm == "gauss-seidel"
-    assert cli.main(["run", str(ssd)]) == 0
+    assert cli.main(["run", str(ssd.parent)]) == 0  # the system's folder
     assert f"step size:   0.05 s from osp:FixedStepAlgorithm baseStepSize at {at}" in capsys.readouterr().out
     assert cli.main(["info", str(ssd)]) == 0
     assert f"step size: 0.05 s from osp:FixedStepAlgorithm baseStepSize at {at}" in capsys.readouterr().out
