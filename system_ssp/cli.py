@@ -48,8 +48,8 @@ def _parser():
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)
     r = sub.add_parser("run", help="run a system (.ssp or .ssd), or one FMU alone (.fmu)")
-    r.add_argument("path", help="the system (.ssp, or an .ssd in its folder; or a built system's name, e.g. "
-                   "detumble) or one FMU (.fmu)")
+    r.add_argument("path", help="the system (.ssp, an .ssd in its folder, a folder with SystemStructure.ssd, or a "
+                   "built system's name, e.g. detumble) or one FMU (.fmu)")
     r.add_argument("--stop-time", type=finite_float, help="seconds (default: the SSD's DefaultExperiment)")
     r.add_argument("--step-size", type=positive_float,
                    help="communication step in s (default: the SSD's master annotation; an nc:Schedule sets its own)")
