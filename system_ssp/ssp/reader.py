@@ -527,12 +527,8 @@ def parse_osp_annotation(el, namer, settings):
     under `el`) into `settings.osp_step_size`; the annotation's other content is libcosim's own."""
     for ann in _annotations(el, OSP_ANNOTATION_TYPE):
         for fixed in ann.iterfind(f"{{{NS_OSP}}}Algorithm/{{{NS_OSP}}}FixedStepAlgorithm"):
-            origin = _where(fixed, namer)
-            h = _float_attr(fixed, "baseStepSize", origin)
-            if h is None or h <= 0:
-                raise SSPError(f"{origin}: osp:FixedStepAlgorithm baseStepSize must be a positive number, "
-                               f"got {fixed.get('baseStepSize')!r}")
-            settings.osp_step_size, settings.osp_step_size_origin = h, origin
+            settings.osp_step_size, settings.osp_step_size_origin = _step_attr(
+                fixed, "baseStepSize", "osp:FixedStepAlgorithm", namer)
             # libcosim's fixed-step algorithm steps every component from the values at t (Jacobi)
             settings.osp_algorithm = "jacobi"
 
@@ -543,12 +539,17 @@ def parse_oms_annotation(el, namer, settings):
     for ann in _annotations(el, OMS_ANNOTATION_TYPE):
         for fixed in ann.iter():
             if isinstance(fixed.tag, str) and _local(fixed) == "FixedStepMaster" and fixed.get("stepSize"):
-                origin = _where(fixed, namer)
-                h = _float_attr(fixed, "stepSize", origin)
-                if h is None or h <= 0:
-                    raise SSPError(f"{origin}: oms:FixedStepMaster stepSize must be a positive number, "
-                                   f"got {fixed.get('stepSize')!r}")
-                settings.oms_step_size, settings.oms_step_size_origin = h, origin
+                settings.oms_step_size, settings.oms_step_size_origin = _step_attr(
+                    fixed, "stepSize", "oms:FixedStepMaster", namer)
+
+
+def _step_attr(el, attr, what, namer):
+    """(step, file:line) of another tool's step attribute `attr` on `el`: a positive number."""
+    origin = _where(el, namer)
+    h = _float_attr(el, attr, origin)
+    if h is None or h <= 0:
+        raise SSPError(f"{origin}: {what} {attr} must be a positive number, got {el.get(attr)!r}")
+    return h, origin
 
 
 def _where(e, namer):
