@@ -22,553 +22,28 @@
  *   others are not touched); fmi2Fatal only for errors that leave the interpreter unusable
  *   (out of memory, an internal error).
  *
- * The Python side lives in the FMU's resources: neighbor_runtime.py (the loader, executed from
- * its path into a module private to the FMU build, never imported) and one private package with
- * the model's code (see build_fmus.py).
+ * The part shared with the FMI 3.0 binary is neighbor_core.c (included below). The Python side
+ * lives in the FMU's resources: neighbor_runtime.py (the loader, executed from its path into a
+ * module private to the FMU build, never imported) and one private package with the model's code
+ * (see system_ssp/builder.py).
  */
 #ifndef _WIN32
 #define _GNU_SOURCE  /* dladdr */
 #endif
 #include <stdarg.h>
-#include <stddef.h>
 #include <stdio.h>
-#include <stdlib.h>
-#include <string.h>
 
 #include "fmi2Functions.h"
 
-#ifdef _WIN32
-#include <windows.h>
-typedef HMODULE lib_handle;
-static void *lib_sym(lib_handle h, const char *name) { return (void *)GetProcAddress(h, name); }
-static void *process_sym(const char *name) {
-    /* a Python already in the host: look in the modules the process has loaded */
-    static const char *dlls[] = {"python3.dll", "python313.dll", "python312.dll", "python311.dll", "python310.dll"};
-    for (size_t i = 0; i < sizeof dlls / sizeof dlls[0]; i++) {
-        HMODULE m = GetModuleHandleA(dlls[i]);
-        if (m) {
-            void *p = (void *)GetProcAddress(m, name);
-            if (p) return p;
-        }
-    }
-    return NULL;
-}
-#define PATH_SEP '\\'
-#else
-#include <dlfcn.h>
-#include <sys/wait.h>
-typedef void *lib_handle;
-static void *lib_sym(lib_handle h, const char *name) { return dlsym(h, name); }
-static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
-#define PATH_SEP '/'
-#endif
-
-/* ---- the Python C API, by pointer ---------------------------------------------------------- */
-typedef struct _object PyObject;
-typedef ptrdiff_t Py_ssize_t;
-#define PY_FILE_INPUT 257 /* Py_file_input */
-
-static struct {
-    int (*IsInitialized)(void);
-    void (*InitializeEx)(int);
-    void *(*EvalSaveThread)(void);
-    int (*GILStateEnsure)(void);
-    void (*GILStateRelease)(int);
-    PyObject *(*RunString)(const char *, int, PyObject *, PyObject *);
-    PyObject *(*DictNew)(void);
-    int (*DictSetItemString)(PyObject *, const char *, PyObject *);
-    PyObject *(*DictGetItemString)(PyObject *, const char *);
-    PyObject *(*EvalGetBuiltins)(void);
-    PyObject *(*GetAttrString)(PyObject *, const char *);
-    PyObject *(*CallObject)(PyObject *, PyObject *);
-    PyObject *(*Str)(PyObject *);
-    PyObject *(*TupleNew)(Py_ssize_t);
-    int (*TupleSetItem)(PyObject *, Py_ssize_t, PyObject *);
-    PyObject *(*TupleGetItem)(PyObject *, Py_ssize_t);
-    PyObject *(*ListNew)(Py_ssize_t);
-    int (*ListSetItem)(PyObject *, Py_ssize_t, PyObject *);
-    PyObject *(*ListGetItem)(PyObject *, Py_ssize_t);
-    Py_ssize_t (*ListSize)(PyObject *);
-    PyObject *(*LongFromLong)(long);
-    PyObject *(*LongFromUnsignedLong)(unsigned long);
-    long (*LongAsLong)(PyObject *);
-    PyObject *(*FloatFromDouble)(double);
-    double (*FloatAsDouble)(PyObject *);
-    PyObject *(*BoolFromLong)(long);
-    int (*IsTrue)(PyObject *);
-    PyObject *(*UnicodeFromString)(const char *);
-    const char *(*UnicodeAsUTF8)(PyObject *);
-    PyObject *(*ErrOccurred)(void);
-    void (*ErrFetch)(PyObject **, PyObject **, PyObject **);
-    void (*ErrNormalize)(PyObject **, PyObject **, PyObject **);
-    void (*ErrClear)(void);
-    void (*IncRef)(PyObject *);
-    void (*DecRef)(PyObject *);
-    PyObject *(*ImportAddModule)(const char *);
-    PyObject *(*ModuleGetDict)(PyObject *);
-} py;
-
-static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
-#define S(field, name) {name, offsetof(__typeof__(py), field)}
-    S(IsInitialized, "Py_IsInitialized"), S(InitializeEx, "Py_InitializeEx"),
-    S(EvalSaveThread, "PyEval_SaveThread"), S(GILStateEnsure, "PyGILState_Ensure"),
-    S(GILStateRelease, "PyGILState_Release"), S(RunString, "PyRun_String"), S(DictNew, "PyDict_New"),
-    S(DictSetItemString, "PyDict_SetItemString"), S(DictGetItemString, "PyDict_GetItemString"),
-    S(EvalGetBuiltins, "PyEval_GetBuiltins"), S(GetAttrString, "PyObject_GetAttrString"),
-    S(CallObject, "PyObject_CallObject"), S(Str, "PyObject_Str"), S(TupleNew, "PyTuple_New"), S(TupleSetItem, "PyTuple_SetItem"),
-    S(TupleGetItem, "PyTuple_GetItem"), S(ListNew, "PyList_New"), S(ListSetItem, "PyList_SetItem"),
-    S(ListGetItem, "PyList_GetItem"), S(ListSize, "PyList_Size"), S(LongFromLong, "PyLong_FromLong"),
-    S(LongFromUnsignedLong, "PyLong_FromUnsignedLong"), S(LongAsLong, "PyLong_AsLong"),
-    S(FloatFromDouble, "PyFloat_FromDouble"), S(FloatAsDouble, "PyFloat_AsDouble"),
-    S(BoolFromLong, "PyBool_FromLong"), S(IsTrue, "PyObject_IsTrue"),
-    S(UnicodeFromString, "PyUnicode_FromString"), S(UnicodeAsUTF8, "PyUnicode_AsUTF8"),
-    S(ErrOccurred, "PyErr_Occurred"), S(ErrFetch, "PyErr_Fetch"), S(ErrNormalize, "PyErr_NormalizeException"),
-    S(ErrClear, "PyErr_Clear"), S(IncRef, "Py_IncRef"), S(DecRef, "Py_DecRef"),
-    S(ImportAddModule, "PyImport_AddModule"), S(ModuleGetDict, "PyModule_GetDict"),
-#undef S
-};
-
-/* ---- one runtime per loaded library ---------------------------------------------------------- */
-static int runtime_ready = 0;  /* the API is resolved and an interpreter runs */
-static int runtime_embedded = 0;  /* this library started the interpreter */
-static char runtime_error[2048];  /* why the runtime could not start (reported per instance) */
-static PyObject *loader = NULL;  /* namespace of neighbor_runtime.py */
-
-static int resolve_all(lib_handle handle) {
-    for (size_t i = 0; i < sizeof PY_SYMBOLS / sizeof PY_SYMBOLS[0]; i++) {
-        void *p = handle ? lib_sym(handle, PY_SYMBOLS[i].name) : process_sym(PY_SYMBOLS[i].name);
-        if (!p) {
-            snprintf(runtime_error, sizeof runtime_error, "the Python library lacks %s", PY_SYMBOLS[i].name);
-            return 0;
-        }
-        memcpy((char *)&py + PY_SYMBOLS[i].offset, &p, sizeof p);
-    }
-    return 1;
+typedef fmi2CallbackFunctions HostCallbacks;
+static void host_log(HostCallbacks *cb, const char *instance, int status, const char *category, const char *text) {
+    if (cb && cb->logger) cb->logger(cb->componentEnvironment, instance, (fmi2Status)status, category, "%s", text);
 }
 
-/* The value of `key=` in resources/neighbor_runtime.txt (first match), or "" */
-static void config_value(const char *resources, const char *key, char *out, size_t size) {
-    char path[4096];
-    out[0] = '\0';
-    snprintf(path, sizeof path, "%s%cneighbor_runtime.txt", resources, PATH_SEP);
-    FILE *f = fopen(path, "r");
-    if (!f) return;
-    char line[4096];
-    size_t n = strlen(key);
-    while (fgets(line, sizeof line, f)) {
-        if (strncmp(line, key, n) == 0 && line[n] == '=') {
-            line[strcspn(line, "\r\n")] = '\0';
-            snprintf(out, size, "%s", line + n + 1);
-            break;
-        }
-    }
-    fclose(f);
-}
+#include "neighbor_core.c"
 
-/* ---- finding a Python on the target -------------------------------------------------------------
- * In order: NEIGHBOR_FMU_LIBPYTHON (an explicit choice: its failure is the answer); the python3 on
- * the host's PATH (asked for its shared library); libpython3.X through the system's linker for
- * every supported minor version, newest first; the build machine's library last, and only when its
- * prefix exists. A library is taken only with its standard library: the Python home is PYTHONHOME
- * when the user set it, else the folder above the library that holds lib/python3.X/encodings (so
- * the build machine's paths are never used for another Python). Python's own initialization
- * exits the process when it finds no standard library; checking first keeps the host alive. */
-#define MIN_MINOR 9
-#define MAX_MINOR 13
-
-static void note(char *tried, size_t size, const char *fmt, ...) {
-    size_t used = strlen(tried);
-    if (used + 3 >= size) return;
-    if (used) {
-        memcpy(tried + used, "; ", 3);
-        used += 2;
-    }
-    va_list ap;
-    va_start(ap, fmt);
-    vsnprintf(tried + used, size - used, fmt, ap);
-    va_end(ap);
-}
-
-static int file_exists(const char *path) {
-    FILE *f = fopen(path, "rb");
-    if (!f) return 0;
-    fclose(f);
-    return 1;
-}
-
-/* The standard library of Python `version` (3.X) below `home`: its landmark's path in `landmark`. */
-static int stdlib_at(const char *home, const char *version, char *landmark, size_t size) {
-#ifdef _WIN32
-    (void)version;
-    snprintf(landmark, size, "%s\\Lib\\encodings\\__init__.py", home);
-#else
-    snprintf(landmark, size, "%s/lib/python%s/encodings/__init__.py", home, version);
-#endif
-    return file_exists(landmark);
-}
-
-/* The home of the library at `libpath`: it or one of the 3 folders above it holding the standard
-   library (pyenv and python.org: <home>/lib/libpython3.X.so; Debian: /usr/lib/<arch>/; Windows:
-   <home>/python3X.dll). */
-static int home_of_library(const char *libpath, const char *version, char *home, size_t size) {
-    char dir[4096], landmark[4200];
-    snprintf(dir, sizeof dir, "%s", libpath);
-    for (int up = 0; up < 4; up++) {
-        char *sep = strrchr(dir, PATH_SEP);
-#ifdef _WIN32
-        char *alt = strrchr(dir, '/');
-        if (alt > sep) sep = alt;
-#endif
-        if (!sep || sep == dir) return 0;
-        *sep = '\0';
-        if (stdlib_at(dir, version, landmark, sizeof landmark)) {
-            snprintf(home, size, "%s", dir);
-            return 1;
-        }
-    }
-    return 0;
-}
-
-static lib_handle lib_probe(const char *path) {
-#ifdef _WIN32
-    return LoadLibraryA(path);
-#else
-    return dlopen(path, RTLD_NOW | RTLD_LOCAL);  /* made global only once it is chosen */
-#endif
-}
-
-static void lib_close(lib_handle h) {
-#ifdef _WIN32
-    FreeLibrary(h);
-#else
-    dlclose(h);
-#endif
-}
-
-/* Where the library that holds `symbol` (in `h`) was loaded from. */
-static int library_file(lib_handle h, void *symbol, char *out, size_t size) {
-#ifdef _WIN32
-    (void)symbol;
-    DWORD n = GetModuleFileNameA(h, out, (DWORD)size);
-    return n > 0 && n < size;
-#else
-    (void)h;
-    Dl_info info;
-    if (!dladdr(symbol, &info) || !info.dli_fname) return 0;
-    char *real = realpath(info.dli_fname, NULL);  /* Debian: /lib/<arch>/ is /usr/lib/<arch>/ */
-    snprintf(out, size, "%s", real ? real : info.dli_fname);
-    free(real);
-    return 1;
-#endif
-}
-
-/* Try the CPython library `spec` (a path or a name for the linker), found as `how`. On success
-   the handle (made global), its version "3.X" and its home. */
-static lib_handle try_library(const char *spec, const char *how, char *version, size_t vsize, char *home,
-                              size_t hsize, char *tried, size_t tsize) {
-    lib_handle h = lib_probe(spec);
-    if (!h) {
-        note(tried, tsize, "%s (%s): not found", spec, how);
-        return NULL;
-    }
-    void *sym = lib_sym(h, "Py_GetVersion");
-    if (!sym) {
-        note(tried, tsize, "%s (%s): not a CPython library", spec, how);
-        lib_close(h);
-        return NULL;
-    }
-    const char *(*get_version)(void) = (const char *(*)(void))sym;
-    int major = 0, minor = 0;
-    if (sscanf(get_version(), "%d.%d", &major, &minor) != 2 || major != 3 || minor < MIN_MINOR) {
-        note(tried, tsize, "%s (%s): Python %.12s is not supported (3.%d or newer)", spec, how, get_version(),
-             MIN_MINOR);
-        lib_close(h);
-        return NULL;
-    }
-    snprintf(version, vsize, "%d.%d", major, minor);
-    char file[4096], landmark[4200];
-    if (!library_file(h, sym, file, sizeof file)) snprintf(file, sizeof file, "%s", spec);
-    const char *user_home = getenv("PYTHONHOME");
-    if (user_home && user_home[0]) {
-        if (!stdlib_at(user_home, version, landmark, sizeof landmark)) {
-            note(tried, tsize, "%s (%s, Python %s): PYTHONHOME=%s has no standard library for it (no %s)", file,
-                 how, version, user_home, landmark);
-            lib_close(h);
-            return NULL;
-        }
-        snprintf(home, hsize, "%s", user_home);
-    } else if (!home_of_library(file, version, home, hsize)) {
-        note(tried, tsize, "%s (%s, Python %s): no standard library beside it (no lib/python%s/encodings in the "
-             "folders above it; set PYTHONHOME to its prefix)", file, how, version, version);
-        lib_close(h);
-        return NULL;
-    }
-#ifndef _WIN32
-    /* global from now on: extension modules (numpy) find the C API in the process */
-    lib_handle global = dlopen(file, RTLD_NOW | RTLD_GLOBAL);
-    if (global) {
-        dlclose(h);
-        h = global;
-    }
-#endif
-    return h;
-}
-
-/* The shared library of the python3 on the host's PATH, asked from that Python ("" if none);
-   the command's exit status (127: no python3 on PATH). */
-static int python_on_path(char *out, size_t size) {
-    out[0] = '\0';
-#ifdef _WIN32
-    FILE *p = _popen("python -E -S -c \"import sys, os; print(os.path.join(sys.base_prefix, "
-                     "'python%d%d.dll' % sys.version_info[:2]))\" 2>NUL", "r");
-#else
-    FILE *p = popen("python3 -E -S -c \"import os, sysconfig as s; "
-                    "print(os.path.join(s.get_config_var('LIBDIR') or '', s.get_config_var('INSTSONAME') or ''))\" "
-                    "2>/dev/null", "r");
-#endif
-    if (!p) return -1;
-    if (fgets(out, (int)size, p)) out[strcspn(out, "\r\n")] = '\0';
-    else out[0] = '\0';
-#ifdef _WIN32
-    return _pclose(p);
-#else
-    int status = pclose(p);
-    return WIFEXITED(status) ? WEXITSTATUS(status) : -1;
-#endif
-}
-
-static void library_name(int minor, char *out, size_t size) {
-#ifdef _WIN32
-    snprintf(out, size, "python3%d.dll", minor);
-#else
-    snprintf(out, size, "libpython3.%d.so.1.0", minor);
-#endif
-}
-
-static lib_handle find_python(const char *resources, char *version, size_t vsize, char *home, size_t hsize) {
-    char tried[3000] = "", spec[4096];
-    lib_handle h = NULL;
-    const char *env = getenv("NEIGHBOR_FMU_LIBPYTHON");
-    if (env && env[0]) {
-        h = try_library(env, "NEIGHBOR_FMU_LIBPYTHON", version, vsize, home, hsize, tried, sizeof tried);
-        if (!h) snprintf(runtime_error, sizeof runtime_error, "no usable Python for this FMU: %s", tried);
-        return h;
-    }
-    int status = python_on_path(spec, sizeof spec);
-    if (spec[0] && file_exists(spec))
-        h = try_library(spec, "the python3 on PATH", version, vsize, home, hsize, tried, sizeof tried);
-    else if (spec[0])
-        note(tried, sizeof tried, "the python3 on PATH has no shared library (no %s)", spec);
-    else if (status == 127 || status == 9009)  /* sh / cmd.exe: no such command */
-        note(tried, sizeof tried, "no python3 on PATH");
-    else
-        note(tried, sizeof tried, "the python3 on PATH did not answer (exit status %d)", status);
-    for (int minor = MAX_MINOR; minor >= MIN_MINOR && !h; minor--) {
-        library_name(minor, spec, sizeof spec);
-        h = try_library(spec, "system linker", version, vsize, home, hsize, tried, sizeof tried);
-    }
-    if (!h) {
-        char built[4096], built_home[4096], landmark[4200];
-        config_value(resources, "libpython", built, sizeof built);
-        config_value(resources, "python_home", built_home, sizeof built_home);
-        config_value(resources, "python_version", version, vsize);
-        if (built[0] && built_home[0] && stdlib_at(built_home, version, landmark, sizeof landmark))
-            h = try_library(built, "the build's Python", version, vsize, home, hsize, tried, sizeof tried);
-    }
-    if (!h)
-        snprintf(runtime_error, sizeof runtime_error,
-                 "this FMU runs its model in CPython 3.%d to 3.%d with numpy and found none it can use (%s). Install "
-                 "CPython 3 with its shared library (e.g. Debian's libpython3.11) and numpy, put its python3 on "
-                 "PATH, or set NEIGHBOR_FMU_LIBPYTHON to the library's path", MIN_MINOR, MAX_MINOR, tried);
-    return h;
-}
-
-static int start_runtime(const char *resources) {
-    if (runtime_ready) return 1;
-    if (runtime_error[0]) return 0;  /* tried in this process before: the same answer, no retry */
-    if (process_sym("Py_IsInitialized") && resolve_all(NULL) && py.IsInitialized()) {
-        runtime_ready = 1;  /* the host runs Python: use its interpreter */
-        return 1;
-    }
-    runtime_error[0] = '\0';
-    char version[64], home[4096];
-    lib_handle handle = find_python(resources, version, sizeof version, home, sizeof home);
-    if (!handle) return 0;
-    if (!resolve_all(handle)) return 0;
-    if (!py.IsInitialized()) {
-        void *(*decode)(const char *, size_t *) = (void *(*)(const char *, size_t *))lib_sym(handle, "Py_DecodeLocale");
-        void (*set_home)(const void *) = (void (*)(const void *))lib_sym(handle, "Py_SetPythonHome");
-        if (!decode || !set_home) {
-            snprintf(runtime_error, sizeof runtime_error, "the Python %s library lacks Py_SetPythonHome", version);
-            return 0;
-        }
-        static void *whome = NULL;  /* kept: Python reads it during initialization and after */
-        whome = decode(home, NULL);
-        if (whome) set_home(whome);
-        py.InitializeEx(0);  /* no signal handlers: the host owns the signals */
-        runtime_embedded = 1;
-        py.EvalSaveThread();  /* release the GIL: every call takes it with PyGILState_Ensure */
-    }
-    runtime_ready = 1;
-    return 1;
-}
-
-/* ---- instances ------------------------------------------------------------------------------ */
-typedef struct {
-    fmi2CallbackFunctions cb;
-    char *name;
-    int logging_on;
-    PyObject *slave;
-    PyObject *log_queue;  /* the slave's list of pending messages */
-    PyObject *m_get[4], *m_set[4];  /* bound get_real ... get_string, set_real ... set_string */
-    PyObject *m_do_step;
-    char **strings;  /* fmi2GetString results, valid until the next call */
-    size_t n_strings;
-    int broken;  /* a fatal error: every later call returns fmi2Fatal */
-} Instance;
-
-enum { KIND_REAL, KIND_INTEGER, KIND_BOOLEAN, KIND_STRING };
-static const char *GET_NAMES[] = {"get_real", "get_integer", "get_boolean", "get_string"};
-static const char *SET_NAMES[] = {"set_real", "set_integer", "set_boolean", "set_string"};
 static const char *GET_CALLS[] = {"fmi2GetReal", "fmi2GetInteger", "fmi2GetBoolean", "fmi2GetString"};
 static const char *SET_CALLS[] = {"fmi2SetReal", "fmi2SetInteger", "fmi2SetBoolean", "fmi2SetString"};
-
-static char *copy_string(const char *s) {
-    size_t n = strlen(s) + 1;
-    char *out = (char *)malloc(n);
-    if (out) memcpy(out, s, n);
-    return out;
-}
-
-static void log_text(fmi2CallbackFunctions *cb, const char *instance, fmi2Status status, const char *category,
-                     const char *text) {
-    if (cb && cb->logger) cb->logger(cb->componentEnvironment, instance, status, category, "%s", text);
-}
-
-/* Pass the messages the model queued to the host (ok messages only with logging on). GIL held. */
-static void drain_log(Instance *inst) {
-    if (!inst->log_queue || py.ListSize(inst->log_queue) <= 0) return;
-    PyObject *drain = py.DictGetItemString(loader, "drain");
-    PyObject *args = py.TupleNew(1);
-    py.IncRef(inst->slave);
-    py.TupleSetItem(args, 0, inst->slave);
-    PyObject *items = py.CallObject(drain, args);
-    py.DecRef(args);
-    if (!items) {
-        py.ErrClear();
-        return;
-    }
-    Py_ssize_t n = py.ListSize(items);
-    for (Py_ssize_t i = 0; i < n; i++) {
-        PyObject *t = py.ListGetItem(items, i);
-        long status = py.LongAsLong(py.TupleGetItem(t, 0));
-        const char *category = py.UnicodeAsUTF8(py.TupleGetItem(t, 1));
-        const char *text = py.UnicodeAsUTF8(py.TupleGetItem(t, 2));
-        if (status > fmi2OK || inst->logging_on)
-            log_text(&inst->cb, inst->name, (fmi2Status)status, category ? category : "logAll", text ? text : "");
-    }
-    py.DecRef(items);
-}
-
-/* A Python exception is pending: log it and return its status (fmi2Error or fmi2Fatal). GIL held. */
-static fmi2Status fail(Instance *inst, const char *call) {
-    PyObject *type = NULL, *value = NULL, *tb = NULL;
-    py.ErrFetch(&type, &value, &tb);
-    if (type) py.ErrNormalize(&type, &value, &tb);
-    fmi2Status status = fmi2Error;
-    PyObject *describe = loader ? py.DictGetItemString(loader, "describe") : NULL;
-    PyObject *res = NULL;
-    if (describe) {
-        PyObject *fetched[3] = {type, value, tb};
-        PyObject *args = py.TupleNew(4);
-        for (int i = 0; i < 3; i++) {
-            PyObject *o = fetched[i];
-            if (!o) {
-                o = py.DictGetItemString(loader, "NONE");
-                py.IncRef(o);
-            }
-            py.TupleSetItem(args, i, o);  /* steals the fetched references */
-        }
-        type = value = tb = NULL;
-        py.TupleSetItem(args, 3, py.UnicodeFromString(call));
-        res = py.CallObject(describe, args);
-        py.DecRef(args);
-    }
-    if (res) {
-        status = (fmi2Status)py.LongAsLong(py.TupleGetItem(res, 0));
-        const char *text = py.UnicodeAsUTF8(py.TupleGetItem(res, 1));
-        log_text(&inst->cb, inst->name, status, status == fmi2Fatal ? "logStatusFatal" : "logStatusError",
-                 text ? text : call);
-        py.DecRef(res);
-    } else {
-        /* no loader yet (or it failed): the exception's own text */
-        py.ErrClear();
-        PyObject *str = value ? py.Str(value) : NULL;
-        const char *text = str ? py.UnicodeAsUTF8(str) : NULL;
-        char line[2048];
-        snprintf(line, sizeof line, "%s: %s", call, text ? text : "failed");
-        log_text(&inst->cb, inst->name, fmi2Error, "logStatusError", line);
-        if (str) py.DecRef(str);
-        py.ErrClear();
-    }
-    if (type) py.DecRef(type);
-    if (value) py.DecRef(value);
-    if (tb) py.DecRef(tb);
-    if (status == fmi2Fatal) inst->broken = 1;
-    return status;
-}
-
-/* Call fn(args...) (a new tuple, stolen); the result (new reference) or NULL with the status set. */
-static PyObject *call(Instance *inst, PyObject *fn, PyObject *args, const char *what, fmi2Status *status) {
-    PyObject *res = py.CallObject(fn, args);
-    if (args) py.DecRef(args);
-    *status = res ? fmi2OK : fail(inst, what);
-    drain_log(inst);
-    return res;
-}
-
-static PyObject *method(Instance *inst, const char *name) { return py.GetAttrString(inst->slave, name); }
-
-static PyObject *tuple_of(int n, ...) {
-    va_list ap;
-    va_start(ap, n);
-    PyObject *t = py.TupleNew(n);
-    for (int i = 0; i < n; i++) py.TupleSetItem(t, i, va_arg(ap, PyObject *));
-    va_end(ap);
-    return t;
-}
-
-static PyObject *vr_list(const fmi2ValueReference vr[], size_t n) {
-    PyObject *list = py.ListNew((Py_ssize_t)n);
-    for (size_t i = 0; i < n; i++) py.ListSetItem(list, (Py_ssize_t)i, py.LongFromUnsignedLong(vr[i]));
-    return list;
-}
-
-#define ENTER(c, what)                                                 \
-    Instance *inst = (Instance *)(c);                                  \
-    if (!inst) return fmi2Error;                                       \
-    if (inst->broken) return fmi2Fatal;                                \
-    int gil = py.GILStateEnsure();                                     \
-    fmi2Status status = fmi2OK;                                        \
-    (void)status;
-#define LEAVE() py.GILStateRelease(gil)
-
-/* FMI call `what`: the slave's method `name` without arguments (or with `make_args(data)`),
-   its result ignored. */
-static fmi2Status call_method(fmi2Component c, const char *what, const char *name, PyObject *(*make_args)(void *),
-                              void *data) {
-    ENTER(c, what)
-    PyObject *fn = method(inst, name);
-    if (!fn) {
-        status = fail(inst, what);
-    } else {
-        PyObject *res = call(inst, fn, make_args ? make_args(data) : NULL, what, &status);
-        if (res) py.DecRef(res);
-        py.DecRef(fn);
-    }
-    LEAVE();
-    return status;
-}
 
 /* ---- FMI 2.0 -------------------------------------------------------------------------------- */
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
@@ -583,32 +58,6 @@ fmi2Status fmi2SetDebugLogging(fmi2Component c, fmi2Boolean loggingOn, size_t nC
     return fmi2OK;
 }
 
-/* file:///a/b, file:/a/b, file://host/a/b (percent-decoded) or a plain path -> path */
-static void uri_to_path(const char *uri, char *out, size_t size) {
-    const char *p = uri;
-    if (strncmp(p, "file://", 7) == 0) {
-        p += 7;
-        if (*p != '/') p = strchr(p, '/') ? strchr(p, '/') : p;  /* skip a host name */
-    } else if (strncmp(p, "file:", 5) == 0) {
-        p += 5;
-    }
-#ifdef _WIN32
-    if (p[0] == '/' && p[1] && p[2] == ':') p++;  /* /C:/dir -> C:/dir */
-#endif
-    size_t k = 0;
-    for (; *p && k + 1 < size; p++) {
-        if (*p == '%' && p[1] && p[2]) {
-            char hex[3] = {p[1], p[2], 0};
-            out[k++] = (char)strtol(hex, NULL, 16);
-            p += 2;
-        } else {
-            out[k++] = *p;
-        }
-    }
-    while (k > 0 && (out[k - 1] == '/' || out[k - 1] == '\\')) k--;  /* no trailing separator */
-    out[k] = '\0';
-}
-
 fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2String fmuGUID,
                               fmi2String fmuResourceLocation, const fmi2CallbackFunctions *functions,
                               fmi2Boolean visible, fmi2Boolean loggingOn) {
@@ -617,376 +66,127 @@ fmi2Component fmi2Instantiate(fmi2String instanceName, fmi2Type fmuType, fmi2Str
     memset(&cb, 0, sizeof cb);
     if (functions) cb = *functions;
     if (fmuType != fmi2CoSimulation) {
-        log_text(&cb, name, fmi2Error, "logStatusError", "this FMU supports co-simulation only");
+        host_log(&cb, name, fmi2Error, "logStatusError", "this FMU supports co-simulation only");
         return NULL;
     }
     if (!fmuResourceLocation) {
-        log_text(&cb, name, fmi2Error, "logStatusError", "fmi2Instantiate needs the fmuResourceLocation");
+        host_log(&cb, name, fmi2Error, "logStatusError", "fmi2Instantiate needs the fmuResourceLocation");
         return NULL;
     }
     char resources[4096];
     uri_to_path(fmuResourceLocation, resources, sizeof resources);
-    if (!start_runtime(resources)) {
-        log_text(&cb, name, fmi2Error, "logStatusError", runtime_error);
-        return NULL;
-    }
-    Instance *inst = (Instance *)calloc(1, sizeof(Instance));
-    if (!inst) return NULL;
-    inst->cb = cb;
-    inst->name = copy_string(name);
-    inst->logging_on = loggingOn ? 1 : 0;
-    int gil = py.GILStateEnsure();
-    fmi2Status status = fmi2OK;
-    if (!loader) {
-        char path[4200];
-        snprintf(path, sizeof path, "%s%cneighbor_runtime.py", resources, PATH_SEP);
-        FILE *f = fopen(path, "rb");
-        char *code = NULL;
-        if (f) {
-            fseek(f, 0, SEEK_END);
-            long n = ftell(f);
-            fseek(f, 0, SEEK_SET);
-            code = (char *)calloc((size_t)n + 1, 1);
-            if (code && fread(code, 1, (size_t)n, f) != (size_t)n) {
-                free(code);
-                code = NULL;
-            }
-            fclose(f);
-        }
-        if (!code) {
-            log_text(&cb, name, fmi2Error, "logStatusError", "the FMU's resources lack neighbor_runtime.py");
-            py.GILStateRelease(gil);
-            free(inst->name);
-            free(inst);
-            return NULL;
-        }
-        /* The loader's namespace is a module of the interpreter named after a hash of its code and
-         * the FMU's GUID, so unloading and loading the library again (a host that frees it after
-         * every run) reuses it instead of leaving one more copy behind, and no two FMU builds
-         * share one. */
-        unsigned long long h = 1469598103934665603ULL;  /* FNV-1a 64 */
-        for (const unsigned char *p = (const unsigned char *)code; *p; p++) h = (h ^ *p) * 1099511628211ULL;
-        for (const unsigned char *p = (const unsigned char *)(fmuGUID ? fmuGUID : ""); *p; p++)
-            h = (h ^ *p) * 1099511628211ULL;
-        char module_name[64];
-        snprintf(module_name, sizeof module_name, "_neighbor_runtime_%016llx", h);
-        PyObject *module = py.ImportAddModule(module_name);  /* borrowed, kept in sys.modules */
-        PyObject *ns = module ? py.ModuleGetDict(module) : NULL;  /* borrowed */
-        if (ns && !py.DictGetItemString(ns, "instantiate")) {
-            py.DictSetItemString(ns, "__builtins__", py.EvalGetBuiltins());
-            PyObject *r = py.RunString(code, PY_FILE_INPUT, ns, ns);
-            if (r) py.DecRef(r);
-            else ns = NULL;
-        }
-        free(code);
-        if (!ns) {
-            status = fail(inst, "loading neighbor_runtime.py");
-        } else {
-            py.IncRef(ns);
-            loader = ns;
-        }
-    }
-    if (loader) {
-        PyObject *fn = py.DictGetItemString(loader, "instantiate");
-        PyObject *args = tuple_of(6, py.UnicodeFromString(resources), py.UnicodeFromString(name),
-                                  py.UnicodeFromString(fmuGUID ? fmuGUID : ""), py.BoolFromLong(visible),
-                                  py.BoolFromLong(runtime_embedded), py.BoolFromLong(inst->logging_on));
-        PyObject *res = py.CallObject(fn, args);
-        py.DecRef(args);
-        if (!res) {
-            status = fail(inst, "fmi2Instantiate");
-        } else {
-            inst->slave = res;
-            inst->log_queue = method(inst, "log_queue");
-            for (int k = 0; k < 4 && inst->log_queue; k++) {
-                inst->m_get[k] = method(inst, GET_NAMES[k]);
-                inst->m_set[k] = method(inst, SET_NAMES[k]);
-                if (!inst->m_get[k] || !inst->m_set[k]) status = fail(inst, "fmi2Instantiate");
-            }
-            inst->m_do_step = method(inst, "do_step");
-            if (!inst->log_queue || !inst->m_do_step) status = fail(inst, "fmi2Instantiate");
-            drain_log(inst);
-        }
-    }
-    if (status != fmi2OK) {
-        if (inst->slave) {
-            for (int k = 0; k < 4; k++) {
-                if (inst->m_get[k]) py.DecRef(inst->m_get[k]);
-                if (inst->m_set[k]) py.DecRef(inst->m_set[k]);
-            }
-            if (inst->m_do_step) py.DecRef(inst->m_do_step);
-            if (inst->log_queue) py.DecRef(inst->log_queue);
-            py.DecRef(inst->slave);
-        }
-        py.GILStateRelease(gil);
-        free(inst->name);
-        free(inst);
-        return NULL;
-    }
-    py.GILStateRelease(gil);
-    return inst;
+    return new_instance("fmi2Instantiate", name, fmuGUID, resources, visible, loggingOn, cb);
 }
 
-static void free_strings(Instance *inst) {
-    for (size_t i = 0; i < inst->n_strings; i++) free(inst->strings[i]);
-    free(inst->strings);
-    inst->strings = NULL;
-    inst->n_strings = 0;
-}
+void fmi2FreeInstance(fmi2Component c) { free_instance((Instance *)c); }
 
-void fmi2FreeInstance(fmi2Component c) {
-    Instance *inst = (Instance *)c;
-    if (!inst) return;
-    int gil = py.GILStateEnsure();
-    for (int k = 0; k < 4; k++) {
-        if (inst->m_get[k]) py.DecRef(inst->m_get[k]);
-        if (inst->m_set[k]) py.DecRef(inst->m_set[k]);
-    }
-    if (inst->m_do_step) py.DecRef(inst->m_do_step);
-    if (inst->log_queue) py.DecRef(inst->log_queue);
-    if (inst->slave) py.DecRef(inst->slave);
-    py.GILStateRelease(gil);
-    free_strings(inst);
-    free(inst->name);
-    free(inst);
-}
-
-typedef struct { fmi2Boolean tol_defined, stop_defined; fmi2Real tol, start, stop; } Setup;
-static PyObject *none_ref(void) {
-    PyObject *none = py.DictGetItemString(loader, "NONE");
-    py.IncRef(none);
-    return none;
-}
-static PyObject *setup_args(void *data) {
-    Setup *s = (Setup *)data;
-    return tuple_of(3, py.FloatFromDouble(s->start), s->stop_defined ? py.FloatFromDouble(s->stop) : none_ref(),
-                    s->tol_defined ? py.FloatFromDouble(s->tol) : none_ref());
-}
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     Setup s = {toleranceDefined, stopTimeDefined, tolerance, startTime, stopTime};
-    return call_method(c, "fmi2SetupExperiment", "setup_experiment", setup_args, &s);
+    return (fmi2Status)call_method(c, "fmi2SetupExperiment", "setup_experiment", setup_args, &s);
 }
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    return call_method(c, "fmi2EnterInitializationMode", "enter_initialization_mode", NULL, NULL);
+    return (fmi2Status)call_method(c, "fmi2EnterInitializationMode", "enter_initialization_mode", NULL, NULL);
 }
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    return call_method(c, "fmi2ExitInitializationMode", "exit_initialization_mode", NULL, NULL);
+    return (fmi2Status)call_method(c, "fmi2ExitInitializationMode", "exit_initialization_mode", NULL, NULL);
 }
-fmi2Status fmi2Terminate(fmi2Component c) { return call_method(c, "fmi2Terminate", "terminate", NULL, NULL); }
-
-fmi2Status fmi2Reset(fmi2Component c) {
-    ENTER(c, "fmi2Reset")
-    PyObject *fn = py.DictGetItemString(loader, "reset");
-    py.IncRef(inst->slave);
-    PyObject *res = call(inst, fn, tuple_of(1, inst->slave), "fmi2Reset", &status);
-    if (res) {
-        /* a fresh model in the same slave object: the cached bound methods stay valid */
-        py.DecRef(res);
-    }
-    LEAVE();
-    return status;
+fmi2Status fmi2Terminate(fmi2Component c) {
+    return (fmi2Status)call_method(c, "fmi2Terminate", "terminate", NULL, NULL);
 }
+fmi2Status fmi2Reset(fmi2Component c) { return (fmi2Status)reset_instance(c, "fmi2Reset"); }
 
 /* ---- values -------------------------------------------------------------------------------- */
-static fmi2Status get_values(fmi2Component c, int kind, const fmi2ValueReference vr[], size_t nvr, void *out) {
-    ENTER(c, GET_CALLS[kind])
-    PyObject *res = call(inst, inst->m_get[kind], tuple_of(1, vr_list(vr, nvr)), GET_CALLS[kind], &status);
-    if (res) {
-        if (kind == KIND_STRING) free_strings(inst);
-        if (kind == KIND_STRING) {
-            inst->strings = (char **)calloc(nvr ? nvr : 1, sizeof(char *));
-            inst->n_strings = nvr;
-        }
-        for (size_t i = 0; i < nvr; i++) {
-            PyObject *item = py.ListGetItem(res, (Py_ssize_t)i);
-            if (!item) {
-                py.ErrClear();
-                status = fmi2Error;
-                log_text(&inst->cb, inst->name, fmi2Error, "logStatusError", "the model returned too few values");
-                break;
-            }
-            switch (kind) {
-            case KIND_REAL: ((fmi2Real *)out)[i] = py.FloatAsDouble(item); break;
-            case KIND_INTEGER: ((fmi2Integer *)out)[i] = (fmi2Integer)py.LongAsLong(item); break;
-            case KIND_BOOLEAN: ((fmi2Boolean *)out)[i] = py.IsTrue(item) ? fmi2True : fmi2False; break;
-            default: {
-                const char *s = py.UnicodeAsUTF8(item);
-                inst->strings[i] = copy_string(s ? s : "");
-                ((fmi2String *)out)[i] = inst->strings[i];
-            }
-            }
-        }
-        if (py.ErrOccurred()) status = fail(inst, GET_CALLS[kind]);
-        py.DecRef(res);
-    }
-    LEAVE();
-    return status;
-}
-
-static fmi2Status set_values(fmi2Component c, int kind, const fmi2ValueReference vr[], size_t nvr, const void *in) {
-    ENTER(c, SET_CALLS[kind])
-    PyObject *values = py.ListNew((Py_ssize_t)nvr);
-    for (size_t i = 0; i < nvr; i++) {
-        PyObject *v;
-        switch (kind) {
-        case KIND_REAL: v = py.FloatFromDouble(((const fmi2Real *)in)[i]); break;
-        case KIND_INTEGER: v = py.LongFromLong(((const fmi2Integer *)in)[i]); break;
-        case KIND_BOOLEAN: v = py.BoolFromLong(((const fmi2Boolean *)in)[i]); break;
-        default: {
-            const char *s = ((const fmi2String *)in)[i];
-            v = py.UnicodeFromString(s ? s : "");
-            if (!v) v = py.UnicodeFromString("");  /* not UTF-8: the model refuses it as a value */
-        }
-        }
-        py.ListSetItem(values, (Py_ssize_t)i, v);
-    }
-    PyObject *res = call(inst, inst->m_set[kind], tuple_of(2, vr_list(vr, nvr), values), SET_CALLS[kind], &status);
-    if (res) py.DecRef(res);
-    LEAVE();
-    return status;
-}
-
+#define GET2(kind, v) (fmi2Status)get_values(c, kind, vr, nvr, v, nvr, 0, sizeof(fmi2Boolean), GET_CALLS[kind])
+#define SET2(kind, v) (fmi2Status)set_values(c, kind, vr, nvr, v, nvr, 0, sizeof(fmi2Boolean), SET_CALLS[kind])
 fmi2Status fmi2GetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Real value[]) {
-    return get_values(c, KIND_REAL, vr, nvr, value);
+    return GET2(KIND_REAL, value);
 }
 fmi2Status fmi2GetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Integer value[]) {
-    return get_values(c, KIND_INTEGER, vr, nvr, value);
+    return GET2(KIND_INTEGER, value);
 }
 fmi2Status fmi2GetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2Boolean value[]) {
-    return get_values(c, KIND_BOOLEAN, vr, nvr, value);
+    return GET2(KIND_BOOLEAN, value);
 }
 fmi2Status fmi2GetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, fmi2String value[]) {
-    return get_values(c, KIND_STRING, vr, nvr, value);
+    return GET2(KIND_STRING, (void *)value);
 }
 fmi2Status fmi2SetReal(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Real value[]) {
-    return set_values(c, KIND_REAL, vr, nvr, value);
+    return SET2(KIND_REAL, value);
 }
 fmi2Status fmi2SetInteger(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Integer value[]) {
-    return set_values(c, KIND_INTEGER, vr, nvr, value);
+    return SET2(KIND_INTEGER, value);
 }
 fmi2Status fmi2SetBoolean(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2Boolean value[]) {
-    return set_values(c, KIND_BOOLEAN, vr, nvr, value);
+    return SET2(KIND_BOOLEAN, value);
 }
 fmi2Status fmi2SetString(fmi2Component c, const fmi2ValueReference vr[], size_t nvr, const fmi2String value[]) {
-    return set_values(c, KIND_STRING, vr, nvr, value);
+    return SET2(KIND_STRING, value);
 }
 
 /* ---- state ---------------------------------------------------------------------------------- */
 fmi2Status fmi2GetFMUstate(fmi2Component c, fmi2FMUstate *state) {
-    ENTER(c, "fmi2GetFMUstate")
-    PyObject *fn = method(inst, "_get_fmu_state");
-    PyObject *res = fn ? call(inst, fn, NULL, "fmi2GetFMUstate", &status) : NULL;
-    if (!fn) status = fail(inst, "fmi2GetFMUstate");
-    if (fn) py.DecRef(fn);
-    if (res) {
-        if (state && *state) py.DecRef((PyObject *)*state);  /* FMI: a given state is overwritten */
-        if (state) *state = (fmi2FMUstate)res; else py.DecRef(res);
-    }
-    LEAVE();
-    return status;
+    return (fmi2Status)get_state(c, state, "fmi2GetFMUstate");
 }
 fmi2Status fmi2SetFMUstate(fmi2Component c, fmi2FMUstate state) {
-    ENTER(c, "fmi2SetFMUstate")
-    if (!state) {
-        log_text(&inst->cb, inst->name, fmi2Error, "logStatusError", "fmi2SetFMUstate: no state given");
-        LEAVE();
-        return fmi2Error;
-    }
-    PyObject *fn = method(inst, "_set_fmu_state");
-    if (!fn) {
-        status = fail(inst, "fmi2SetFMUstate");
-    } else {
-        py.IncRef((PyObject *)state);
-        PyObject *res = call(inst, fn, tuple_of(1, (PyObject *)state), "fmi2SetFMUstate", &status);
-        if (res) py.DecRef(res);
-        py.DecRef(fn);
-    }
-    LEAVE();
-    return status;
+    return (fmi2Status)set_state(c, state, "fmi2SetFMUstate");
 }
 fmi2Status fmi2FreeFMUstate(fmi2Component c, fmi2FMUstate *state) {
-    ENTER(c, "fmi2FreeFMUstate")
-    if (state && *state) {
-        py.DecRef((PyObject *)*state);
-        *state = NULL;
-    }
-    LEAVE();
-    return fmi2OK;
-}
-
-static fmi2Status unsupported(fmi2Component c, const char *what) {
-    Instance *inst = (Instance *)c;
-    if (inst) {
-        char text[256];
-        snprintf(text, sizeof text, "%s is not supported by this FMU", what);
-        log_text(&inst->cb, inst->name, fmi2Error, "logStatusError", text);
-    }
-    return fmi2Error;
+    return (fmi2Status)free_state(c, state);
 }
 fmi2Status fmi2SerializedFMUstateSize(fmi2Component c, fmi2FMUstate s, size_t *n) {
     (void)s; (void)n;
-    return unsupported(c, "fmi2SerializedFMUstateSize");
+    return (fmi2Status)unsupported(c, "fmi2SerializedFMUstateSize");
 }
 fmi2Status fmi2SerializeFMUstate(fmi2Component c, fmi2FMUstate s, fmi2Byte b[], size_t n) {
     (void)s; (void)b; (void)n;
-    return unsupported(c, "fmi2SerializeFMUstate");
+    return (fmi2Status)unsupported(c, "fmi2SerializeFMUstate");
 }
 fmi2Status fmi2DeSerializeFMUstate(fmi2Component c, const fmi2Byte b[], size_t n, fmi2FMUstate *s) {
     (void)b; (void)n; (void)s;
-    return unsupported(c, "fmi2DeSerializeFMUstate");
+    return (fmi2Status)unsupported(c, "fmi2DeSerializeFMUstate");
 }
 fmi2Status fmi2GetDirectionalDerivative(fmi2Component c, const fmi2ValueReference u[], size_t nu,
                                         const fmi2ValueReference z[], size_t nz, const fmi2Real dv[],
                                         fmi2Real dz[]) {
     (void)u; (void)nu; (void)z; (void)nz; (void)dv; (void)dz;
-    return unsupported(c, "fmi2GetDirectionalDerivative");
+    return (fmi2Status)unsupported(c, "fmi2GetDirectionalDerivative");
 }
 
 /* ---- co-simulation -------------------------------------------------------------------------- */
 fmi2Status fmi2SetRealInputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                        const fmi2Integer order[], const fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
-    return unsupported(c, "fmi2SetRealInputDerivatives");
+    return (fmi2Status)unsupported(c, "fmi2SetRealInputDerivatives");
 }
 fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReference vr[], size_t nvr,
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
-    return unsupported(c, "fmi2GetRealOutputDerivatives");
+    return (fmi2Status)unsupported(c, "fmi2GetRealOutputDerivatives");
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {
     (void)noSetFMUStatePriorToCurrentPoint;
-    ENTER(c, "fmi2DoStep")
-    PyObject *res = call(inst, inst->m_do_step, tuple_of(2, py.FloatFromDouble(t), py.FloatFromDouble(h)),
-                         "fmi2DoStep", &status);
-    if (res) {
-        int ok = py.IsTrue(res);
-        if (ok < 0) status = fail(inst, "fmi2DoStep");
-        else if (!ok) status = fmi2Discard;
-        py.DecRef(res);
-    }
-    LEAVE();
-    return status;
+    return (fmi2Status)do_step(c, t, h, "fmi2DoStep");
 }
-fmi2Status fmi2CancelStep(fmi2Component c) { return unsupported(c, "fmi2CancelStep"); }
+fmi2Status fmi2CancelStep(fmi2Component c) { return (fmi2Status)unsupported(c, "fmi2CancelStep"); }
 fmi2Status fmi2GetStatus(fmi2Component c, const fmi2StatusKind s, fmi2Status *value) {
     (void)s; (void)value;
-    return unsupported(c, "fmi2GetStatus");
+    return (fmi2Status)unsupported(c, "fmi2GetStatus");
 }
 fmi2Status fmi2GetRealStatus(fmi2Component c, const fmi2StatusKind s, fmi2Real *value) {
     (void)s; (void)value;
-    return unsupported(c, "fmi2GetRealStatus");
+    return (fmi2Status)unsupported(c, "fmi2GetRealStatus");
 }
 fmi2Status fmi2GetIntegerStatus(fmi2Component c, const fmi2StatusKind s, fmi2Integer *value) {
     (void)s; (void)value;
-    return unsupported(c, "fmi2GetIntegerStatus");
+    return (fmi2Status)unsupported(c, "fmi2GetIntegerStatus");
 }
 fmi2Status fmi2GetBooleanStatus(fmi2Component c, const fmi2StatusKind s, fmi2Boolean *value) {
     (void)s; (void)value;
-    return unsupported(c, "fmi2GetBooleanStatus");
+    return (fmi2Status)unsupported(c, "fmi2GetBooleanStatus");
 }
 fmi2Status fmi2GetStringStatus(fmi2Component c, const fmi2StatusKind s, fmi2String *value) {
     (void)s; (void)value;
-    return unsupported(c, "fmi2GetStringStatus");
+    return (fmi2Status)unsupported(c, "fmi2GetStringStatus");
 }

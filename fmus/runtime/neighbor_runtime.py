@@ -1,9 +1,11 @@
-"""The Python side of a neighbor-cosim FMU's binary (neighbor_fmi2.c): loads the model.
+"""The Python side of a neighbor-cosim FMU's binary (neighbor_fmi2.c or neighbor_fmi3.c): loads
+the model.
 
 The binary executes this file from the FMU's resources into a module of its own, named after a
-hash of this code and the FMU's GUID (it is never imported, so the loaders of different FMU builds
-cannot collide; a library loaded again reuses it) and calls `instantiate`, `reset`,
-`drain` and `describe`. The model's code is one package with a name private to the FMU build
+hash of this code and the FMU's GUID or instantiation token (it is never imported, so the loaders
+of different FMU builds cannot collide; a library loaded again reuses it) and calls `instantiate`,
+`reset`, `drain` and `describe`; the FMI 3.0 binary also `get_values` and `set_values`, which
+expand array variables into the model's elements. The model's code is one package with a name private to the FMU build
 (resources/<package>/, named in neighbor_runtime.txt): two FMUs, or two builds of one FMU, in one
 process never share code or data; two instances of the same build share the loaded modules.
 """
@@ -93,15 +95,80 @@ def instantiate(resources, instance_name, guid, visible, embedded, logging_on):
     kwargs = dict(instance_name=instance_name, resources=resources, visible=bool(visible))
     slave = cls(**kwargs)
     slave._neighbor_init = kwargs
+    if "arrays" in cfg:
+        _fmi3_variables(slave, cfg)
     host = "a Python this FMU started" if embedded else "the Python already running in this process"
     slave.log(f"{cls.__name__} in {host}: Python {version} ({sys.prefix}), numpy {numpy.__version__}")
     return slave
 
 
+def _fmi3_variables(slave, cfg):
+    """FMI 3.0: the arrays ({value reference: elements}; the elements are the model's variables
+    from that value reference on), the value references inside arrays (not FMI 3.0 variables),
+    and time (the independent variable, which the model does not declare: kept from doStep)."""
+    arrays = {}
+    for item in cfg["arrays"][0].split():
+        vr, n = item.split(":")
+        arrays[int(vr)] = int(n)
+    slave._neighbor_arrays = arrays
+    slave._neighbor_inner = {vr + k for vr, n in arrays.items() for k in range(1, n)}
+    slave._neighbor_time_vr = int(cfg["time"][0])
+    slave._neighbor_time = None
+    step = slave.do_step
+
+    def do_step(current_time, step_size):
+        done = step(current_time, step_size)
+        if done:
+            slave._neighbor_time = current_time + step_size
+        return done
+
+    slave.do_step = do_step
+
+
+def _elements(slave, vrs):
+    """The model's value references of the FMI 3.0 variables `vrs`, arrays expanded."""
+    arrays, inner = slave._neighbor_arrays, slave._neighbor_inner
+    out = []
+    for vr in vrs:
+        if vr in inner:
+            raise ValueError(f"value reference {vr} is not a variable of this FMU (it is inside an array)")
+        n = arrays.get(vr)
+        if n is None:
+            out.append(vr)
+        else:
+            out.extend(range(vr, vr + n))
+    return out
+
+
+KINDS = ("real", "integer", "boolean", "string")
+
+
+def get_values(slave, kind, vrs):
+    """FMI 3.0 get of the variables `vrs` of `kind` (0 Float64, 1 Int32, 2 Boolean, 3 String): the
+    values, arrays serialized in row-major order."""
+    if kind == 0 and slave._neighbor_time_vr in vrs:
+        time = slave.start_time if slave._neighbor_time is None else slave._neighbor_time
+        i = vrs.index(slave._neighbor_time_vr)
+        return get_values(slave, kind, vrs[:i]) + [time] + get_values(slave, kind, vrs[i + 1:])
+    return getattr(slave, f"get_{KINDS[kind]}")(_elements(slave, vrs))
+
+
+def set_values(slave, kind, vrs, values):
+    """FMI 3.0 set: `values` hold every element of every variable, in order."""
+    if kind == 0 and slave._neighbor_time_vr in vrs:
+        raise ValueError("time (the independent variable) cannot be set")
+    elements = _elements(slave, vrs)
+    if len(values) != len(elements):
+        raise ValueError(f"{len(values)} values given for {len(elements)} elements of value references {vrs}")
+    getattr(slave, f"set_{KINDS[kind]}")(elements, values)
+
+
 def reset(slave):
-    """fmi2Reset: the slave as fmi2Instantiate left it (the binary keeps its log queue)."""
+    """fmi2Reset/fmi3Reset: the slave as instantiation left it (the binary keeps its log queue)."""
     queue = slave.log_queue
     slave.__init__(**slave._neighbor_init)
+    if hasattr(slave, "_neighbor_time"):
+        slave._neighbor_time = None
     queue.extend(slave.log_queue)
     slave.log_queue = queue
 
