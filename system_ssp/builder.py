@@ -56,6 +56,7 @@ import pythonfmu
 
 from .atomic import atomic_write, write_text_atomic
 from .errors import SSPError
+from .fmi3_description import fmi3_model_description
 from .locations import BUILD, COMPONENTS, FMU_SOURCES, ROOT, SYSTEM_SOURCES as SYSTEMS, system_names
 from .ssp.reader import NS_SSD, NS_SSV
 from .ssp.units import BUILTIN, base_unit_attributes
@@ -184,27 +185,30 @@ def write_zip(dest, entries):
 
 
 # ---- the FMU runtime: one C binary for every FMU, the Python loader, the model's own package -----
-RUNTIME_C = RUNTIME / "neighbor_fmi2.c"
+RUNTIME_C = {2: RUNTIME / "neighbor_fmi2.c", 3: RUNTIME / "neighbor_fmi3.c"}  # the entry points per standard
+RUNTIME_CORE = RUNTIME / "neighbor_core.c"  # what both share (included by each)
 RUNTIME_LOADER = RUNTIME / "neighbor_runtime.py"
 PLATFORMS = {  # FMI platform folder: (compiler, file suffix, extra flags)
     "linux64": ("gcc", ".so", ["-fPIC", "-fvisibility=hidden", "-ldl"]),
     "win64": ("x86_64-w64-mingw32-gcc", ".dll", ["-static-libgcc"]),
 }
+FMI3_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-windows"}  # FMI 3.0's platform tuples
 _compiled: dict = {}  # {runtime digest: {platform: binary path}}
 
 
-def compile_runtime(out_dir=None):
-    """{platform: path} of the runtime binary compiled for every platform whose compiler is on
-    this machine (linux64 always: gcc is required; win64 with mingw-w64). Compiled once per
-    source version (build/runtime/<digest>/)."""
-    digest = _digest([RUNTIME_C])[:16]
+def compile_runtime(out_dir=None, fmi_version=2):
+    """{platform: path} of the runtime binary of FMI `fmi_version` (2 or 3) compiled for every
+    platform whose compiler is on this machine (linux64 always: gcc is required; win64 with
+    mingw-w64). Compiled once per source version (build/runtime/<digest>/)."""
+    source = RUNTIME_C[fmi_version]
+    digest = _digest([source, RUNTIME_CORE])[:16]
     if digest in _compiled:
         return _compiled[digest]
     out_dir = Path(out_dir or BUILD / "runtime" / digest)
-    headers = Path(fmpy.__file__).parent / "c-code"  # the FMI 2.0 headers FMPy ships (BSD-2)
+    headers = Path(fmpy.__file__).parent / "c-code"  # the FMI 2.0 and 3.0 headers FMPy ships (BSD-2)
     out = {}
     for platform, (cc, suffix, flags) in PLATFORMS.items():
-        target = out_dir / f"neighbor_fmi2{suffix}"
+        target = out_dir / f"{source.stem}{suffix}"
         if not target.is_file():
             if shutil.which(cc) is None:
                 if platform == "linux64":
@@ -212,7 +216,7 @@ def compile_runtime(out_dir=None):
                 continue
             out_dir.mkdir(parents=True, exist_ok=True)
             tmp = target.with_name(target.name + ".tmp")
-            cmd = [cc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", f"-I{headers}", str(RUNTIME_C),
+            cmd = [cc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", f"-I{headers}", str(source),
                    "-o", str(tmp), *flags]
             proc = subprocess.run(cmd, capture_output=True, text=True)
             if proc.returncode != 0:
@@ -345,9 +349,10 @@ def _package_data(path):
     return []
 
 
-def _runtime_config(package, wrapper, cls, guid):
-    """resources/neighbor_runtime.txt: the model's class, its GUID, and where the Python the FMU
-    was built with lives (a Python-less host starts that one when it exists; see docs)."""
+def _runtime_config(package, wrapper, cls, guid, fmi3=None):
+    """resources/neighbor_runtime.txt: the model's class, its GUID, where the Python the FMU
+    was built with lives (a Python-less host starts that one when it exists; see docs), and for
+    FMI 3.0 the arrays (value reference:elements) the loader expands and time's value reference."""
     libdir, soname = sysconfig.get_config_var("LIBDIR"), sysconfig.get_config_var("INSTSONAME")
     libpython = Path(libdir or "", soname or "")
     lines = [f"slave={package} {wrapper} {cls.__name__}", f"guid={guid}",
@@ -357,14 +362,19 @@ def _runtime_config(package, wrapper, cls, guid):
     for folder in dict.fromkeys(site.getsitepackages() + [site.getusersitepackages()]):
         if Path(folder).is_dir():
             lines.append(f"site_packages={folder}")
+    if fmi3 is not None:
+        arrays, time_vr = fmi3
+        lines += ["arrays=" + " ".join(f"{vr}:{n}" for vr, n in sorted(arrays.items())), f"time={time_vr}"]
     return ("\n".join(lines) + "\n").encode("utf-8")
 
 
-def build_fmu(script, dest_dir):
-    """Build one wrapper script into `<dest_dir>/<ClassName>.fmu`: the model description from
-    pythonfmu's declarations, completed; the runtime binary per platform; the loader; the
-    model's own modules under a package name private to this build. Returns the FMU path; raises
-    BuildError if fmpy finds a problem."""
+def build_fmu(script, dest_dir, fmi_version=2):
+    """Build one wrapper script into `<dest_dir>/<ClassName>.fmu` as an FMI `fmi_version` (2 or 3)
+    co-simulation FMU: the model description from pythonfmu's declarations, completed (for 3.0
+    written from the completed 2.0 one: system_ssp.fmi3_description); the runtime binary per
+    platform; the loader; the model's own modules under a package name private to this build
+    (the two standards' builds of one wrapper have different names and tokens: they share
+    nothing in a process). Returns the FMU path; raises BuildError if fmpy finds a problem."""
     script = Path(script).resolve()
     dest_dir = Path(dest_dir)
     cls = _import_wrapper(script)
@@ -372,20 +382,27 @@ def build_fmu(script, dest_dir):
     files = bundle(script)
     code_digest = hashlib.sha256(b"".join(name.encode() + b"\0" + data for name, data in sorted(files.items())))
     code_digest.update(RUNTIME_LOADER.read_bytes())
-    package = f"nc_{cls.__name__.lower()}_{code_digest.hexdigest()[:12]}"
+    prefix = "nc" if fmi_version == 2 else "nc3"
+    package = f"{prefix}_{cls.__name__.lower()}_{code_digest.hexdigest()[:12]}"
     files["__init__.py"] = f'"""{cls.__name__}: this FMU build\'s private package."""\n'.encode()
     guid = str(uuid.uuid5(uuid.NAMESPACE_URL, f"https://neighbor-cosim.org/fmu/{__version__}/{package}"))
     instance.guid = guid
     options = {"needsExecutionTool": "false", "canGetAndSetFMUstate": cls.can_get_and_set_state}
     xml = ET.tostring(instance.to_xml(options), encoding="utf-8")
-    entries = {"modelDescription.xml": complete_model_description(xml, instance.fmu_meta,
-                                                                  cls.can_get_and_set_state, instance.values),
+    description = complete_model_description(xml, instance.fmu_meta, cls.can_get_and_set_state, instance.values)
+    fmi3 = None
+    if fmi_version == 3:
+        guid = "{" + guid + "}"
+        description, arrays, time_vr = fmi3_model_description(description, guid, cls.can_get_and_set_state)
+        fmi3 = (arrays, time_vr)
+    entries = {"modelDescription.xml": description,
                "resources/neighbor_runtime.py": RUNTIME_LOADER.read_bytes(),
-               "resources/neighbor_runtime.txt": _runtime_config(package, script.stem, cls, guid)}
+               "resources/neighbor_runtime.txt": _runtime_config(package, script.stem, cls, guid, fmi3)}
     for name, data in files.items():
         entries[f"resources/{package}/{name}"] = data
-    for platform, binary in compile_runtime().items():
-        entries[f"binaries/{platform}/{cls.__name__}{binary.suffix}"] = binary.read_bytes()
+    for platform, binary in compile_runtime(fmi_version=fmi_version).items():
+        entries[f"binaries/{FMI3_PLATFORMS[platform] if fmi_version == 3 else platform}/"
+                f"{cls.__name__}{binary.suffix}"] = binary.read_bytes()
     dest = dest_dir / f"{cls.__name__}.fmu"
     write_zip(dest, entries)
     problems = validate_fmu(str(dest))
@@ -518,27 +535,35 @@ def _build_all(clean, verbose):
         _save_state(state)
         return made
 
-    fmu_dir, ssp_dir = BUILD / "fmus", BUILD / "ssp"
     shared = _component_files() + sorted(FMU_SOURCES.glob("neighbor_*_support.py")) + [
-        RUNTIME_C, RUNTIME_LOADER, Path(__file__).resolve()]
-    fmus = []
+        *RUNTIME_C.values(), RUNTIME_CORE, RUNTIME_LOADER, Path(__file__).resolve()]
+    fmi3_inputs = [Path(fmi3_model_description.__code__.co_filename)]
+    scripts = []
     names = {}
     for script in wrapper_scripts():
         cls = _import_wrapper(script)
         if cls.__name__ in names:
             raise BuildError(f"{script.name} and {names[cls.__name__]} both define FMU {cls.__name__}")
         names[cls.__name__] = script.name
-        target = fmu_dir / f"{cls.__name__}.fmu"
-        fmus.append(refresh(f"fmu:{cls.__name__}", _digest(shared + [script]), target,
-                            lambda script=script: build_fmu(script, fmu_dir), "building"))
-    ssps = []
-    for ssd in sorted(SYSTEMS.glob("*.ssd")):
-        refs, used = _system_files(ssd)
-        inputs = [ssd] + [ssd.parent / r for r in refs] + [fmu_dir / f for f in used if (fmu_dir / f).is_file()]
-        digest = _digest(inputs)
-        ssps.append(refresh(f"ssp:{ssd.stem}", digest, ssp_dir / f"{ssd.stem}.ssp",
-                            lambda ssd=ssd: pack_ssp(ssd, fmu_dir, ssp_dir), "packing"))
-    return fmus, ssps
+        scripts.append((script, cls.__name__))
+    built = {}
+    # FMI 2.0 in fmus/ and ssp/ (the product's systems), the same FMUs as FMI 3.0 in fmus3/ and
+    # the same systems packed with them in ssp3/
+    for version, fmu_dir, ssp_dir, key in ((2, BUILD / "fmus", BUILD / "ssp", ""),
+                                           (3, BUILD / "fmus3", BUILD / "ssp3", "3")):
+        inputs_of_version = shared + (fmi3_inputs if version == 3 else [])
+        fmus = [refresh(f"fmu{key}:{name}", _digest(inputs_of_version + [script]), fmu_dir / f"{name}.fmu",
+                        lambda script=script, fmu_dir=fmu_dir, version=version: build_fmu(script, fmu_dir, version),
+                        "building") for script, name in scripts]
+        ssps = []
+        for ssd in sorted(SYSTEMS.glob("*.ssd")):
+            refs, used = _system_files(ssd)
+            inputs = [ssd] + [ssd.parent / r for r in refs] + [fmu_dir / f for f in used if (fmu_dir / f).is_file()]
+            ssps.append(refresh(f"ssp{key}:{ssd.stem}", _digest(inputs), ssp_dir / f"{ssd.stem}.ssp",
+                                lambda ssd=ssd, fmu_dir=fmu_dir, ssp_dir=ssp_dir: pack_ssp(ssd, fmu_dir, ssp_dir),
+                                "packing"))
+        built[version] = (fmus, ssps)
+    return built[2]
 
 
 def resolve_system(name):
@@ -557,7 +582,8 @@ def resolve_system(name):
         path = BUILD / "ssp" / f"{name}.ssp"
         if path.is_file():
             return path
-    elif path.suffix != ".ssp" or path.stem not in system_names() or path.parent.resolve() != (BUILD / "ssp").resolve():
+    elif (path.suffix != ".ssp" or path.stem not in system_names()
+          or path.parent.resolve() not in ((BUILD / "ssp").resolve(), (BUILD / "ssp3").resolve())):
         raise SSPError(f"{path}: file not found")
     print(f"neighbor-cosim: the FMUs and systems are not built yet; building them into {BUILD} "
           "(once per version, under a minute; `neighbor-cosim build` does it ahead)", file=sys.stderr, flush=True)

@@ -42,6 +42,7 @@ BUILD = build_dir()
 FMU_DIR = BUILD / "fmus"
 SSP_DIR = BUILD / "ssp"
 COMPAT_DIR = BUILD / "compat"
+COMPAT3_DIR = BUILD / "compat3"  # the same for the FMI 3.0 FMUs
 
 
 def system_names() -> list:

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import argparse
 import csv
+import itertools
 from dataclasses import dataclass
 import os
 from pathlib import Path
@@ -56,20 +57,36 @@ class Options:
         return cls(**values)
 
 
+NUMERIC = ("Real", "Integer", "Boolean", "Float64", "Float32", "Int8", "UInt8", "Int16", "UInt16", "Int32", "UInt32",
+           "Int64", "UInt64")
+
+
 def outputs(md: Any) -> List[str]:
-    """The Real, Integer and Boolean outputs, in model-description order (the reference's columns)."""
-    return [v.name for v in md.modelVariables
-            if v.causality == "output" and v.type in ("Real", "Integer", "Boolean")]
+    """The numeric and Boolean outputs, in model-description order: the variables FMPy records (an
+    FMI 3.0 array whole)."""
+    return [v.name for v in md.modelVariables if v.causality == "output" and v.type in NUMERIC]
 
 
 def reference(fmu: Path, options: Options) -> Dict[str, List[float]]:
-    """{"time": [...], output: [...]}: FMPy's result of the experiment, inputs at their starts."""
+    """{"time": [...], output: [...]}: FMPy's result of the experiment, inputs at their starts. An
+    FMI 3.0 array is written as its elements `name[1]` .. (`name[1,1]` .. row-major), the columns
+    its FMI 2.0 twin has."""
     md = fmpy.read_model_description(str(fmu))
     names = outputs(md)
     result = fmpy.simulate_fmu(str(fmu), start_time=options.start_time, stop_time=options.stop_time,
                                step_size=options.step_size, output_interval=options.output_interval,
                                output=names, relative_tolerance=options.rel_tol)
-    return {name: [float(x) for x in result[name]] for name in ["time", *names]}
+    columns: Dict[str, List[float]] = {"time": [float(x) for x in result["time"]]}
+    for name in names:
+        values = result[name]
+        shape = values.shape[1:]
+        if not shape:
+            columns[name] = [float(x) for x in values]
+            continue
+        for index in itertools.product(*(range(n) for n in shape)):
+            element = f"{name}[{','.join(str(i + 1) for i in index)}]"
+            columns[element] = [float(x) for x in values[(slice(None),) + tuple(index)]]
+    return columns
 
 
 def write_csv(path: Path, columns: Mapping[str, Sequence[float]]) -> None:
@@ -108,9 +125,9 @@ README = """# {model}
 
 {description}
 
-- FMI 2.0 co-simulation, model identifier `{model}`, built by neighbor-cosim {version} (model description
-  by {tool}).
-- Platforms: linux64 (run); {win64}.
+- FMI {fmi_version} co-simulation, model identifier `{model}`, built by neighbor-cosim {version} (model
+  description by {tool}).
+- Platforms: {linux} (run); {win64}.
 - Needs on the target: CPython 3.9 to 3.13 with its shared library, and numpy (the FMU finds a
   Python by itself; see the project's docs/interoperability.md).
 
@@ -120,7 +137,7 @@ README = """# {model}
 `{model}_ref.opt` (start {o.start_time:g} s, stop {o.stop_time:g} s, communication step {o.step_size:g} s,
 a row every {o.output_interval:g} s), every input held at its start value (so no `{model}_in.csv`),
 every parameter at its start value. Columns: time and the {n} outputs (Real, Integer, Boolean as
-0/1).
+0/1; an FMI 3.0 array as its elements, name[1] .., a matrix row-major).
 """
 
 
@@ -137,12 +154,15 @@ def write_bundle(fmu: Path, out_dir: Path, options: Options = Options()) -> Path
         write_csv(tmp / f"{model}_ref.csv", reference(fmu, options))
         write_text_atomic(tmp / f"{model}_ref.opt", options.text())
         with zipfile.ZipFile(fmu) as z:
-            win64 = any(n.startswith("binaries/win64/") for n in z.namelist())
+            win64 = any(n.startswith(("binaries/win64/", "binaries/x86_64-windows/")) for n in z.namelist())
         write_text_atomic(tmp / "README.md", README.format(
-            model=model, description=md.description or "", version=__version__, tool=md.generationTool or "?",
-            win64="win64 (compiled, not yet run on Windows)" if win64 else "no win64 binary in this build",
+            model=model, fmi_version=md.fmiVersion, description=md.description or "", version=__version__,
+            tool=md.generationTool or "?",
+            linux="x86_64-linux" if md.fmiVersion.startswith("3.") else "linux64",
+            win64=("x86_64-windows" if md.fmiVersion.startswith("3.") else "win64")
+            + (" (compiled, not yet run on Windows)" if win64 else ": no binary in this build"),
             fmpy_version=fmpy.__version__, system=platform.system(), machine=platform.machine(),
-            python=platform.python_version(), o=options, n=len(outputs(md))))
+            python=platform.python_version(), o=options, n=len(outputs(md))))  # variables (arrays whole)
         if target.exists():
             shutil.rmtree(target)
         os.replace(tmp, target)
