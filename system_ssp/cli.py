@@ -43,7 +43,7 @@ APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": m
 
 
 def _parser():
-    ap = ArgumentParser(prog="neighbor-cosim", description="Run SSP 1.0 co-simulations of FMI 2.0 FMUs "
+    ap = ArgumentParser(prog="neighbor-cosim", description="Run SSP 1.0 and 2.0 co-simulations of FMI 2.0 and 3.0 FMUs "
                                  "and the NEIGHBOR applications (python -m system_ssp is the same command).")
     ap.add_argument("--version", action="version", version=f"neighbor-cosim {__version__}")
     sub = ap.add_subparsers(dest="command", required=True)

@@ -55,6 +55,20 @@ def fmu_paths(built):
 
 
 @pytest.fixture(scope="session")
+def fmu3_paths(built):
+    """The same FMUs as FMI 3.0 (build/fmus3), built with the FMI 2.0 ones."""
+    folder = next(iter(built[0].values())).parent.parent / "fmus3"
+    return {name: folder / f"{name}.fmu" for name in built[0]}
+
+
+@pytest.fixture(scope="session")
+def ssp3_paths(built):
+    """The same systems packed with the FMI 3.0 FMUs (build/ssp3)."""
+    folder = next(iter(built[1].values())).parent.parent / "ssp3"
+    return {name: folder / f"{name}.ssp" for name in built[1]}
+
+
+@pytest.fixture(scope="session")
 def ssp_paths(built):
     return built[1]
 

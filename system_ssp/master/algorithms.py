@@ -138,7 +138,7 @@ class _Signal:
         comps = table.system.comps
         self.vr = (ctypes.c_uint * 1)(comps[ci].vars[var].valueReference)
         self.buf = (CTYPE[kind] * 1)()
-        self.fn = table.instances[ci].fn[GET[kind]]
+        self.fn = table.instances[ci].function(GET[kind], self.vr, 1)
         self.c = table.instances[ci].fmu.component
         self.ci = ci
         self.name = f"{comps[ci].name}.{var}"

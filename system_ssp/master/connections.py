@@ -1,6 +1,7 @@
 """Connections resolved against the FMUs: which output feeds which input, with the unit
 conversion and transformation folded into one affine map (or an Integer/Boolean mapping), and
 the direct-feedthrough graph that orders Gauss-Seidel steps."""
+import dataclasses
 from typing import NamedTuple, Optional
 
 from ..errors import SSPError
@@ -150,7 +151,7 @@ def parameter_connections(desc, by_name):
                 raise SSPError(f"{where}: no component named {element!r}{near(element, by_name)}")
             v = comp.vars.get(var)
             if v is None:
-                raise SSPError(f"{where}: component {element!r} has no variable {var!r}{near(var, comp.vars)}")
+                raise SSPError(f"{where}: component {element!r} has no variable {var!r}{comp.not_a_variable(var)}")
             allowed = ("parameter",) if sc.kind == "parameter" else ("input", "parameter")
             if v.causality not in allowed:
                 raise SSPError(f"{where}: {element}.{var} has causality {v.causality}; a system {sc.kind} can only "
@@ -177,14 +178,39 @@ def _end(desc, by_name, element, connector, c):
                        f"{near(element, by_name)}")
     if connector not in comp.vars:
         raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} has no variable "
-                       f"{connector!r}{near(connector, comp.vars)}")
+                       f"{connector!r}{comp.not_a_variable(connector)}")
     declared = comp.decl.connectors
-    if declared and connector not in declared:
+    if declared and connector not in declared and connector.partition("[")[0] not in declared:
         # a component that lists its connectors lists all it is connected through (SSP 1.0);
         # one that lists none is taken to expose its FMU's variables
         raise SSPError(f"{c.origin}: connection {c.label()}: component {element!r} declares connectors but not "
                        f"{connector!r}{near(connector, declared)} (add an ssd:Connector for it)")
     return ("comp", comp, connector)
+
+
+def _whole_arrays_expanded(connections, by_name):
+    """The connections with each one between two whole arrays (an FMI 3.0 array, or a vector or
+    matrix an FMI 2.0 FMU spells element by element, named without indices: `a.q_BN -> b.q_BN`)
+    replaced by one connection per element, in row-major order; the two must have as many
+    elements."""
+    out = []
+    for c in connections:
+        a = by_name.get(c.start_element) if c.start_element else None
+        b = by_name.get(c.end_element) if c.end_element else None
+        wa = a.whole(c.start_connector) if a is not None else None
+        wb = b.whole(c.end_connector) if b is not None else None
+        if wa is None and wb is None:
+            out.append(c)
+            continue
+        if wa is None or wb is None:
+            whole, other = (c.start_connector, c.end_connector) if wa else (c.end_connector, c.start_connector)
+            raise SSPError(f"{c.origin}: connection {c.label()}: {whole!r} is a whole array, {other!r} is not (connect "
+                           "two arrays of the same size, or element to element)")
+        if len(wa) != len(wb):
+            raise SSPError(f"{c.origin}: connection {c.label()}: arrays of {len(wa)} and {len(wb)} elements (connect "
+                           "arrays of the same size, or element to element)")
+        out += [dataclasses.replace(c, start_connector=x, end_connector=y) for x, y in zip(wa, wb)]
+    return out
 
 
 def _role(e):
@@ -205,7 +231,7 @@ def resolve_connections(desc, comps, by_name, units):
     half = []  # (src_end, dst_end, transform, suppress, connection)
     # a valued system connector's connections fan its value out before the run (parameter_connections)
     parameter_ids = _parameter_connection_ids(desc)
-    for c in [c for c in desc.connections if id(c) not in parameter_ids]:
+    for c in _whole_arrays_expanded([c for c in desc.connections if id(c) not in parameter_ids], by_name):
         a = _end(desc, by_name, c.start_element, c.start_connector, c)
         b = _end(desc, by_name, c.end_element, c.end_connector, c)
         ra, rb = _role(a), _role(b)

@@ -22,12 +22,16 @@ import numpy as np
 
 from ..errors import SimulationError, SSPError
 from .connections import KIND
+from .fmi3 import Fmi3Calls
 from .graph import toposort
 
 CTYPE = {"Real": ctypes.c_double, "Integer": ctypes.c_int, "Boolean": ctypes.c_int, "String": ctypes.c_char_p}
 NPTYPE = {"Real": np.float64, "Integer": np.int32, "Boolean": np.int32}
 GET = {"Real": "fmi2GetReal", "Integer": "fmi2GetInteger", "Boolean": "fmi2GetBoolean", "String": "fmi2GetString"}
 SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBoolean", "String": "fmi2SetString"}
+FMI3_CALLS = {"fmi2GetReal": "fmi3GetFloat64", "fmi2SetReal": "fmi3SetFloat64", "fmi2GetInteger": "fmi3GetInt32",
+              "fmi2SetInteger": "fmi3SetInt32", "fmi2Instantiate": "fmi3InstantiateCoSimulation",
+              "fmi2SetupExperiment": "fmi3EnterInitializationMode"}
 STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
 # FMU messages also go to Python logging ("system_ssp.fmu"), at these levels per FMI status; with
 # INFO enabled there, the FMUs are instantiated with logging on.
@@ -78,10 +82,15 @@ class _Messages:
         except Exception:  # never let a logging problem propagate into C
             pass
 
-    def callbacks(self, inst):
-        """The fmi2CallbackFunctions for one new instance, its componentEnvironment registered."""
+    def register(self, inst):
+        """A new instance's number (its componentEnvironment / instanceEnvironment)."""
         number = next(self.numbers)
         self.live[number] = inst
+        return number
+
+    def callbacks(self, inst):
+        """The fmi2CallbackFunctions for one new instance, its componentEnvironment registered."""
+        number = self.register(inst)
         cb = fmi2CallbackFunctions()
         cb.logger = self.c_logger
         cb.allocateMemory = _ALLOCATE
@@ -119,6 +128,12 @@ class FmuInstance:
         self.initialized = False
         self.failed_status = None  # the FMI status of a failed call (3 error, 4 fatal), once one failed
         md = info.md
+        self.fmi3 = info.fmi3_md is not None
+        if self.fmi3:  # FMI 3.0 behind the FMI 2.0 calls the table makes (system_ssp.master.fmi3)
+            self.callbacks = (_MESSAGES, _MESSAGES.register(self))
+            self.fmu = Fmi3Calls(info, info.name)
+            self.fn = self.fmu.fn
+            return
         self.callbacks = _MESSAGES.callbacks(self)
         self.fmu = FMU2Slave(guid=md.guid, unzipDirectory=info.unzipdir,
                              modelIdentifier=md.coSimulation.modelIdentifier, instanceName=info.name)
@@ -139,7 +154,7 @@ class FmuInstance:
                 pass
         if self.instantiated and self.failed_status != 4:
             try:
-                fmu.fmi2FreeInstance(fmu.component)
+                fmu.free_instance() if self.fmi3 else fmu.fmi2FreeInstance(fmu.component)
             except Exception:
                 pass
         if self.failed_status != 4 and _unloadable(self.info.unzipdir):
@@ -147,6 +162,11 @@ class FmuInstance:
                 fmu.freeLibrary()
             except Exception:
                 pass
+
+    def function(self, name, vr, n):
+        """The FMI call `name` (by its FMI 2.0 name) for the value reference block `vr[:n]`, which
+        the caller keeps: FMPy's loaded function, or for FMI 3.0 one prepared for the block."""
+        return self.fmu.specialized(name, vr, n) if self.fmi3 else self.fn[name]
 
     def take_messages(self):
         msgs = self.messages
@@ -286,9 +306,9 @@ class ReadOp:
 
     def __init__(self, instance, ci, kind, variables, vrefs, names):
         m = len(vrefs)
-        self.fn = instance.fn[GET[kind]]
         self.c = instance.fmu.component
         self.vr = (ctypes.c_uint * m)(*vrefs)
+        self.fn = instance.function(GET[kind], self.vr, m)
         self.n = m
         self.buf = (CTYPE[kind] * m)()
         # Strings: the texts, decoded (a list, copied at each read: the FMU owns the char pointers)
@@ -358,6 +378,8 @@ class InstanceTable:
         else:
             what = "failed"
         detail = f": {text}" if text else ""
+        if inst.fmi3:  # the calls are made under FMI 2.0 names (system_ssp.master.fmi3): say the FMI 3.0 ones
+            call = FMI3_CALLS.get(call, call.replace("fmi2", "fmi3"))
         if names:
             shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
             call = f"{call} of {shown}"
@@ -368,6 +390,9 @@ class InstanceTable:
         ended the simulation (fmi2Terminated): the time it reached (fmi2LastSuccessfulTime, or
         the communication point the step started from when it does not say), else None."""
         fmu = self.instances[ci].fmu
+        if self.instances[ci].fmi3:  # FMI 3.0 said so in fmi3DoStep (terminateSimulation)
+            reached = fmu.terminated
+            return None if reached is None else (reached if np.isfinite(reached) and reached >= self.t else self.t)
         ended, reached = fmi2Boolean(fmi2False), fmi2Real(self.t)
         try:
             if fmu.fmi2GetBooleanStatus(fmu.component, fmi2Terminated, ctypes.byref(ended)) > 1 or not ended.value:
@@ -451,8 +476,8 @@ class InstanceTable:
                 for ci, vars_, pos in blocks:
                     vr = (ctypes.c_uint * len(vars_))(*[comps[ci].vars[v].valueReference for v in vars_])
                     inst = self.instances[ci]
-                    self.gets[ci].append(StringGetOp(inst.fn[GET[kind]], inst.fmu.component, vr, len(vars_), G,
-                                                     pos, ci, tuple(vars_)))
+                    self.gets[ci].append(StringGetOp(inst.function(GET[kind], vr, len(vars_)), inst.fmu.component, vr,
+                                                     len(vars_), G, pos, ci, tuple(vars_)))
                 continue
             G = np.zeros(max(total, 1), dtype=NPTYPE[kind])
             self.G[kind] = G
@@ -461,8 +486,8 @@ class InstanceTable:
                 vr = (ctypes.c_uint * m)(*[comps[ci].vars[v].valueReference for v in vars_])
                 buf = (CTYPE[kind] * m).from_address(G.ctypes.data + pos * G.itemsize)
                 inst = self.instances[ci]
-                self.gets[ci].append(GetOp(inst.fn[GET[kind]], inst.fmu.component, vr, m, buf, ci, GET[kind],
-                                           tuple(vars_)))
+                self.gets[ci].append(GetOp(inst.function(GET[kind], vr, m), inst.fmu.component, vr, m, buf, ci,
+                                           GET[kind], tuple(vars_)))
         self.sets = [[] for _ in range(n)]
         by_dst = {}
         for lk in sysm.links:
@@ -472,8 +497,8 @@ class InstanceTable:
             if kind == "String":
                 inst = self.instances[ci]
                 vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
-                self.sets[ci].append(StringSetOp(inst.fn[SET[kind]], inst.fmu.component, vr, m, self.G[kind],
-                                                 [slots[kind][(lk.src, lk.src_var)] for lk in lks], ci,
+                self.sets[ci].append(StringSetOp(inst.function(SET[kind], vr, m), inst.fmu.component, vr, m,
+                                                 self.G[kind], [slots[kind][(lk.src, lk.src_var)] for lk in lks], ci,
                                                  tuple(lk.dst_var for lk in lks)))
                 continue
             vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
@@ -483,7 +508,7 @@ class InstanceTable:
             off = np.array([lk.offset for lk in lks])
             affine = kind == "Real" and (np.any(fac != 1.0) or np.any(off != 0.0))
             inst = self.instances[ci]
-            self.sets[ci].append(SetOp(inst.fn[SET[kind]], inst.fmu.component, vr, m, buf,
+            self.sets[ci].append(SetOp(inst.function(SET[kind], vr, m), inst.fmu.component, vr, m, buf,
                                        np.ctypeslib.as_array(buf), self.G[kind], idx, fac if affine else None,
                                        off if affine else None, _mapper(kind, lks), ci, SET[kind],
                                        tuple(lk.dst_var for lk in lks)))

@@ -20,7 +20,7 @@ def split_name(comps, name, what="variable"):
             var = name[len(comp.name) + 1:]
             if var not in comp.vars:
                 raise SSPError(f"{what} {name!r}: component {comp.name!r} has no variable {var!r}"
-                               f"{near(var, comp.vars)}")
+                               f"{comp.not_a_variable(var)}")
             return comp, var
     head = name.split(".", 1)[0]
     if "." not in name:

@@ -94,7 +94,7 @@ def resolve_parameter(system, comp, var, value, vtype=None, unit=None, units=Non
     where = f"{origin}: {label}" if origin else label
     v = comp.vars.get(var)
     if v is None:
-        raise SSPError(f"{where}: component {comp.name!r} has no variable {var!r}{near(var, comp.vars)}")
+        raise SSPError(f"{where}: component {comp.name!r} has no variable {var!r}{comp.not_a_variable(var)}")
     if not settable(v):
         raise SSPError(f"{where}: cannot be set (causality {v.causality}, variability {v.variability}, "
                        f"initial {v.initial}); only parameters, inputs and variables with a start value can")

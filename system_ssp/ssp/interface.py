@@ -38,8 +38,9 @@ class Variable:
 class FmuInterface:
     """The variables and unit definitions of one FMU (`FmuInterface.read(path)`)."""
 
-    def __init__(self, path, model_name, model_identifier, guid, description, variables, units):
+    def __init__(self, path, model_name, model_identifier, guid, description, variables, units, fmi_version="2.0"):
         self.path = Path(path)
+        self.fmi_version = fmi_version
         self.model_name = model_name
         self.model_identifier = model_identifier
         self.guid = guid
@@ -57,14 +58,21 @@ class FmuInterface:
         except Exception as exc:
             raise SSPError(f"{path}: not a readable FMU ({exc})") from None
         if md.coSimulation is None:
-            raise SSPError(f"{path}: not an FMI 2.0 co-simulation FMU")
+            raise SSPError(f"{path}: not a co-simulation FMU (FMI {md.fmiVersion}, model exchange only)")
         return cls.from_model_description(md, path)
 
     @classmethod
     def from_model_description(cls, md, path):
-        """From an fmpy ModelDescription already read (`path`: the FMU it came from)."""
+        """From an fmpy ModelDescription already read (`path`: the FMU it came from). An FMI 3.0
+        FMU's variables are its element view (arrays as their elements, types as the master
+        transfers them: system_ssp.master.fmi3), so an FMU and its FMI 2.0 twin compare equal."""
         variables = {}
-        for v in md.modelVariables:
+        model_variables = md.modelVariables
+        if md.fmiVersion.startswith("3."):
+            from ..master.fmi3 import element_view
+
+            model_variables = element_view(md)[0]
+        for v in model_variables:
             dt = v.declaredType
             variables[v.name] = Variable(
                 name=v.name, causality=v.causality, type=v.type, unit=variable_unit(v) if v.type == "Real" else None,
@@ -72,7 +80,7 @@ class FmuInterface:
                 min=_limit(v, dt, "min"), max=_limit(v, dt, "max"), description=v.description or "",
                 variability=v.variability)
         return cls(Path(path), md.modelName, md.coSimulation.modelIdentifier, md.guid, md.description or "", variables,
-                   unit_definitions(md))
+                   unit_definitions(md), md.fmiVersion)
 
     def connectors(self):
         """The variables an SSD declares as connectors (inputs, outputs, parameters)."""
@@ -88,7 +96,8 @@ class FmuInterface:
 
     def as_dict(self):
         """The interface as JSON-ready data."""
-        return {"path": str(self.path), "model_name": self.model_name, "model_identifier": self.model_identifier,
+        return {"path": str(self.path), "fmi_version": self.fmi_version, "model_name": self.model_name,
+                "model_identifier": self.model_identifier,
                 "guid": self.guid, "description": self.description,
                 "variables": [v.as_dict() for v in self.variables.values()]}
 
@@ -164,7 +173,8 @@ def describe_fmu(fmu, bound=None):
     """Text listing every variable of FmuInterface `fmu` with its start value, unit, range and
     description; `bound` {variable: where} marks the parameters a system binds."""
     bound = bound or {}
-    lines = [f"FMU {fmu.model_name} ({fmu.path.name}): {fmu.description}".rstrip(": ")]
+    version = ("FMI 3.0, arrays as their elements" if fmu.fmi_version.startswith("3.") else f"FMI {fmu.fmi_version}")
+    lines = [f"FMU {fmu.model_name} ({fmu.path.name}, {version}): {fmu.description}".rstrip(": ")]
     sections = (("inputs", ("input",)), ("outputs", ("output",)), ("parameters", ("parameter",)),
                 ("other variables", ("calculatedParameter", "local", "independent")))
     for title, causalities in sections:

@@ -1,0 +1,348 @@
+"""FMI 3.0 co-simulation FMUs in the master, beside FMI 2.0 ones.
+
+The master moves scalars along connections, as SSP 1.0 connectors are scalars. An FMI 3.0 FMU is
+seen through an element view: each scalar variable as itself, each array variable as its elements
+`name[i]` (a matrix `name[i,j]`, row-major as FMI 3.0 serializes arrays), so a system connects an
+array element by element under the names an FMI 2.0 export of the same model uses (ours:
+`q_BN[1]` .. `q_BN[4]`), and a connection between two arrays of the same shape, named without
+indices, is expanded into its elements (system_ssp.master.connections). Types map onto the
+master's four: Float64 and Float32 -> Real; Int8 .. Int64, UInt8 .. UInt64 -> Integer (values
+must fit 32 bits); Enumeration -> Enumeration; Boolean; String. Binary and Clock variables, the
+independent variable and structural parameters are not in the view (a connector naming one is
+refused with the reason).
+
+`Fmi3Calls` gives the instance table what FMPy's FMU2Slave gives it for FMI 2.0: the calls by
+their FMI 2.0 names with FMI 2.0 signatures over the element view (prepared once per value
+reference block, then one FMI 3.0 call per type per block), and the life-cycle methods. An array
+is always set whole: the elements a call does not set keep the value last set (the start value
+at first).
+"""
+import ctypes
+from ctypes import byref, c_bool, c_char_p, c_double, c_float, c_int, c_size_t, c_uint32, c_void_p
+
+from fmpy.fmi3 import FMU3Slave
+from fmpy.model_description import ModelVariable, Unknown
+import numpy as np
+
+KIND = {"Float64": "Real", "Float32": "Real", "Int8": "Integer", "UInt8": "Integer", "Int16": "Integer",
+        "UInt16": "Integer", "Int32": "Integer", "UInt32": "Integer", "Int64": "Integer", "UInt64": "Integer",
+        "Boolean": "Boolean", "String": "String", "Enumeration": "Enumeration"}
+# the C type and the call's type name of each FMI 3.0 type (an Enumeration is an Int64)
+C_TYPE = {"Float64": c_double, "Float32": c_float, "Int8": ctypes.c_int8, "UInt8": ctypes.c_uint8,
+          "Int16": ctypes.c_int16, "UInt16": ctypes.c_uint16, "Int32": ctypes.c_int32, "UInt32": ctypes.c_uint32,
+          "Int64": ctypes.c_int64, "UInt64": ctypes.c_uint64, "Boolean": c_bool, "String": c_char_p,
+          "Enumeration": ctypes.c_int64}
+CALL_TYPE = {t: ("Int64" if t == "Enumeration" else t) for t in C_TYPE}
+NOT_TRANSFERRED = {"Binary": "a Binary variable", "Clock": "a Clock"}
+
+
+class Element:
+    """Where an element of the view lives in the FMU: its variable's type and value reference,
+    its offset in the variable's values and the variable's number of values."""
+    __slots__ = ("type", "vr", "offset", "size")
+
+    def __init__(self, type_, vr, offset, size):
+        self.type, self.vr, self.offset, self.size = type_, vr, offset, size
+
+
+def _size(dimension):
+    if dimension.start is not None:
+        return int(dimension.start)
+    return int(dimension.variable.start)  # a structural parameter's start value
+
+
+def _index_names(name, shape):
+    """name[1] .. (row-major) for an array of `shape`."""
+    return [f"{name}[{','.join(str(i + 1) for i in ix)}]" for ix in np.ndindex(*shape)]
+
+
+def element_view(md):
+    """(variables, outputs, {element value reference: Element}, {name: why it is not in the
+    view}) of FMI 3.0 model description `md`: ModelVariables with FMI 2.0 type names (Real,
+    Integer, ...) and value references numbering the elements, and the outputs' Unknowns over
+    them."""
+    variables, elements, left_out, of_var = [], {}, {}, {}
+    for v in md.modelVariables:
+        if v.causality == "independent":
+            left_out[v.name] = "the independent variable (time)"
+            continue
+        if v.causality == "structuralParameter":
+            left_out[v.name] = "a structural parameter (set in configuration mode, which this master does not use)"
+            continue
+        if v.type not in KIND:
+            left_out[v.name] = NOT_TRANSFERRED.get(v.type, f"of type {v.type}")
+            continue
+        shape = tuple(_size(d) for d in v.dimensions)
+        size = int(np.prod(shape)) if shape else 1
+        names = _index_names(v.name, shape) if shape else [v.name]
+        starts = None if v.start is None else str(v.start).split() if v.type != "String" else [v.start] * size
+        if starts is not None and len(starts) != size:
+            starts = [starts[0]] * size if len(starts) == 1 else None
+        of_var[v.name] = []
+        for offset, name in enumerate(names):
+            ev = len(elements)
+            elements[ev] = Element(v.type, v.valueReference, offset, size)
+            element = ModelVariable(name=name, valueReference=ev, type=KIND[v.type], description=v.description,
+                                    causality=v.causality, variability=v.variability, initial=v.initial,
+                                    declaredType=v.declaredType, unit=v.unit, displayUnit=v.displayUnit,
+                                    min=v.min, max=v.max, nominal=v.nominal,
+                                    start=None if starts is None else starts[offset])
+            variables.append(element)
+            of_var[v.name].append(element)
+    outputs = []
+    for unknown in md.outputs:
+        deps = None
+        if unknown.dependencies is not None:
+            deps = [e for d in unknown.dependencies for e in of_var.get(d.name, [])]
+        for element in of_var.get(unknown.variable.name, []):
+            outputs.append(Unknown(variable=element, dependencies=deps))
+    return variables, outputs, elements, left_out
+
+
+class _Plan:
+    """One element block's FMI 3.0 calls: per FMI 3.0 type, the value references, a buffer of
+    all their values, and where each element of the block is in it."""
+
+    def __init__(self, calls, evrs):
+        groups = {}
+        for i, ev in enumerate(evrs):
+            e = calls.elements[ev]
+            groups.setdefault(e.type, []).append((i, e))
+        self.parts = []
+        for type_, items in groups.items():
+            vrs = list(dict.fromkeys(e.vr for _, e in items))
+            start = {}
+            total = 0
+            for vr in vrs:
+                start[vr] = total
+                total += calls.sizes[vr]
+            buf = (C_TYPE[type_] * total)()
+            positions = np.array([start[e.vr] + e.offset for _, e in items], dtype=np.intp)
+            targets = np.array([i for i, _ in items], dtype=np.intp)
+            self.parts.append((type_, (c_uint32 * len(vrs))(*vrs), len(vrs), buf, total, positions, targets, vrs))
+
+
+class Fmi3Calls:
+    """An FMI 3.0 co-simulation FMU instance behind the calls the instance table makes on FMPy's
+    FMU2Slave (see the module's text)."""
+
+    def __init__(self, info, instance_name):
+        md = info.fmi3_md
+        self.info = info
+        self.elements = info.fmi3_elements
+        self.sizes = {e.vr: e.size for e in self.elements.values()}
+        self.slave = FMU3Slave(guid=md.guid, unzipDirectory=info.unzipdir,
+                               modelIdentifier=md.coSimulation.modelIdentifier, instanceName=instance_name)
+        dll = self.slave.dll
+        self._c = {}
+        for type_ in set(CALL_TYPE.values()):
+            for verb in ("Get", "Set"):
+                fn = getattr(dll, f"fmi3{verb}{type_}")
+                fn.argtypes = [c_void_p, ctypes.POINTER(c_uint32), c_size_t, c_void_p, c_size_t]
+                fn.restype = c_int
+                self._c[(verb, type_)] = fn
+        step = dll.fmi3DoStep
+        step.argtypes = [c_void_p, c_double, c_double, c_bool, ctypes.POINTER(c_bool), ctypes.POINTER(c_bool),
+                         ctypes.POINTER(c_bool), ctypes.POINTER(c_double)]
+        step.restype = c_int
+        self._step = step
+        # the values last set of every array (an array is set whole), from the start values
+        self.shadow = {}
+        for ev, e in self.elements.items():
+            if e.size > 1:
+                values = self.shadow.setdefault(e.vr, (C_TYPE[e.type] * e.size)())
+                start = info.md_view_vars[ev].start
+                if start is not None:
+                    values[e.offset] = _c_value(e.type, start)
+        self.terminated = None  # lastSuccessfulTime when the FMU asked to end the simulation
+        self.fn = {}
+        for kind in ("Real", "Integer", "Boolean", "String"):
+            self.fn[f"fmi2Get{kind}"] = self._cached(f"fmi2Get{kind}")
+            self.fn[f"fmi2Set{kind}"] = self._cached(f"fmi2Set{kind}")
+        self.fn["fmi2DoStep"] = self._do_step
+        self.component = None
+
+    # ---- values ------------------------------------------------------------------------
+    def specialized(self, name, vr, n):
+        """The FMI 2.0-style call `name` (fmi2GetReal ...) for the element block `vr[:n]`, prepared
+        once: a block that is whole variables of the master's own C type in order (a Float64
+        array, Int32s, Strings) goes straight to the FMI 3.0 call with the caller's buffer;
+        anything else through a per-type buffer."""
+        verb = name[4:7]
+        kind = name[7:]
+        plan = _Plan(self, list(vr[:n]))
+        if len(plan.parts) == 1:
+            type_, vrs, nvr, tbuf, total, positions, targets, plain = plan.parts[0]
+            direct = (total == n and np.array_equal(positions, np.arange(n)) and np.array_equal(targets, np.arange(n))
+                      and C_TYPE[type_] is _MASTER_C[kind] and not (kind == "Boolean"))
+            if direct:
+                fn3 = self._c[(verb, CALL_TYPE[type_])]
+                arrays = [v for v in plain if self.sizes[v] > 1] if verb == "Set" else []
+                if not arrays:
+                    return lambda c, vr, n, buf: fn3(c, vrs, nvr, buf, total)
+                return self._direct_set(fn3, vrs, nvr, total, plain, type_)
+        return self._general(verb, plan)
+
+    def _direct_set(self, fn3, vrs, nvr, total, plain, type_):
+        """A whole-variable set that also keeps the arrays' values last set."""
+        size = ctypes.sizeof(C_TYPE[type_])
+        copies = []
+        offset = 0
+        for v in plain:
+            if self.sizes[v] > 1:
+                copies.append((self.shadow[v], offset * size, self.sizes[v] * size))
+            offset += self.sizes[v]
+        memmove, addressof = ctypes.memmove, ctypes.addressof
+
+        def set_(c, vr, n, buf):
+            s = fn3(c, vrs, nvr, buf, total)
+            if s <= 1:
+                base = addressof(buf)
+                for shadow, at, nbytes in copies:
+                    memmove(shadow, base + at, nbytes)
+            return s
+
+        return set_
+
+    def _general(self, verb, plan):
+        calls = self
+        parts = [(calls._c[(verb, CALL_TYPE[type_])], type_, vrs, nvr, tbuf, total, positions.tolist(),
+                  targets.tolist(), plain) for type_, vrs, nvr, tbuf, total, positions, targets, plain in plan.parts]
+        if verb == "Get":
+            def get(c, vr, n, buf):
+                for fn3, _, vrs, nvr, tbuf, total, positions, targets, _ in parts:
+                    s = fn3(c, vrs, nvr, tbuf, total)
+                    if s > 1:
+                        return s
+                    for p, t in zip(positions, targets):
+                        buf[t] = tbuf[p]
+                return 0
+
+            return get
+
+        def set_(c, vr, n, buf):
+            for fn3, type_, vrs, nvr, tbuf, total, positions, targets, plain in parts:
+                size = ctypes.sizeof(C_TYPE[type_])
+                offset = 0
+                for v in plain:  # the elements not set keep the values last set
+                    if calls.sizes[v] > 1:
+                        ctypes.memmove(ctypes.addressof(tbuf) + offset * size, calls.shadow[v], calls.sizes[v] * size)
+                    offset += calls.sizes[v]
+                for p, t in zip(positions, targets):
+                    tbuf[p] = _convert(type_, buf[t])
+                s = fn3(c, vrs, nvr, tbuf, total)
+                if s > 1:
+                    return s
+                offset = 0
+                for v in plain:
+                    if calls.sizes[v] > 1:
+                        ctypes.memmove(calls.shadow[v], ctypes.addressof(tbuf) + offset * size, calls.sizes[v] * size)
+                    offset += calls.sizes[v]
+            return 0
+
+        return set_
+
+    def _cached(self, name):
+        """`name` for any block (the blocks are prepared on first use): the calls outside the
+        step loop (parameters, final values)."""
+        plans = {}
+
+        def call(c, vr, n, buf):
+            key = bytes(vr)[:4 * n]
+            fn = plans.get(key)
+            if fn is None:
+                fn = plans[key] = self.specialized(name, vr, n)
+            return fn(c, vr, n, buf)
+
+        return call
+
+    def _do_step(self, c, t, h, no_set_prior):
+        event, terminate, early, reached = c_bool(False), c_bool(False), c_bool(False), c_double(t)
+        s = self._step(c, t, h, bool(no_set_prior), byref(event), byref(terminate), byref(early), byref(reached))
+        if s <= 1 and terminate.value:
+            # FMI 3.0 asks the importer to end here: as FMI 2.0's fmi2Discard + fmi2Terminated
+            self.terminated = reached.value
+            return 2
+        if s == 2:
+            self.terminated = None
+        return s
+
+    def _typed(self, kind):
+        """get(vrs) / set(vrs, values) over element value references (Python lists)."""
+        def get(vrs):
+            vrs = list(vrs)
+            arr = (c_uint32 * len(vrs))(*vrs)
+            buf = (_MASTER_C[kind] * len(vrs))()
+            s = self.fn[f"fmi2Get{kind}"](self.component, arr, len(vrs), buf)
+            if s > 1:
+                raise RuntimeError(f"fmi3Get{kind} returned status {s}")
+            return list(buf)
+
+        def set_(vrs, values):
+            vrs = list(vrs)
+            arr = (c_uint32 * len(vrs))(*vrs)
+            buf = (_MASTER_C[kind] * len(vrs))()
+            for i, v in enumerate(values):
+                buf[i] = v.encode("utf-8") if isinstance(v, str) else v
+            s = self.fn[f"fmi2Set{kind}"](self.component, arr, len(vrs), buf)
+            if s > 1:
+                raise RuntimeError(f"fmi3Set{kind} returned status {s}")
+
+        return get, set_
+
+    # ---- FMPy's FMU2Slave interface, as the instance table uses it ----------------------
+    def instantiate(self, visible, callbacks, logging_on):
+        messages, env = callbacks
+
+        def log(instance_env, status, category, message):
+            messages.log(env, self.slave.instanceName.encode(), status, category, message)
+
+        self.slave.instantiate(visible=visible, loggingOn=logging_on, eventModeUsed=False, earlyReturnAllowed=False,
+                               logMessage=log)
+        self._log = self.slave.logMessage  # kept alive with the instance
+        self.component = self.slave.component
+        self.getReal, self.setReal = self._typed("Real")
+        self.getInteger, self.setInteger = self._typed("Integer")
+        self.getBoolean, self.setBoolean = self._typed("Boolean")
+        self.getString, self.setString = self._typed("String")
+
+    def setupExperiment(self, tolerance, start, stop):
+        self._experiment = (tolerance, start, stop)
+
+    def enterInitializationMode(self):
+        tolerance, start, stop = self._experiment
+        self.slave.enterInitializationMode(tolerance=tolerance, startTime=start, stopTime=stop)
+
+    def exitInitializationMode(self):
+        self.slave.exitInitializationMode()
+
+    def terminate(self):
+        self.slave.terminate()
+
+    def free_instance(self):
+        self.slave.fmi3FreeInstance(self.component)
+
+    def freeLibrary(self):
+        self.slave.freeLibrary()
+
+
+_MASTER_C = {"Real": c_double, "Integer": c_int, "Boolean": c_int, "String": c_char_p}
+
+
+def _convert(type_, value):
+    """A master value (double, int, int as Boolean, bytes) as the FMI 3.0 type's C value."""
+    if type_ == "Boolean":
+        return bool(value)
+    return value
+
+
+def _c_value(type_, text):
+    """A start value's text as the C value of FMI 3.0 type `type_`."""
+    if type_ in ("Float64", "Float32"):
+        return float(text)
+    if type_ == "Boolean":
+        return text in ("true", "1")
+    if type_ == "String":
+        return text.encode("utf-8")
+    return int(text)
+
