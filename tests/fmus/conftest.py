@@ -47,3 +47,12 @@ def user_machine():
     reason = can_unshare()
     if reason:
         pytest.skip(reason)
+
+
+@pytest.fixture(scope="session")
+def fmusim(tmp_path_factory):
+    """fmusim compiled from the vendored sources (tests/fmus/fmusim), outside the checkout so a
+    simulated user machine (which hides the checkout) can run it."""
+    import fmusim_host
+
+    return fmusim_host.build(tmp_path_factory.mktemp("fmusim"))

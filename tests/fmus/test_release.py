@@ -128,7 +128,7 @@ def test_export_bundle(built, c_host, tmp_path, capsys):
     fmu_paths, ssp_paths = built
     assert cli.main(["export", "--out", str(tmp_path / "release")]) == 0
     target = tmp_path / "release" / f"neighbor-cosim-{system_ssp.__version__}-fmi.zip"
-    assert f"{target}: 39 FMUs, 13 systems" in capsys.readouterr().out
+    assert f"{target}: 39 FMUs (and 39 as FMI 3.0), 13 systems" in capsys.readouterr().out
     top = f"neighbor-cosim-{system_ssp.__version__}-fmi/"
     with zipfile.ZipFile(target) as z:
         files = {name[len(top):]: z.read(name) for name in z.namelist()}
@@ -140,6 +140,10 @@ def test_export_bundle(built, c_host, tmp_path, capsys):
                 f"reference/{name}.md"} <= set(files), name
         guid = fmpy.read_model_description(str(path)).guid
         assert f"| `{name}` | `{guid}` |" in files["README.md"].decode()
+        fmu3 = path.parent.parent / "fmus3" / path.name  # its FMI 3.0 twin, with the same reference columns
+        assert files[f"fmus3/{name}/{name}.fmu"] == fmu3.read_bytes(), name
+        assert files[f"fmus3/{name}/{name}_ref.csv"].split(b"\n")[0] == files[f"fmus/{name}/{name}_ref.csv"].split(
+            b"\n")[0], name
     for name, path in ssp_paths.items():
         assert files[f"systems/{name}.ssp"] == path.read_bytes(), name
     assert files["LICENSE"] == (REPO / "LICENSE").read_bytes()

@@ -67,6 +67,39 @@ def test_every_fmu_runs_on_a_user_machine(target, user_machine, c_host, fmu_fold
             np.testing.assert_allclose(got, expected, rtol=1e-12, atol=0, err_msg=f"{target_id} {name}")
 
 
+FMI3_SAMPLE = ("RigidBody", "AttitudeEstimator", "MissionManager", "Power", "Gyro")
+
+
+@pytest.mark.parametrize("target", TARGETS, ids=[t[0] for t in TARGETS])
+def test_fmi3_fmus_in_fmusim_on_a_user_machine(target, user_machine, fmusim, fmu3_paths, tmp_path):
+    """FMI 3.0 FMUs (the same runtime core, behind the FMI 3.0 entry points) in fmusim on the
+    user's machine: the user's CPython found on PATH; results equal fmusim's on the build
+    machine, value for value."""
+    import shutil
+
+    import fmusim_host
+
+    target_id, python, bin_dir, installer = target
+    if python is None:
+        pytest.skip(f"{target_id}: not on this machine")
+    prefix = Path(python).parents[1]
+    if any(str(prefix) == h or Path(h) in prefix.parents for h in hidden()):
+        pytest.skip(f"{target_id}: the build's own Python ({prefix}), which a user's machine does not have")
+    numpy_dir = numpy_for(target_id, installer, int(target_id.rsplit(".", 1)[1]))
+    for name in FMI3_SAMPLE:
+        fmu = tmp_path / f"{name}.fmu"  # outside the checkout, which the user's machine does not have
+        shutil.copy(fmu3_paths[name], fmu)
+        assert fmusim_host.run(fmusim, fmu, tmp_path / f"{name}_build.csv", 0.045, 0.015).returncode == 0
+        proc = on_user_machine(fmusim_host.command(fmusim, fmu, tmp_path / f"{name}_user.csv", 0.045, 0.015),
+                               [bin_dir], str(numpy_dir))
+        assert proc.returncode == 0, f"{target_id} {name}:\n{proc.stdout[-3000:]}\n{proc.stderr[-2000:]}"
+        expected = fmusim_host.read(tmp_path / f"{name}_build.csv")
+        got = fmusim_host.read(tmp_path / f"{name}_user.csv")
+        assert got.keys() == expected.keys()
+        for variable, values in expected.items():
+            assert got[variable].tolist() == values.tolist(), f"{target_id} {name}.{variable}"
+
+
 def test_without_python_every_fmu_refuses_and_the_host_exits(user_machine, c_host, fmu_folders):
     """No CPython anywhere: fmi2Instantiate returns NULL with a message naming what was looked
     for and what to install; the host calls again (a second round) and exits by itself."""
