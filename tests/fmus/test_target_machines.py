@@ -34,6 +34,19 @@ def fmu_folders(fmu_paths, tmp_path_factory):
     return out
 
 
+def _user_python(target):
+    """(id, bin folder, prefix, minor version, numpy folder) of a target's CPython; the test is
+    skipped where this machine does not have it or it is the build's own."""
+    target_id, python, bin_dir, installer = target
+    if python is None:
+        pytest.skip(f"{target_id}: not on this machine")
+    prefix = Path(python).parents[1]
+    if any(str(prefix) == h or Path(h) in prefix.parents for h in hidden()):
+        pytest.skip(f"{target_id}: the build's own Python ({prefix}), which a user's machine does not have")
+    minor = int(target_id.rsplit(".", 1)[1])
+    return target_id, bin_dir, prefix, minor, numpy_for(target_id, installer, minor)
+
+
 def _host_command(c_host, folder, model, guid, opts, rounds):
     return [str(c_host), str(folder), model, guid, *opts, "--steps", str(STEPS), "--step", str(STEP),
             "--rounds", str(rounds)]
@@ -43,14 +56,7 @@ def _host_command(c_host, folder, model, guid, opts, rounds):
 def test_every_fmu_runs_on_a_user_machine(target, user_machine, c_host, fmu_folders):
     """The user's CPython found on PATH, its home derived from where its library is, numpy from
     PYTHONPATH; values equal the build machine's to 1e-12."""
-    target_id, python, bin_dir, installer = target
-    if python is None:
-        pytest.skip(f"{target_id}: not on this machine")
-    prefix = Path(python).parents[1]
-    if any(str(prefix) == h or Path(h) in prefix.parents for h in hidden()):
-        pytest.skip(f"{target_id}: the build's own Python ({prefix}), which a user's machine does not have")
-    minor = int(target_id.rsplit(".", 1)[1])
-    numpy_dir = numpy_for(target_id, installer, minor)
+    target_id, bin_dir, prefix, minor, numpy_dir = _user_python(target)
 
     def run(item):
         name, (folder, model, guid, opts, expected) = item
@@ -79,13 +85,7 @@ def test_fmi3_fmus_in_fmusim_on_a_user_machine(target, user_machine, fmusim, fmu
 
     import fmusim_host
 
-    target_id, python, bin_dir, installer = target
-    if python is None:
-        pytest.skip(f"{target_id}: not on this machine")
-    prefix = Path(python).parents[1]
-    if any(str(prefix) == h or Path(h) in prefix.parents for h in hidden()):
-        pytest.skip(f"{target_id}: the build's own Python ({prefix}), which a user's machine does not have")
-    numpy_dir = numpy_for(target_id, installer, int(target_id.rsplit(".", 1)[1]))
+    target_id, bin_dir, _, _, numpy_dir = _user_python(target)
     for name in FMI3_SAMPLE:
         fmu = tmp_path / f"{name}.fmu"  # outside the checkout, which the user's machine does not have
         shutil.copy(fmu3_paths[name], fmu)
