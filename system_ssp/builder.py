@@ -10,17 +10,22 @@ FMUs: each `fmus/neighbor_*.py` wrapper becomes `<build>/fmus/<ClassName>.fmu`:
   `dependencies` and `InitialUnknowns`; `canGetAndSetFMUstate` where the wrapper captures the
   model's full state. The GUID is derived from the product version and the code, so the same
   code of the same version gives the same FMU; `version` is the product's.
-- binaries/<platform>/<ClassName>.so|.dll: the runtime (fmus/runtime/neighbor_fmi2.c),
-  compiled here with gcc (linux64) and, when it is installed, mingw-w64 (win64).
+- binaries/<platform>/<ClassName>.so|.dll: the runtime (fmus/runtime/neighbor_fmi2.c on
+  neighbor_core.c), compiled here with gcc (linux64) and, when it is installed, mingw-w64 (win64).
 - resources/neighbor_runtime.py and .txt: the loader the binary runs and what it needs to know
   (the model's class, the GUID, the Python the FMU was built with).
 - resources/nc_<name>_<digest>/: the model's code, as one package whose name is private to this
   build: the wrapper, the support modules it uses, exactly the modules of components/ it
   imports (computed from the import statements), their PACKAGE_DATA files, and pythonfmu's
   authoring classes. The target needs Python and numpy only (docs/interoperability.md).
-A built FMU must pass `fmpy.validation.validate_fmu` or the build fails.
+A built FMU must pass `fmpy.validation.validate_fmu` or the build fails. Each wrapper is also
+built as an FMI 3.0 co-simulation FMU, `<build>/fmus3/<ClassName>.fmu`: its model description
+written from the completed FMI 2.0 one (system_ssp.fmi3_description: arrays with dimensions),
+the FMI 3.0 binary (neighbor_fmi3.c on the same core, binaries/x86_64-linux|x86_64-windows/),
+its own instantiation token and private package (nc3_...).
 
-SSPs: each `system_ssp/systems/<name>.ssd` becomes `<build>/ssp/<name>.ssp` with the SSD as
+SSPs: each `system_ssp/systems/<name>.ssd` becomes `<build>/ssp/<name>.ssp` (and, with the FMI
+3.0 FMUs, `<build>/ssp3/<name>.ssp`) with the SSD as
 SystemStructure.ssd (a component's several parameter bindings merged into one, which libcosim
 needs), every .ssv/.ssm it references, the scenario parameter sets named
 `parameters/<name>_*.ssv`, and the FMUs its components use under resources/.
