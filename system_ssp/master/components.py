@@ -7,8 +7,8 @@ from fmpy import read_model_description
 from .. import archive
 
 from ..errors import SSPError
+from ..ssp.fmi3_view import element_view
 from ..ssp.interface import unit_definitions, variable_unit
-from .fmi3 import element_view
 from .names import near
 
 
@@ -24,7 +24,7 @@ class ComponentInfo:
         self.left_out = {}  # FMI 3.0 variables the master does not transfer -> why
         self.arrays = {}  # FMI 3.0 array variable -> its elements' names (row-major)
         if md.fmiVersion.startswith("3."):
-            # the master sees an FMI 3.0 FMU through its element view (system_ssp.master.fmi3)
+            # the master sees an FMI 3.0 FMU through its element view (system_ssp.ssp.fmi3_view)
             variables, outputs, self.fmi3_elements, self.left_out = element_view(md)
             self.fmi3_md = md
             for v in variables:

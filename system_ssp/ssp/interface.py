@@ -9,6 +9,7 @@ from typing import Optional
 from fmpy import read_model_description
 
 from ..errors import SSPError
+from .fmi3_view import element_view
 from .units import BUILTIN, SI_BASE_UNITS, Unit, conversion, describe
 
 # what a connection or a binding can use: the variables an SSD declares as connectors
@@ -65,12 +66,10 @@ class FmuInterface:
     def from_model_description(cls, md, path):
         """From an fmpy ModelDescription already read (`path`: the FMU it came from). An FMI 3.0
         FMU's variables are its element view (arrays as their elements, types as the master
-        transfers them: system_ssp.master.fmi3), so an FMU and its FMI 2.0 twin compare equal."""
+        transfers them: system_ssp.ssp.fmi3_view), so an FMU and its FMI 2.0 twin compare equal."""
         variables = {}
         model_variables = md.modelVariables
         if md.fmiVersion.startswith("3."):
-            from ..master.fmi3 import element_view
-
             model_variables = element_view(md)[0]
         for v in model_variables:
             dt = v.declaredType
