@@ -61,6 +61,7 @@ import pythonfmu
 
 from .atomic import atomic_write, write_text_atomic
 from .errors import SSPError
+from . import fmi3_description
 from .fmi3_description import fmi3_model_description
 from .locations import BUILD, COMPONENTS, FMU_SOURCES, ROOT, SYSTEM_SOURCES as SYSTEMS, system_names
 from .ssp.reader import NS_SSD, NS_SSV
@@ -542,7 +543,7 @@ def _build_all(clean, verbose):
 
     shared = _component_files() + sorted(FMU_SOURCES.glob("neighbor_*_support.py")) + [
         *RUNTIME_C.values(), RUNTIME_CORE, RUNTIME_LOADER, Path(__file__).resolve()]
-    fmi3_inputs = [Path(fmi3_model_description.__code__.co_filename)]
+    fmi3_inputs = [Path(fmi3_description.__file__)]
     scripts = []
     names = {}
     for script in wrapper_scripts():

@@ -106,7 +106,7 @@ class Fmi3Calls:
         if len(plan.parts) == 1:
             type_, vrs, nvr, tbuf, total, positions, targets, plain = plan.parts[0]
             direct = (total == n and np.array_equal(positions, np.arange(n)) and np.array_equal(targets, np.arange(n))
-                      and C_TYPE[type_] is _MASTER_C[kind] and not (kind == "Boolean"))
+                      and C_TYPE[type_] is _MASTER_C[kind])  # Boolean never: 1-byte bool vs int
             if direct:
                 fn3 = self._c[(verb, CALL_TYPE[type_])]
                 arrays = [v for v in plain if self.sizes[v] > 1] if verb == "Set" else []
@@ -139,10 +139,11 @@ class Fmi3Calls:
     def _general(self, verb, plan):
         calls = self
         parts = [(calls._c[(verb, CALL_TYPE[type_])], type_, vrs, nvr, tbuf, total, positions.tolist(),
-                  targets.tolist(), plain) for type_, vrs, nvr, tbuf, total, positions, targets, plain in plan.parts]
+                  targets.tolist(), plain, ctypes.sizeof(C_TYPE[type_]))
+                 for type_, vrs, nvr, tbuf, total, positions, targets, plain in plan.parts]
         if verb == "Get":
             def get(c, vr, n, buf):
-                for fn3, _, vrs, nvr, tbuf, total, positions, targets, _ in parts:
+                for fn3, _, vrs, nvr, tbuf, total, positions, targets, _, _ in parts:
                     s = fn3(c, vrs, nvr, tbuf, total)
                     if s > 1:
                         return s
@@ -153,8 +154,7 @@ class Fmi3Calls:
             return get
 
         def set_(c, vr, n, buf):
-            for fn3, type_, vrs, nvr, tbuf, total, positions, targets, plain in parts:
-                size = ctypes.sizeof(C_TYPE[type_])
+            for fn3, type_, vrs, nvr, tbuf, total, positions, targets, plain, size in parts:
                 offset = 0
                 for v in plain:  # the elements not set keep the values last set
                     if calls.sizes[v] > 1:
