@@ -1,12 +1,12 @@
 """FMU `SunAvoidanceGuidance` (instance `guidance`): Sun-avoidance slew reference.
 
-Wraps components.attitude.sun_avoidance.SunAvoidanceGuidance: plans (from parameters only) a rest-to-
-rest eigenaxis slew from q0 to q_f, split into three eigenaxis segments around the Sun keep-out
-cone when the direct one would sweep the boresight through it, each with a bang-coast-bang
-profile, and streams the analytic reference at the communication point time. Its outputs
-depend on time only; its one input, the spacecraft's attitude, is only checked against q0 when
-initialization ends (a mismatch is an error, not a reference that jumps). The reference time is
-the FMU's only state.
+Wraps components.attitude.sun_avoidance.SunAvoidanceGuidance: plans (from parameters only) an
+eigenaxis slew from q0 to q_f (from rest or the start rate phi_dot_0, to rest or the end rate
+phi_dot_f), split into three eigenaxis segments around the Sun keep-out cone when the direct one
+would sweep the boresight through it, each with a bang-coast-bang profile, and streams the
+analytic reference at the communication point time. Its outputs depend on time only; its one
+input, the spacecraft's attitude, is only checked against q0 when initialization ends (a
+mismatch is an error, not a reference that jumps). The reference time is the FMU's only state.
 """
 import math
 
@@ -35,6 +35,11 @@ class SunAvoidanceGuidance(NeighborSlave):
         self.parameter("w_max", 0.05, "rad/s", "Maximum slew rate of each segment (> 0)")
         self.parameter("a_max", 0.01, "rad/s2", "Maximum slew acceleration of each segment (> 0)")
         self.parameter("t_start", 0.0, "s", "Simulation time at which the slew starts (q0 held before)")
+        self.parameter("phi_dot_0", 0.0, "rad/s",
+                       "Rate along the first segment's axis at t_start, in [0, w_max] (0: from rest)")
+        self.parameter("phi_dot_f", 0.0, "rad/s",
+                       "Rate along the last segment's axis at the end, in [0, w_max] (0: to rest; after the end "
+                       "the reference goes on turning at it)")
         self.parameter("q0_tolerance", 1e-6, "rad",
                        "Largest rotation between q0 and the attitude input q_BN when initialization ends (> 0)")
         self.input_array("q_BN", [0.0] * 4, "1",
@@ -60,8 +65,8 @@ class SunAvoidanceGuidance(NeighborSlave):
         self.output("sun_angle", lambda: ref()["sun_angle"], "rad", "Angle between the reference boresight and the Sun")
         self.output("min_sun_angle", lambda: self.model.min_angle, "rad",
                     "Smallest boresight-to-Sun angle of the whole planned path (exact swept-arc test)")
-        self.output("done", lambda: ref()["done"], None, "The reference profile has ended (final attitude, at rest)",
-                    bool)
+        self.output("done", lambda: ref()["done"], None,
+                    "The reference profile has ended (final attitude, at the end rate phi_dot_f)", bool)
         self.output("duration", lambda: self.model.duration, "s", "Planned total duration (sum of segment durations)")
         self.output_array("segment_angle", MAX_SEGMENTS, lambda: self._per_segment(lambda s: s.angle), "rad",
                           "Eigenaxis rotation angle of each segment (0 for unused segments)")
@@ -84,7 +89,8 @@ class SunAvoidanceGuidance(NeighborSlave):
         J = rigid_body.box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"]).tolist()
         model = sun_avoidance.SunAvoidanceGuidance(
             self.vector("boresight_B", 3), self.vector("sun_N", 3), v["epsilon"], self.vector("q0", 4),
-            self.vector("q_f", 4), v["w_max"], v["a_max"], J, v["margin"], v["t_start"])
+            self.vector("q_f", 4), v["w_max"], v["a_max"], J, v["margin"], v["t_start"], v["phi_dot_0"],
+            v["phi_dot_f"])
         model.time = self.start_time
         return model
 

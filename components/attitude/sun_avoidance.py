@@ -93,6 +93,24 @@ w_p = a_max t1:  theta = a t^2/2 (t < t1);  a t1^2/2 + w_p (t - t1) (t1 <= t < t
 phi - a (tf - t)^2 / 2 (t2 <= t < tf); phi after tf. Segments follow one another (each from rest
 to rest); the plan starts at t_start and lasts the sum of the segment durations.
 
+4. From and to a moving state (seed step 2b)
+--------------------------------------------
+The slew may start while the detumble's residual rate remains and hand over to tracking at its
+rate: the first segment starts at the rate phi_dot_0 and the last ends at phi_dot_f, both along
+the segment's axis and in [0, w_max] (the segments between meet at rest: the axis changes there).
+With the coast (phi at least the angles of speeding up from phi_dot_0 to w_max and slowing down
+to phi_dot_f), the seed's times:
+    t1 = (w_max - phi_dot_0) / a_max,
+    t2 = t1 + [phi - phi_dot_0 t1 - a_max t1^2 / 2 - w_max (w_max - phi_dot_f) / a_max
+               + (w_max - phi_dot_f)^2 / (2 a_max)] / w_max,
+    tf = t1 + [phi - phi_dot_0 t1 - a_max t1^2 / 2 + (w_max - phi_dot_f)^2 / (2 a_max)] / w_max;
+without it the peak rate is w_p = sqrt(a_max phi + (phi_dot_0^2 + phi_dot_f^2) / 2), t1 = t2 =
+(w_p - phi_dot_0) / a_max, tf = t1 + (w_p - phi_dot_f) / a_max; a segment too short to change
+from one rate to the other (|phi_dot_0^2 - phi_dot_f^2| / (2 a_max) > phi) is refused. The angle
+stays monotone in [0, phi] within the segment, so the keep-out test of section 1 holds as
+before; after the end the reference goes on turning at phi_dot_f about the last axis (the
+follower's business). phi_dot_0 = phi_dot_f = 0 is the rest-to-rest profile of section 3.
+
 Reference outputs at time t: q_ref = q(e_B,k, theta_k(t)) (x) q_start,k, omega_ref = theta_dot e_B,k,
 omega_dot_ref = theta_ddot e_B,k, feed-forward torque (Euler's equation)
 torque_ff = J omega_dot_ref + omega_ref x J omega_ref.
@@ -216,27 +234,67 @@ def eigenaxis(q_from, q_to):
 
 
 class BangCoastBang:
-    """Rest-to-rest angle profile limited by w_max and a_max (section 3 of the docstring)."""
+    """Angle profile limited by w_max and a_max (section 3 of the docstring): rest to rest, or
+    from the start rate w0 to the end rate wf (0 <= w0, wf <= w_max; section 4)."""
 
-    def __init__(self, phi, w_max, a_max):
+    def __init__(self, phi, w_max, a_max, w0=0.0, wf=0.0):
         if not (math.isfinite(phi) and phi >= 0):
             raise ValueError(f"segment angle {phi!r} must be finite and >= 0")
         self.phi, self.a = float(phi), float(a_max)
+        self.w0, self.wf = float(w0), float(wf)
+        for name, w in (("start rate phi_dot_0", self.w0), ("end rate phi_dot_f", self.wf)):
+            if not (math.isfinite(w) and 0.0 <= w <= w_max):
+                raise ValueError(f"{name} = {w!r} rad/s must lie in [0, w_max = {w_max!r}] (along the slew)")
         self.phi_tt = w_max * w_max / a_max
-        if self.phi > self.phi_tt:
-            self.triangle = False
-            self.t1 = w_max / a_max
-            self.t2 = self.t1 + (self.phi - self.phi_tt) / w_max
-            self.tf = self.t2 + self.t1
+        self.rest_to_rest = self.w0 == 0.0 and self.wf == 0.0
+        if self.rest_to_rest:
+            if self.phi > self.phi_tt:
+                self.triangle = False
+                self.t1 = w_max / a_max
+                self.t2 = self.t1 + (self.phi - self.phi_tt) / w_max
+                self.tf = self.t2 + self.t1
+            else:
+                self.triangle = True
+                self.t1 = self.t2 = math.sqrt(self.phi / a_max)
+                self.tf = 2.0 * self.t1
+            self.w_peak = a_max * self.t1
+            return
+        w0, wf, a = self.w0, self.wf, self.a
+        # the angles of speeding up from w0 to w_max and slowing down from w_max to wf
+        up, down = (w_max - w0) / a, (w_max - wf) / a
+        if self.phi >= w0 * up + 0.5 * a * up * up + w_max * down - 0.5 * a * down * down:
+            self.triangle = False  # a coast at w_max (the seed's step 2b timing)
+            self.t1 = up
+            self.t2 = self.t1 + (self.phi - w0 * up - 0.5 * a * up * up - w_max * down + 0.5 * a * down * down) / w_max
+            self.tf = self.t2 + down
+            self.w_peak = w_max
         else:
+            # no coast: the peak rate that covers phi, (w_p^2 - w0^2 + w_p^2 - wf^2) / (2 a) = phi
             self.triangle = True
-            self.t1 = self.t2 = math.sqrt(self.phi / a_max)
-            self.tf = 2.0 * self.t1
-        self.w_peak = a_max * self.t1
+            self.w_peak = math.sqrt(a * self.phi + 0.5 * (w0 * w0 + wf * wf))
+            if self.w_peak < max(w0, wf) * (1.0 - 1e-12):
+                raise ValueError(f"a {self.phi!r} rad segment is too short to go from {w0!r} to {wf!r} rad/s at "
+                                 f"{a!r} rad/s2 (needs {abs(w0 * w0 - wf * wf) / (2.0 * a)!r} rad)")
+            self.w_peak = max(self.w_peak, w0, wf)
+            self.t1 = self.t2 = (self.w_peak - w0) / a
+            self.tf = self.t1 + (self.w_peak - wf) / a
+        self.angle_t1 = w0 * self.t1 + 0.5 * a * self.t1 * self.t1
 
     def evaluate(self, t):
-        """(angle, rate, acceleration) at time t from the segment start."""
+        """(angle, rate, acceleration) at time t from the segment start; after the end the angle
+        goes on at the end rate (rest to rest: stays at phi)."""
         a = self.a
+        if not self.rest_to_rest:
+            if t <= 0.0:
+                return 0.0, self.w0, 0.0
+            if t < self.t1:
+                return self.w0 * t + 0.5 * a * t * t, self.w0 + a * t, a
+            if t < self.t2:
+                return self.angle_t1 + self.w_peak * (t - self.t1), self.w_peak, 0.0
+            if t < self.tf:
+                r = self.tf - t
+                return self.phi - self.wf * r - 0.5 * a * r * r, self.wf + a * r, -a
+            return self.phi + self.wf * (t - self.tf), self.wf, 0.0
         if t <= 0.0:
             return 0.0, 0.0, 0.0
         if t < self.t1:
@@ -250,11 +308,11 @@ class BangCoastBang:
 
 
 class Segment:
-    def __init__(self, q_start, axis_B, angle, w_max, a_max, t_begin):
+    def __init__(self, q_start, axis_B, angle, w_max, a_max, t_begin, w0=0.0, wf=0.0):
         self.q_start = tuple(q_start)
         self.axis_B = tuple(axis_B)
         self.angle = float(angle)
-        self.profile = BangCoastBang(angle, w_max, a_max)
+        self.profile = BangCoastBang(angle, w_max, a_max, w0, wf)
         self.t_begin = float(t_begin)
         self.t_end = self.t_begin + self.profile.tf
         self.q_end = self.attitude(self.angle)
@@ -270,7 +328,7 @@ class SunAvoidanceGuidance:
 
     def __init__(self, boresight_B, sun_N, epsilon, q0, q_f, w_max, a_max,
                  inertia=((0.05, 0, 0), (0, 0.13, 0), (0, 0, 0.1)),
-                 margin=math.radians(5.0), t_start=0.0):
+                 margin=math.radians(5.0), t_start=0.0, phi_dot_0=0.0, phi_dot_f=0.0):
         self.P = _unit(boresight_B, "boresight_B")
         self.S = _unit(sun_N, "sun_N")
         epsilon = float(epsilon)
@@ -289,6 +347,7 @@ class SunAvoidanceGuidance:
         if not math.isfinite(t_start):
             raise ValueError(f"t_start = {t_start!r} s must be finite")
         self.t_start = t_start
+        self.phi_dot_0, self.phi_dot_f = float(phi_dot_0), float(phi_dot_f)
         J = [[float(x) for x in row] for row in inertia]
         if len(J) != 3 or any(len(r) != 3 for r in J) or not all(math.isfinite(x) for r in J for x in r):
             raise ValueError(f"inertia {J} must be a finite 3x3 matrix (kg.m2)")
@@ -335,10 +394,14 @@ class SunAvoidanceGuidance:
     def _build(self, turns):
         segments, angles = [], []
         q, t = self.q0, self.t_start
-        for axis, angle in turns:
-            if angle <= 1e-12:
-                continue
-            seg = Segment(q, axis, angle, self.w_max, self.a_max, t)
+        turns = [(axis, angle) for axis, angle in turns if angle > 1e-12]
+        if not turns and (self.phi_dot_0 or self.phi_dot_f):
+            raise ValueError("q0 and q_f are the same attitude: no slew to start at phi_dot_0 or end at phi_dot_f")
+        for k, (axis, angle) in enumerate(turns):
+            # the first segment starts at phi_dot_0, the last ends at phi_dot_f; the axis changes
+            # between segments, so they meet at rest
+            seg = Segment(q, axis, angle, self.w_max, self.a_max, t, self.phi_dot_0 if k == 0 else 0.0,
+                          self.phi_dot_f if k == len(turns) - 1 else 0.0)
             segments.append(seg)
             q, t = seg.q_end, seg.t_end
             pN = boresight_N(seg.q_start, self.P)

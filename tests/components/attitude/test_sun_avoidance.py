@@ -89,6 +89,68 @@ def test_triangle_profile_for_short_angle():
 
 
 # ---- swept-arc test -----------------------------------------------------------------------
+def _seed_times(phi, w, a, w0, wf):
+    """Seed 000, step 2b, as written (t0 = 0): the switching times with start and end rates."""
+    t1 = (w - w0) / a
+    t2 = t1 + (phi - w0 * t1 - 0.5 * a * t1 ** 2 - w * (w - wf) / a + (w - wf) ** 2 / (2 * a)) / w
+    tf = t1 + (phi - w0 * t1 - 0.5 * a * t1 ** 2 + (w - wf) ** 2 / (2 * a)) / w
+    return t1, t2, tf
+
+
+@pytest.mark.parametrize("phi,w0,wf", [(1.0, 0.02, 0.03), (1.0, 0.05, 0.0), (0.6, 0.0, 0.04), (2.0, 0.01, 0.01)])
+def test_profile_from_and_to_a_moving_state_follows_the_seed(phi, w0, wf):
+    w, a = 0.05, 0.01
+    p = sa.BangCoastBang(phi, w, a, w0, wf)
+    assert not p.triangle
+    assert (p.t1, p.t2, p.tf) == pytest.approx(_seed_times(phi, w, a, w0, wf), rel=1e-12, abs=1e-12)
+    assert p.evaluate(0.0)[1] == w0 and p.evaluate(p.tf)[:2] == (phi, wf)
+    assert p.evaluate(p.tf + 10.0)[:2] == pytest.approx((phi + 10.0 * wf, wf))  # goes on at the end rate
+    ts = np.linspace(0.0, p.tf, 20001)
+    vals = np.array([p.evaluate(t) for t in ts])
+    assert np.all(np.diff(vals[:, 0]) >= 0.0) and vals[:, 1].max() <= w + 1e-15  # monotone, rate-limited
+    rate_int = np.concatenate([[0.0], np.cumsum(0.5 * (vals[1:, 1] + vals[:-1, 1]) * np.diff(ts))])
+    assert np.max(np.abs(rate_int - vals[:, 0])) < 1e-6  # the angle is the rate's integral
+    for tb in (p.t1, p.t2, p.tf):
+        lo, hi = p.evaluate(tb - 1e-9), p.evaluate(tb)
+        assert abs(lo[0] - hi[0]) < 1e-9 and abs(lo[1] - hi[1]) < 1e-9
+    # a moving start or end is quicker than rest to rest
+    assert p.tf < sa.BangCoastBang(phi, w, a).tf
+
+
+def test_short_profile_between_rates_and_refusals():
+    w, a = 0.05, 0.01
+    p = sa.BangCoastBang(0.1, w, a, 0.01, 0.02)
+    assert p.triangle and p.w_peak < w
+    assert p.w_peak == pytest.approx(math.sqrt(a * 0.1 + (0.01 ** 2 + 0.02 ** 2) / 2), rel=1e-12)
+    assert p.evaluate(p.tf)[:2] == (pytest.approx(0.1), 0.02) and p.tf == pytest.approx(
+        (2 * p.w_peak - 0.01 - 0.02) / a)
+    # too short to slow from 0.05 to rest (0.125 rad needed), rates outside [0, w_max]
+    with pytest.raises(ValueError, match="too short to go from 0.05 to 0.0 rad/s"):
+        sa.BangCoastBang(0.1, w, a, 0.05, 0.0)
+    for w0, wf in ((-0.01, 0.0), (0.0, 0.06), (math.nan, 0.0)):
+        with pytest.raises(ValueError, match="must lie in \\[0, w_max"):
+            sa.BangCoastBang(1.0, w, a, w0, wf)
+    with pytest.raises(ValueError, match="no slew to start at phi_dot_0"):
+        plan(gen.sun_far(), q_f=gen.Q0, phi_dot_0=0.01)
+
+
+@pytest.mark.parametrize("sun", ["near", "far"])
+def test_guidance_from_and_to_a_moving_state(sun):
+    """The first segment starts at phi_dot_0 along its axis, the last ends at phi_dot_f; the
+    segments between meet at rest; the keep-out cone is never entered."""
+    S = gen.sun_near() if sun == "near" else gen.sun_far()
+    rest, g = plan(S), plan(S, phi_dot_0=0.02, phi_dot_f=0.015)
+    assert len(g.segments) == len(rest.segments) and g.duration < rest.duration
+    first, last = g.segments[0], g.segments[-1]
+    assert g.reference(g.t_start)["omega"] == pytest.approx([0.02 * x for x in first.axis_B], abs=1e-15)
+    end = g.reference(g.t_end)
+    assert end["omega"] == pytest.approx([0.015 * x for x in last.axis_B], abs=1e-15) and end["done"]
+    assert q_close(end["q"], gen.Q_F) < 1e-12
+    for a, b in zip(g.segments, g.segments[1:]):  # at rest where the axis changes
+        assert a.profile.wf == 0.0 and b.profile.w0 == 0.0
+    assert dense_sun_angles(g).min() >= EPS and g.min_angle >= EPS
+
+
 def test_min_sun_angle_matches_brute_force_and_seed_alpha():
     rng = np.random.default_rng(1)
     for _ in range(200):
@@ -356,6 +418,34 @@ def test_system_flies_around_the_sun(sas_build, scenario, n_seg):
     q_end = [r.final[n] for n in q_names]
     assert q_angle(q_end, gen.Q_F) <= math.radians(0.1)
     assert max(abs(r.final[n]) for n in w_names) <= math.radians(0.01)
+
+
+def test_system_slews_from_and_to_a_moving_state(sas_build):
+    """The spacecraft still turning along the first segment's axis at the start (the detumble's
+    residual rate), handed over at phi_dot_f: flown around the Sun, never inside the cone."""
+    import system_ssp
+
+    _, ssp = sas_build
+    q_names = [f"dynamics.q_BN[{i}]" for i in (1, 2, 3, 4)]
+    w_names = [f"dynamics.omega_BN_B[{i}]" for i in (1, 2, 3)]
+    g = plan(gen.sun_near(), phi_dot_0=0.02, phi_dot_f=0.01)
+    start = {f"dynamics.omega0[{i}]": 0.02 * x for i, x in enumerate(g.segments[0].axis_B, 1)}
+    r = system_ssp.simulate(ssp, parameter_sets=["parameters/sun_avoidance_slew_near_sun.ssv"],
+                            parameters={**start, "guidance.phi_dot_0": 0.02, "guidance.phi_dot_f": 0.01},
+                            stop_time=round(g.t_end / 0.1) * 0.1, outputs=q_names + w_names + [
+                                "guidance.sun_angle", "guidance.duration", "tracker.attitude_error"])
+    assert r.final["guidance.duration"] == pytest.approx(g.duration) and r.stop_time == pytest.approx(g.t_end, abs=0.1)
+    d = r.data
+    flown = np.array([sa.angle_between(sa.boresight_N([d[n][k] for n in q_names], gen.BORESIGHT), g.S)
+                      for k in range(len(d))])
+    assert d["guidance.sun_angle"].min() >= EPS and flown.min() >= EPS
+    assert d["tracker.attitude_error"].max() < math.radians(0.05)
+    # handed over turning about the last axis, as the reference at that instant (the run stops on
+    # its 0.1 s grid, within 0.05 s of the planned end: 0.01 rad/s give or take 5e-4)
+    w_end = np.array([r.final[n] for n in w_names])
+    assert w_end == pytest.approx(g.reference(r.stop_time)["omega"], abs=3e-5)
+    assert np.linalg.norm(w_end) == pytest.approx(0.01, abs=6e-4)
+    assert np.dot(w_end, g.segments[-1].axis_B) == pytest.approx(np.linalg.norm(w_end), rel=1e-3)
 
 
 def test_start_attitude_must_match_the_dynamics():
