@@ -85,6 +85,15 @@ class AttitudeEstimator(NeighborSlave):
         self.output("attitude_valid", self._valid, None,
                     "The attitude is known well enough to fly on: initialized and the largest sigma_attitude at most "
                     "valid_sigma (always true with truth_feedback)", bool)
+        # the filter's consistency against q_true_BN (a simulation's diagnostic; 0 with truth_feedback)
+        self.output("nees", lambda: self.model.consistency.last, "1",
+                    "Attitude normalized estimation error squared after the last step, dtheta^T P^-1 dtheta against "
+                    "q_true_BN (chi-square, 3 degrees of freedom, when the covariance is consistent)")
+        self.output("nees_mean", lambda: self.model.consistency.mean, "1",
+                    "Mean attitude NEES over the steps since the first fix (3 when consistent)")
+        self.output("nees_over_fraction", lambda: self.model.consistency.over_fraction, "1",
+                    "Share of the steps since the first fix with the NEES above its 95 % bound 7.81 (0.05 when "
+                    "consistent)")
 
     def build_model(self):
         v = self.values
@@ -144,6 +153,7 @@ class AttitudeEstimator(NeighborSlave):
                             self.vector("r_BN_N", 3), self.vector("r_SN_N", 3))
             self.model.step(measurements, self.vector("omega_meas_B", 3), step_size, self.vector("torque_cmd_B", 3),
                             (self.vector("coarse_sun_B", 3), v["coarse_sun_valid"]))
+            self.model.check(self.vector("q_true_BN", 4))
         self._refresh()
         return True
 

@@ -115,6 +115,18 @@ class AttitudeMEKF:
         self._need()
         return tuple(float(math.sqrt(max(0.0, self.P[i, i]))) for i in range(3))
 
+    def attitude_nees(self, q_true):
+        """Normalized estimation error squared of the attitude against the true q:
+        dtheta^T P_aa^-1 dtheta, dtheta the small rotation (body axes) that takes the estimate to
+        q_true, as the filter defines its error (q_true = dq(dtheta) (x) q). Chi-square with 3
+        degrees of freedom when the covariance is consistent: mean 3, above NEES_BOUND_95 one
+        time in twenty."""
+        self._need()
+        e = rotations.circle_cross(rotations.normalized(tuple(float(x) for x in q_true), "q_true"),
+                                   rotations.conjugate(self.q))
+        d = np.array(e[:3]) * (2.0 if e[3] >= 0.0 else -2.0)
+        return float(d @ np.linalg.solve(self.P[:3, :3], d))
+
     def bias_sigma(self):
         self._need()
         return tuple(float(math.sqrt(max(0.0, self.P[i, i]))) for i in range(3, 6))
@@ -193,6 +205,39 @@ class RateFilter:
         self.omega_dot = tuple(float(x) for x in state["omega_dot"])
 
 
+# 95 % quantile of the chi-square distribution with 3 degrees of freedom (scipy.stats.chi2.ppf(0.95, 3))
+NEES_BOUND_95 = 7.814727903251178
+
+
+class NeesMonitor:
+    """The attitude NEES over the steps it is given: its mean (3 when the covariance is
+    consistent) and the share of steps above NEES_BOUND_95 (0.05 when consistent)."""
+
+    def __init__(self):
+        self.count, self.total, self.over, self.last = 0, 0.0, 0, 0.0
+
+    def add(self, nees):
+        self.count += 1
+        self.total += nees
+        self.over += nees > NEES_BOUND_95
+        self.last = nees
+
+    @property
+    def mean(self):
+        return self.total / self.count if self.count else 0.0
+
+    @property
+    def over_fraction(self):
+        return self.over / self.count if self.count else 0.0
+
+    def get_state(self):
+        return {"count": self.count, "total": self.total, "over": self.over, "last": self.last}
+
+    def set_state(self, state):
+        self.count, self.total = int(state["count"]), float(state["total"])
+        self.over, self.last = int(state["over"]), float(state["last"])
+
+
 # The estimator propagates the covariance in steps of at least this long (and before each
 # update): at the 15 ms attitude loop, the 6 x 6 products are most of the filter's cost.
 COVARIANCE_STEP = 0.1
@@ -238,6 +283,7 @@ class AttitudeEstimator:
         self.time = 0.0
         self.cov_pending, self.cov_rate = 0.0, (0.0, 0.0, 0.0)  # covariance propagation gathered
         self.held_rate = None  # the gyro sample of the step's start
+        self.consistency = NeesMonitor()  # against the truth, where a simulation gives it (check)
         self.last = {"nadir": (None, -math.inf), "sun": (None, -math.inf), "coarse": (None, -math.inf)}  # (used, when)
 
     @property
@@ -315,13 +361,24 @@ class AttitudeEstimator:
         self._mark("nadir", nadir_B)
         self._mark(*sun_used)
 
+    def check(self, q_true):
+        """Record the attitude NEES against the true attitude (a simulation's diagnostic of the
+        filter's consistency; nothing the filter uses). Returns it; 0 before the first fix."""
+        if not self.filter.initialized:
+            return 0.0
+        nees = self.filter.attitude_nees(q_true)
+        self.consistency.add(nees)
+        return nees
+
     def get_state(self):
-        return {"filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
+        return {"consistency": self.consistency.get_state(),
+                "filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
                 "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
                 "held_rate": self.held_rate, "last": {k: [None if v is None else list(v), t]
                                                       for k, (v, t) in self.last.items()}}
 
     def set_state(self, state):
+        self.consistency.set_state(state["consistency"])
         self.filter.set_state(state["filter"])
         self.rates.set_state(state["rates"])
         self.time = float(state["time"])

@@ -10,7 +10,7 @@ import pytest
 from components.attitude import rigid_body
 from components.core import rotations
 from components.sensing import triad
-from components.sensing.mekf import AttitudeMEKF
+from components.sensing.mekf import AttitudeMEKF, NeesMonitor
 
 H = 0.1
 GYRO_SIGMA = 5.5e-4  # rad/s per 10 Hz sample (the attitude-determination system's gyro)
@@ -56,6 +56,33 @@ def test_converges_estimates_the_bias_and_is_consistent():
     assert np.abs(filt.bias - BIAS).max() < 5e-5
     inside = np.mean(np.abs(err[late]) <= 3.0 * sig[late])
     assert inside > 0.97  # the covariance tells the truth about the error
+
+
+def test_nees_is_the_error_against_the_filters_own_covariance():
+    """NEES = dtheta^T P_aa^-1 dtheta with dtheta about the body axes (q_true = dq (x) q):
+    an error about body x is weighed by P's x entry, whatever the attitude; over a converged
+    run its mean is near 3 (chi-square, 3 degrees of freedom) and about 5 % of the steps exceed
+    the 95 % bound."""
+    filt = AttitudeMEKF()
+    q = rotations.from_axis_angle((0.3, -0.2, 0.9), 0.7)
+    filt.initialize(q, 1e-3)
+    filt.P[:3, :3] = np.diag([1e-6, 4e-6, 9e-6])  # sigmas 1, 2, 3 mrad
+    for axis, sigma in (((1.0, 0.0, 0.0), 1e-3), ((0.0, 1.0, 0.0), 2e-3), ((0.0, 0.0, 1.0), 3e-3)):
+        q_true = rotations.circle_cross(rotations.from_axis_angle(axis, 2e-3), q)
+        assert filt.attitude_nees(q_true) == pytest.approx((2e-3 / sigma) ** 2, rel=1e-5)
+    assert filt.attitude_nees(q) == 0.0 and filt.attitude_nees(tuple(-x for x in q)) == 0.0
+    # the converged run of the test above: consistent
+    filt, _, err, sig = _run(600.0)
+    late = slice(len(err) // 2, None)
+    nees = np.sum((err[late] / sig[late]) ** 2, axis=1)  # P nearly diagonal once converged
+    monitor = NeesMonitor()
+    for x in nees:
+        monitor.add(float(x))
+    assert 2.0 < monitor.mean < 4.0 and monitor.over_fraction < 0.12
+    assert monitor.count == len(nees) and monitor.mean == pytest.approx(np.mean(nees))
+    restored = NeesMonitor()
+    restored.set_state(monitor.get_state())
+    assert (restored.mean, restored.over_fraction) == (monitor.mean, monitor.over_fraction)
 
 
 def test_eclipse_nadir_only_error_about_nadir_grows_and_the_filter_knows():
