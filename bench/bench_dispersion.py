@@ -24,6 +24,8 @@ import numpy as np
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
 from components.core.constants import YEAR  # noqa: E402
+from components.mission.neighbor import DATA_STORAGE_LIMIT_B  # noqa: E402
+from system_ssp.neighbor import budgets  # noqa: E402
 from system_ssp.tools.campaign import load_spec, run_campaign  # noqa: E402
 from system_ssp.tools.campaign.runner import _read_rows, wilson  # noqa: E402
 
@@ -71,6 +73,19 @@ def main():
     print(distribution("attitude determination (s)", [r["detumble_start_s"] - r["determination_start_s"] for r in ok]))
     print(distribution("largest knowledge error, whole run (deg)",
                        [np.degrees(r["knowledge_error_max_rad"]) for r in ok]))
+    print(distribution("mean attitude NEES (3: consistent)", [r["nees_mean"] for r in ok]))
+    print(distribution("steps above the NEES 95 % bound (%)", [100.0 * r["nees_over_fraction"] for r in ok]))
+    # the budgets (system_ssp.neighbor.budgets): the 95th percentile against each allowance
+    allowed = budgets.allowance("420km")
+    for label, values, limit in (
+            ("RCS propellant (g)", [1e3 * r["rcs_propellant_kg"] for r in ok], allowed.rcs_g),
+            ("total propellant (kg)", [r["burn_propellant_kg"] + r["rcs_propellant_kg"] for r in ok], allowed.tank_kg),
+            ("largest data storage (MB)", [r["max_storage_B"] / 1e6 for r in ok], DATA_STORAGE_LIMIT_B / 1e6)):
+        if values:
+            p95, over = np.percentile(values, 95), sum(v > limit for v in values)
+            print(f"  budget {label}: p95 {p95:.4g} against {limit:.4g}: {'within' if p95 <= limit else 'OVER'} "
+                  f"({over} of {len(values)} runs over)")
+    print(f"  ({allowed.describe()})")
     per_run = np.mean([r["wall_s"] for r in rows]) if rows else float("nan")
     workers = args.workers or len(os.sched_getaffinity(0))
     print(f"wall {wall:.0f} s for {len(rows) - summary['resumed_from']} new runs; {per_run:.1f} s per run in a worker; "

@@ -13,10 +13,17 @@ With target_from_input (appended after the thesis' variables) q_d and omega_d fo
 q_target_BN and omega_target_B instead: the burn attitude the guidance computes from the actual
 orbit, in place of the Eq. 67 rate at Re + 400 km; each new target re-anchors q_d, which is
 propagated in between (DeorbitTrackingController.follow).
+With knowledge_sigmas or impulse_bits (appended last) the boundary layer e widens with the
+estimator's 1-sigma attitude error (input sigma_attitude_B) and the impulse bit, so the law does
+not fire at the estimate's noise (DeorbitTrackingController.boundary_layer); 0 and 0 (the
+defaults) keep the thesis' fixed e.
 """
 from neighbor_fmu_support import TARGET_INPUTS, NeighborSlave
 
 from components.attitude import deorbit_tracking, rigid_body, thruster_control
+from components.core.names import element_names
+
+SIGMA_INPUTS = element_names("sigma_attitude_B", 3)
 
 
 class TrackingController(NeighborSlave):
@@ -40,7 +47,7 @@ class TrackingController(NeighborSlave):
         self.inertia_parameters("Spacecraft mass for the box inertia the law uses (Eq. 4)")
         self.parameter_array("torque_level", thruster_control.pair_torques(), "N.m",
                              "Torque of one thruster pair per axis (Eq. 16, > 0)")
-        reads = lambda s: s.q_BN + s.omega_BN_B + TARGET_INPUTS  # noqa: E731
+        reads = lambda s: s.q_BN + s.omega_BN_B + TARGET_INPUTS + SIGMA_INPUTS  # noqa: E731
         ctl = self.thruster_controller_interface(
             self._command, self._done, reads, reads,
             "Tracking converged: every sliding-vector component within its threshold e (the burn itself "
@@ -61,13 +68,28 @@ class TrackingController(NeighborSlave):
                        "True: q_d and omega_d are the inputs q_target_BN and omega_target_B (burn guidance from the "
                        "actual orbit); false: the thesis' q_d propagated at the parameter omega_d", bool)
         self.target_inputs("used when target_from_input")
+        self.parameter("knowledge_sigmas", 0.0, "1",
+                       "Boundary layer sized for estimates: the law's deadband in s at least this many sigmas of "
+                       "the estimate's noise (0: off, the thesis' fixed e; >= 0)")
+        self.parameter("impulse_bits", 0.0, "1",
+                       "Boundary layer: the law's deadband in s at least this many impulse bits (0: off; >= 0)")
+        self.parameter("rate_sigma", 0.0, "rad/s", "1-sigma error of the rate estimate per axis (>= 0)")
+        self.parameter("min_on_time", 0.015, "s", "Shortest firing, for the impulse bit (> 0; the attitude step)")
+        self.input_array("sigma_attitude_B", [0.0] * 3, "rad",
+                         "1-sigma attitude error of the estimate about the body axes (from the estimator; 0: "
+                         "perfect knowledge)")
+        self.output_array("boundary_layer", 3, lambda: self.feedthrough(self._layer), "rad/s",
+                          "The saturation thresholds e in use (the fixed e, or wider for the estimate's noise and "
+                          "the impulse bit)", depends_on=SIGMA_INPUTS)
 
     def build_model(self):
         J = self.inertia(rigid_body.box_inertia)
         q_d0 = None if self.values["q_d_from_measured"] else self.vector("q_d0", 4)
         return deorbit_tracking.DeorbitTrackingController(
             J, self.values["k"], self.vector("G", 3), self.vector("e", 3), self.vector("omega_d", 3),
-            self.vector("omega_dot_d", 3), self.vector("torque_level", 3), q_d0)
+            self.vector("omega_dot_d", 3), self.vector("torque_level", 3), q_d0,
+            knowledge_sigmas=self.values["knowledge_sigmas"], impulse_bits=self.values["impulse_bits"],
+            rate_sigma=self.values["rate_sigma"], min_on_time=self.values["min_on_time"])
 
     def _targeted(self):
         """The model, its reference taken from the inputs when target_from_input and enabled (a
@@ -76,7 +98,11 @@ class TrackingController(NeighborSlave):
             self.model.follow(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
         return self.model
 
+    def _layer(self):
+        return self.model.boundary_layer(self.vector("sigma_attitude_B", 3))
+
     def _evaluate(self):
+        self._layer()
         return self._targeted().evaluate(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _command(self):
@@ -84,7 +110,7 @@ class TrackingController(NeighborSlave):
         return torque, flags
 
     def _done(self):
-        s, e = self.feedthrough(self._evaluate)[2], self.model.e
+        s, e = self.feedthrough(self._evaluate)[2], self.feedthrough(self._layer)
         return all(abs(s[i]) <= e[i] for i in range(3))
 
     def _angle(self):

@@ -90,11 +90,14 @@ class DeorbitTrackingController:
     omega_d, omega_dot_d: desired rate (rad/s) and its derivative (rad/s^2) in B;
     torque_level: pair torque per axis (N.m), default from the thruster geometry (Eq. 16);
     q_d0: initial desired quaternion, or None to latch the measured q (Appendix F);
-    torque_form: "eq72" (default) or "script_literal" (see the module docstring).
+    torque_form: "eq72" (default) or "script_literal" (see the module docstring);
+    knowledge_sigmas, impulse_bits, rate_sigma, min_on_time: the boundary layer sized for
+    estimates (`boundary_layer`; 0 and 0: the thesis' fixed e).
     """
 
     def __init__(self, inertia, k=1.0, G=(0.1, 0.1, 0.1), e=(0.001, 0.001, 0.001), omega_d=None,
-                 omega_dot_d=(0.0, 0.0, 0.0), torque_level=None, q_d0=None, torque_form="eq72"):
+                 omega_dot_d=(0.0, 0.0, 0.0), torque_level=None, q_d0=None, torque_form="eq72",
+                 knowledge_sigmas=0.0, impulse_bits=0.0, rate_sigma=0.0, min_on_time=0.015):
         J = rigid_body.check_inertia(inertia)
         self.J = tuple(tuple(float(x) for x in row) for row in J.tolist())
         k = float(k)
@@ -109,9 +112,40 @@ class DeorbitTrackingController:
         if torque_form not in TORQUE_FORMS:
             raise ValueError(f"torque_form {torque_form!r} must be one of {', '.join(TORQUE_FORMS)}")
         self.torque_form = torque_form
+        for name, value, unit in (("knowledge_sigmas", knowledge_sigmas, ""), ("impulse_bits", impulse_bits, ""),
+                                  ("rate_sigma", rate_sigma, " rad/s")):
+            if not (math.isfinite(float(value)) and float(value) >= 0.0):
+                raise ValueError(f"{name} = {value!r}{unit} must be a finite number >= 0")
+        self.e_fixed = self.e
+        self.knowledge_sigmas, self.impulse_bits = float(knowledge_sigmas), float(impulse_bits)
+        self.rate_sigma = float(rate_sigma)
+        # the torque per unit of s inside the layer is J_ii G_i / e_i: a pair fires where that
+        # reaches its torque, |s_i| >= e_i level_i / (J_ii G_i), the law's deadband in s
+        self.deadband_per_e = tuple(self.levels[i] / (self.J[i][i] * self.G[i]) for i in range(3))
+        self.bits = tc.impulse_bit_rates(self.levels, [self.J[i][i] for i in range(3)], min_on_time)
+        self.boundary_layer((0.0, 0.0, 0.0))
         self.q_d0 = None if q_d0 is None else rotations.normalized(tuple(float(x) for x in q_d0), "q_d0")
         self.q_d = self.q_d0  # None: latch the measured q at the first enabled step
         self.anchor = None  # the last target taken by follow()
+
+    # ---- boundary layer sized for estimates -------------------------------------------------
+    def boundary_layer(self, sigma_attitude):
+        """Widen e so that the law's deadband in s (e_i level_i / (J_ii G_i)) is at least
+        `knowledge_sigmas` times the noise of s from the estimate, sqrt(rate_sigma^2 +
+        (k sigma_attitude_i / 2)^2) (dq_1:3 is half the small attitude error), and at least
+        `impulse_bits` times the rate change of one shortest firing (a deadband narrower than
+        one pulse is crossed by every pulse, and the next fires back). Never below the fixed e;
+        with both factors 0 it is the fixed e (the thesis). Returns the e now used."""
+        n, m, k = self.knowledge_sigmas, self.impulse_bits, self.k
+        if n == 0.0 and m == 0.0:
+            self.e = self.e_fixed
+            return self.e
+        sig = tuple(float(x) for x in sigma_attitude)
+        if len(sig) != 3 or not all(math.isfinite(x) and x >= 0.0 for x in sig):
+            raise ValueError(f"sigma_attitude {list(sig)} must be three finite numbers >= 0 (rad)")
+        self.e = tuple(max(self.e_fixed[i], max(n * math.hypot(self.rate_sigma, 0.5 * k * sig[i]), m * self.bits[i])
+                           / self.deadband_per_e[i]) for i in range(3))
+        return self.e
 
     # ---- desired attitude ----------------------------------------------------------------
     def target(self, q):

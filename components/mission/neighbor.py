@@ -116,7 +116,8 @@ DEFAULT_GNC = "closed-loop"
 MISSION_RECORD: Tuple[str, ...] = (
     "mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
     "mission.determination_timeouts", "estimator.initialized", "estimator.attitude_error",
-    "estimator.rate_error", *elements("estimator.sigma_attitude", 3),
+    "estimator.rate_error", *elements("estimator.sigma_attitude", 3), "estimator.nees_mean",
+    "estimator.nees_over_fraction",
     "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
     "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
     "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
@@ -129,3 +130,34 @@ DEORBIT_RECORD: Tuple[str, ...] = (
     "orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",
     "orbit.reentered", "orbit.density", "propulsion.mass", "propulsion.propellant_used",
     "propulsion.burn_time", "propulsion.burning")
+
+
+@dataclass(frozen=True)
+class Part:
+    """A component of NEIGHBOR's self-contained configuration outside the propulsion assembly
+    (section 3.8, Tables 8-9): its mass and the box its volume is counted as."""
+    name: str
+    mass_g: float
+    dimensions_mm: Optional[Tuple[float, float, float]]  # None: volume taken as negligible (the harness)
+
+    @property
+    def volume_cm3(self) -> float:
+        return 0.0 if self.dimensions_mm is None else math.prod(self.dimensions_mm) / 1e3
+
+
+# Tables 8-9 without the propulsion assembly, whose propellant, tank, feed lines, nozzles and
+# manifold the propulsion sizing computes (section 3.3.9) from the propellant the mission needs.
+PARTS: Tuple[Part, ...] = (
+    Part("horizon sensor", 120.0, (90.0, 92.0, 50.0)),
+    Part("sun sensor", 6.5, (43.0, 14.0, 5.90)),
+    Part("gyroscope", 0.2, (3.0, 3.0, 0.95)),
+    Part("GPS receiver", 31.0, (46.0, 71.0, 8.0)),
+    Part("GPS antenna", 100.0, (56.0, 56.0, 7.80)),
+    Part("microprocessor", 3.0, (5.30, 5.30, 0.50)),
+    Part("UHF transceiver", 24.5, (65.0, 40.0, 6.50)),
+    Part("UHF antenna", 33.0, (99.60, 99.60, 7.70)),
+    Part("battery", 47.0, (65.0, 18.29, 18.29)),
+    Part("harness", 200.0, None),  # "less than 0.2 kg", "minimal volume"
+)
+ENVELOPE_U = 2.0  # the notional 2 U NEIGHBOR takes in the host (section 3.8); 1 U = 1000 cm3
+DATA_STORAGE_LIMIT_B = 0.1e6  # section 3.6: "never exceeds a total of 0.1 MB" (of the 256 kB flash)

@@ -44,7 +44,7 @@ from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
                              positive_float, staged_results)
-from . import deorbit_study, propulsion_report, thesis
+from . import budgets, deorbit_study, propulsion_report, thesis
 
 SYSTEMS = MISSION_SYSTEMS
 # the parameter set each applies: the closed loop on the estimator (the system's own values), on
@@ -221,6 +221,12 @@ def summarize(r, scenario, orbit):
     s["burn_knowledge_error_rms_deg"] = float(np.sqrt(np.mean(knowledge ** 2))) if knowledge.size else None
     s["burn_rate_error_rms_deg_s"] = float(np.degrees(np.sqrt(np.mean(d["estimator.rate_error"][burning] ** 2)))) \
         if knowledge.size else None
+    # the estimator's consistency against the truth, over every step since its first fix (none
+    # with truth feedback): mean NEES 3 and 5 % of the steps above the 95 % bound when consistent
+    nees_mean, nees_over = float(r.final["estimator.nees_mean"]), float(r.final["estimator.nees_over_fraction"])
+    ran = nees_mean > 0.0
+    s["nees_mean"] = nees_mean if ran else None
+    s["nees_over_fraction_percent"] = 100.0 * nees_over if ran else None
     s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
     s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
     soc, energy = d["power.state_of_charge"], d["power.energy"]
@@ -241,6 +247,8 @@ def summarize(r, scenario, orbit):
     s["lifetime_with_burn_years"] = (r.stop_time - starts[DeorbitPhase.BURN][1]) / YEAR if s["reentered"] else None
     s["thesis"] = THESIS.get(scenario, {})  # a scenario the thesis did not publish: no column
     s["propulsion"] = propulsion_report.of_mission(s)
+    s["allowance"] = budgets.allowance(scenario).describe()
+    s["budgets"] = [b.as_dict() for b in budgets.of_summary(s)]
     return s
 
 
@@ -262,6 +270,10 @@ def table(s):
             ("attitude-knowledge error in the burn, RMS (deg, estimator vs truth; 0: truth feedback)",
              "burn_knowledge_error_rms_deg", "{:.3f}"),
             ("attitude-knowledge error in the burn, largest (deg, after 10 s)", "burn_knowledge_error_deg", "{:.3f}"),
+            ("estimator consistency: mean attitude NEES since the first fix (3 when consistent)", "nees_mean",
+             "{:.2f}"),
+            ("estimator consistency: steps with the NEES above its 95 % bound (%; 5 when consistent)",
+             "nees_over_fraction_percent", "{:.1f}"),
             ("total propellant (kg; thesis: sized for the worst-case slew)", "total_propellant_kg", "{:.4f}"),
             ("battery after the de-orbit maneuver (%)", "soc_after_burn_percent", "{:.2f}"),
             ("energy used to the end of the burn (Wh)", "energy_used_Wh", "{:.3f}"),
@@ -281,6 +293,8 @@ def table(s):
         diff = "-" if value is None or not ref else f"{100.0 * (value - ref) / ref:+.1f} %"
         lines.append(f"| {label} | {ours} | {'-' if ref is None else ref} | {diff} |")
     lines.append(f"\nfault management: {s.get('fault_management', '-')}")
+    if s.get("budgets"):
+        lines += ["", *budgets.lines(s["budgets"], f"budgets, {s.get('scenario')} scenario:"), s.get("allowance", "")]
     if "propulsion" in s:
         lines.append("\npropulsion budget for this run's propellant "
                      "(`neighbor-cosim propulsion` sizes the worst case):")
@@ -583,11 +597,22 @@ def main_propulsion(argv=None):
         summary, _ = run_mission(args.scenario, ssp_dir=args.ssp_dir, progress=progress, gnc=args.gnc)
     budget = propulsion_report.of_mission(summary)
     worst, _ = propulsion_report.worst_case(summary, args.ssp_dir)
-    print(propulsion_report.report(worst, budget, args.scenario), end="")
+    limits = {"worst_case": [b.as_dict() for b in budgets.propellant_budgets(worst, args.scenario)],
+              "mission": [b.as_dict() for b in budgets.propellant_budgets(budget, args.scenario)]}
+    print(propulsion_report.report(worst, budget, args.scenario))
+    print(budgets.allowance(args.scenario).describe())
+    for label, rows in (("worst case", limits["worst_case"]), ("this mission", limits["mission"])):
+        print("\n".join(["", *budgets.lines(rows, f"budgets, {label}:")]))
+    print()
+    print(budgets.mass_volume_report(worst, budget, args.scenario), end="")
     if args.json:
-        write_text_atomic(Path(args.json), json.dumps({"scenario": args.scenario, "worst_case": worst,
-                                                       "mission": budget, "thesis": propulsion_report.THESIS},
-                                                      indent=1))
+        write_text_atomic(Path(args.json), json.dumps(
+            {"scenario": args.scenario, "worst_case": worst, "mission": budget, "thesis": propulsion_report.THESIS,
+             "allowance": budgets.allowance(args.scenario).describe(), "budgets": limits,
+             "mass_g": {"worst_case": budgets.mass_table(worst), "mission": budgets.mass_table(budget),
+                        "thesis": budgets.mass_table()},
+             "volume_cm3": {"worst_case": budgets.volume_table(worst), "mission": budgets.volume_table(budget),
+                            "thesis": budgets.volume_table()}}, indent=1))
     return 0
 
 

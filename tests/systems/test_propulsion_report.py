@@ -43,6 +43,14 @@ def test_propulsion_command_reads_a_mission_summary(mission_420km, ssp_paths, tm
     assert "propulsion assembly (g)" in printed and "2086.93" in printed
     saved = json.loads((tmp_path / "p.json").read_text())
     assert saved["worst_case"]["slew_propellant_g"] == pytest.approx(16.03, abs=0.005)
+    # the budgets against the tank and the RCS allowance, and Tables 8-9 (tests/systems/test_budgets.py)
+    assert "budgets, worst case:" in printed and "budgets, this mission:" in printed
+    assert "| attitude-control (RCS) propellant (g) |" in printed and "Mass and volume, 420km scenario" in printed
+    assert "| 2652.13 |" in printed and "| 1271.84 |" in printed
+    assert saved["mass_g"]["thesis"]["total"] == pytest.approx(2652.13)
+    worst = {b["name"]: b for b in saved["budgets"]["worst_case"]}
+    assert worst["attitude-control (RCS) propellant"]["allowed"] == pytest.approx(23.14)
+    assert worst["total propellant"]["used"] == saved["worst_case"]["total_propellant_kg"]
     # a summary of another scenario is refused, naming both
     assert cli.main(["propulsion", "--scenario", "475km", "--mission", str(out / "summary.json")]) == 2
     assert "'420km' mission run, not --scenario 475km" in capsys.readouterr().err

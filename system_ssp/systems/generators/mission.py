@@ -171,10 +171,14 @@ COARSE_SUN_SIGMA = math.radians(2.0)
 # 1-sigma attitude error is below this: a TRIAD fix right at the end would start it at 1-2 deg.
 VALID_SIGMA = math.radians(0.25)
 ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / INERTIA[0, 0]
+# The tracking law's boundary layer sized for estimates (deorbit_tracking.boundary_layer): its
+# deadband in s at least 3 sigmas of the estimate's noise and one impulse bit; the rate estimate's
+# 1-sigma per axis as the rate filter holds it in the burn (0.0106 deg/s RMS over three axes).
+TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4, "min_on_time": MIN_ON_TIME}
 # What the thesis parameter set restores (names component.variable); every value the closed loop
 # changes appears here.
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
-              "tracking.target_from_input": False,
+              "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
               **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
@@ -307,6 +311,7 @@ def system(orbit_fmu):
              ("estimator", "omega_est_B", "slew", "omega_BN_B", 3),
              ("estimator", "q_est_BN", "tracking", "q_BN", 4),
              ("estimator", "omega_est_B", "tracking", "omega_BN_B", 3),
+             ("estimator", "sigma_attitude", "tracking", "sigma_attitude_B", 3),
              ("mission", "detumble_enable", "detumble", "enabled", 0),
              ("mission", "slew_enable", "slew", "enabled", 0),
              ("mission", "tracking_enable", "tracking", "enabled", 0),
@@ -419,9 +424,10 @@ def generate(writer):
                "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), RK4 attitude integration",
                {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "rk4"})
     writer.ssv("mission_tracking",
-               "De-orbit tracking (Appendix F): k 1, G 0.1 I, e 0.001, desired attitude and rate from the burn "
-               "guidance", {"k": 1.0, **vec("G", [0.1] * 3), **vec("e", [0.001] * 3),
-                            "q_d_from_measured": True, "target_from_input": True})
+               "De-orbit tracking (Appendix F): k 1, G 0.1 I, e 0.001 widened to 3 sigmas of the estimate's noise and "
+               "one impulse bit, desired attitude and rate from the burn guidance",
+               {"k": 1.0, **vec("G", [0.1] * 3), **vec("e", [0.001] * 3), "q_d_from_measured": True,
+                "target_from_input": True, **TRACKING_LAYER})
     writer.ssv("mission_detumble",
                "Detumble flight settle criterion: rate window 0.75 impulse bit per axis held for 1 s", DETUMBLE_FLIGHT)
     writer.ssv("mission_slew",

@@ -4,6 +4,7 @@ attitude-control propellant, the desired-quaternion propagation, bad gains, and 
 FMPy (declarations, state, a short closed loop with RigidBody against the component loop)."""
 import math
 
+import numpy as np
 import pytest
 
 from components.attitude import deorbit_tracking as dtr
@@ -64,7 +65,6 @@ def test_latch_from_measured_q_and_release_when_disabled():
 
 def test_control_law_one_evaluation_by_hand():
     """Eq. 70-72 written out with numpy-free arithmetic, against an independent numpy form."""
-    import numpy as np
 
     J = np.array([[0.05, 0.001, 0.0], [0.001, 0.13, 0.002], [0.0, 0.002, 0.10]])
     c = dtr.DeorbitTrackingController(J, k=0.7, G=(0.2, 0.1, 0.3), e=(0.002, 0.001, 0.0005),
@@ -129,6 +129,61 @@ def test_printed_script_precedence_chatters():
     assert literal > 10 * eq and literal > 30.0
 
 
+def test_boundary_layer_sized_for_the_estimate():
+    """e widens so that the law's deadband in s (e level / (J G)) covers 3 sigmas of the
+    estimate's noise and one impulse bit; without the factors it is the thesis' fixed e."""
+    thesis = dtr.DeorbitTrackingController(J_BOX)
+    assert thesis.boundary_layer((0.01, 0.01, 0.01)) == (0.001, 0.001, 0.001) == thesis.e
+    ctl = dtr.DeorbitTrackingController(J_BOX, knowledge_sigmas=3.0, impulse_bits=1.0, rate_sigma=1e-4)
+    levels = [0.0025] * 3  # Eq. 16: one pair's torque about each axis
+    assert ctl.levels == pytest.approx(levels, rel=1e-12)
+    # one impulse bit, level h / J, is a deadband of e = h G = 1.5e-3 on every axis
+    bits_only = dtr.DeorbitTrackingController(J_BOX, impulse_bits=1.0)
+    assert bits_only.boundary_layer((0.0, 0.0, 0.0)) == pytest.approx((0.0015, 0.0015, 0.0015), rel=1e-12)
+    for sigma in ((0.0, 0.0, 0.0), (1e-3, 2e-3, 5e-4)):
+        by_hand = [max(0.001, 0.0015, 3 * math.hypot(1e-4, 0.5 * sigma[i]) * J_BOX[i, i] * 0.1 / levels[i])
+                   for i in range(3)]
+        assert ctl.boundary_layer(sigma) == pytest.approx(by_hand, rel=1e-12) and ctl.e == tuple(ctl.e)
+    assert by_hand[1] > 0.005  # 2 mrad of attitude noise about y: a layer five times the thesis'
+    # a rate error of 1e-3 rad/s about y: the thesis' layer fires a pair, the sized one does not
+    wd = thesis.omega_d
+    omega = (wd[0], wd[1] + 1e-3, wd[2])
+    assert thesis.command(Q0, omega)[1][1] != 0 and ctl.command(Q0, omega)[1] == [0, 0, 0]
+    with pytest.raises(ValueError, match="sigma_attitude .* must be three finite numbers >= 0"):
+        ctl.boundary_layer((0.0, -1e-3, 0.0))
+    with pytest.raises(ValueError, match="knowledge_sigmas = -1.0 must be a finite number >= 0"):
+        dtr.DeorbitTrackingController(J_BOX, knowledge_sigmas=-1.0)
+
+
+def test_sized_layer_does_not_fire_at_attitude_noise():
+    """Two minutes of the burn on a noisy estimate (1 mrad per axis, white): the thesis' layer
+    fires at the noise, the layer sized for it holds the attitude as well for a fraction of the
+    firing."""
+    rng = np.random.default_rng(7)
+    noise = rng.normal(0.0, 1e-3, size=(8000, 3))
+    result = {}
+    for name, kwargs in (("thesis", {}), ("sized", {"knowledge_sigmas": 3.0, "impulse_bits": 1.0,
+                                                    "rate_sigma": 1e-4})):
+        body = rigid_body.RigidBody(J_BOX, Q0, W0, integrator="euler")
+        ctl = dtr.DeorbitTrackingController(J_BOX, **kwargs)
+        ctl.boundary_layer((1e-3, 1e-3, 1e-3))
+        rcs = thrusters.ThrusterPairs()
+        worst = 0.0
+        for k in range(noise.shape[0]):
+            angle = float(np.linalg.norm(noise[k]))
+            q_est = tuple(float(x) for x in rotations.normalized(rotations.circle_cross(
+                rotations.from_axis_angle(tuple(noise[k] / angle), angle), tuple(body.q))))
+            torque, _ = ctl.command(q_est, body.omega)
+            rcs.step(torque, H)
+            body.step(torque, H)
+            ctl.advance(H, q_est)
+            if k > 2000:
+                worst = max(worst, ctl.attitude_error(body.q))
+        result[name] = (rcs.total_fire_time(), worst)
+    assert result["sized"][0] < 0.25 * result["thesis"][0]
+    assert math.degrees(result["sized"][1]) < 0.5
+
+
 @pytest.mark.parametrize("kwargs, match", [
     ({"k": 0.0}, "k = 0.0 must be a finite positive"),
     ({"k": -1.0}, "k = -1.0"),
@@ -154,11 +209,13 @@ def test_fmu_declarations(build_one):
     q_in = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
     w_in = [f"omega_BN_B[{i}]" for i in (1, 2, 3)]
     target = [f"q_target_BN[{i}]" for i in (1, 2, 3, 4)] + [f"omega_target_B[{i}]" for i in (1, 2, 3)]
-    assert deps["torque_cmd_B[2]"] == sorted(q_in + w_in + target + ["enabled"])
-    assert deps["thrust_flag[1]"] == sorted(q_in + w_in + target + ["enabled"])
-    assert deps["done"] == sorted(q_in + w_in + target)
+    sigma = [f"sigma_attitude_B[{i}]" for i in (1, 2, 3)]
+    assert deps["torque_cmd_B[2]"] == sorted(q_in + w_in + target + sigma + ["enabled"])
+    assert deps["thrust_flag[1]"] == sorted(q_in + w_in + target + sigma + ["enabled"])
+    assert deps["done"] == sorted(q_in + w_in + target + sigma)
+    assert deps["boundary_layer[2]"] == sigma
     assert deps["attitude_error"] == sorted(q_in + target) and deps["q_d[4]"] == sorted(q_in + target)
-    assert deps["sliding_vector[3]"] == sorted(q_in + w_in + target)
+    assert deps["sliding_vector[3]"] == sorted(q_in + w_in + target + sigma)
 
 
 def test_fmu_closed_loop_with_rigid_body_matches_component(build_one, tmp_path):
