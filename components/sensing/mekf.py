@@ -285,6 +285,7 @@ class AttitudeEstimator:
         self.held_rate = None  # the gyro sample of the step's start
         self.consistency = NeesMonitor()  # against the truth, where a simulation gives it (check)
         self.last = {"nadir": (None, -math.inf), "sun": (None, -math.inf), "coarse": (None, -math.inf)}  # (used, when)
+        self.seen = {}  # sensor -> the sample it gave at the last step
 
     @property
     def rate(self):
@@ -298,12 +299,18 @@ class AttitudeEstimator:
         return tuple(self.rates.omega_dot)
 
     def _new(self, name, vector):
-        """A new sample of this sensor: not the one used last, and update_interval after it."""
-        used, when = self.last[name]
-        return tuple(vector) != used and self.time - when >= self.update_interval - 1e-9
+        """A sample to use now: it has just arrived (it differs from the one this sensor gave at
+        the last step) and update_interval has passed since the last update from this sensor. A
+        sample that arrives sooner is dropped, not kept for later: used later it would be older
+        than the estimate it corrects (a held sample 6 steps late is 1.5 deg off at 17 deg/s)."""
+        vector = tuple(vector)
+        arrived = vector != self.seen.get(name)
+        self.seen[name] = vector
+        return arrived and self.time - self.last[name][1] >= self.update_interval - 1e-9
 
     def _mark(self, name, vector):
         self.last[name] = (tuple(vector), self.time)
+        self.seen[name] = tuple(vector)
 
     def step(self, measurements, omega_meas, h, torque=(0.0, 0.0, 0.0), coarse_sun=None):
         """measurements = (nadir_B, nadir_valid, sun_B, sun_valid, r_BN_N, r_SN_N);
@@ -375,7 +382,8 @@ class AttitudeEstimator:
                 "filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
                 "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
                 "held_rate": self.held_rate, "last": {k: [None if v is None else list(v), t]
-                                                      for k, (v, t) in self.last.items()}}
+                                                      for k, (v, t) in self.last.items()},
+                "seen": {k: list(v) for k, v in self.seen.items()}}
 
     def set_state(self, state):
         self.consistency.set_state(state["consistency"])
@@ -385,3 +393,4 @@ class AttitudeEstimator:
         self.cov_pending, self.cov_rate = float(state["cov_pending"]), tuple(state["cov_rate"])
         self.held_rate = None if state["held_rate"] is None else tuple(state["held_rate"])
         self.last = {k: (None if v is None else tuple(v), float(t)) for k, (v, t) in state["last"].items()}
+        self.seen = {k: tuple(v) for k, v in state["seen"].items()}

@@ -231,3 +231,7 @@ def test_off_nominal_mission_finishes_through_phase_timeouts(ssp_paths, tmp_path
     assert "the detumble timed out 2 time(s)" in s["fault_management"]
     assert s["burn_time_min"] == pytest.approx(38.74, abs=0.05)
     assert s["lifetime_with_burn_years"] < 5.0
+    # the limit cycling breaks the attitude-control allowance and the tank, and the summary says so
+    verdicts = {b["name"]: b["within"] for b in s["budgets"]}
+    assert not verdicts["attitude-control (RCS) propellant"] and not verdicts["total propellant"]
+    assert "| OVER |" in mission.table(s)

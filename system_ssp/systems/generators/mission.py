@@ -34,11 +34,12 @@ mission.next_event_time and host.next_event_time:
   decay          mode 7 (battery empty: only the orbit left until re-entry): 1 day
   idle           modes 1-2 (idle, grace period): 6 h, only host, mission, power and orbit
 Each maneuver mode comes twice: with truth feedback (estimator.truth_feedback, a parameter the
-nc:When tests) without the sensors, and with estimation, the vector sensors every 7th step
-(about 10 Hz) and the ephemeris, shadow and GPS every 33rd. With truth feedback the attitude loop
-(dynamics, controllers, thrusters) is suspended until the detumble starts, so the host's tumble at
-takeover is the rigid body's initial state at the detumble (10 deg/s per axis, Eq. 7); with
-estimation the host tumbles on, torque-free, through the determination.
+nc:When tests) without the sensors, and with estimation, the sensors every step (the estimator
+takes a vector sample about every 0.09 s) and the ephemeris, shadow and GPS every 33rd. With
+truth feedback the attitude loop (dynamics, controllers, thrusters) is suspended until the
+detumble starts, so the host's tumble at takeover is the rigid body's initial state at the
+detumble (10 deg/s per axis, Eq. 7); with estimation the host tumbles on, torque-free, through
+the determination.
 
 Scenarios (one .ssv each, names component.variable): the thesis' 420, 475 and 525 km cases.
 The de-orbit starts, as in the thesis' lifetime study, on 2023-01-01 from the scenario altitude:
@@ -122,9 +123,9 @@ COMPONENTS = {
     "sun": ("SunEphemeris", ["mission_sun"], {"sense", "sense_slow"}),
     "shadow": ("EarthShadow", [], {"sense", "sense_slow"}),
     "gps": ("GpsReceiver", ["mission_gps"], {"sense", "sense_slow"}),
-    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense", "sense_vector"}),
-    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense", "sense_vector"}),
-    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense", "sense_vector"}),
+    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense"}),
+    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense"}),
+    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense"}),
     "gyro": ("Gyro", ["mission_gyro"], {"sense"}),
     "estimator": ("AttitudeEstimator", ["mission_estimator"], {"sense", "truth"}),
 }
@@ -141,10 +142,12 @@ MANEUVERS = ("detumble", "slew", "burn")
 ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", "ground", "detumble", "slew",
          "tracking", "selector", "thrusters", "dynamics", "sun", "shadow", "gps", "horizon", "sun_sensor", "coarse_sun",
          "gyro", "estimator"]
-# The vector sensors sample at about 10 Hz in the 15 ms maneuvers (every 7th step, 0.105 s; the
-# estimator uses each sample once), the gyro and the estimator every step; determination runs at
-# the gyro's 0.1 s.
-SENSOR_EVERY = 7
+# The sensors and the estimator step every step of the 15 ms maneuvers; the estimator takes a
+# vector sample about every 0.09 s (`update_interval`), each with its own noise. The vector sensors
+# stepped every 7th step made the estimator overconfident while the host turned fast: a held
+# sample that the update interval deferred was used up to 6 steps late (0.09 s at 17 deg/s is
+# 1.5 deg), and a recorded row's refresh gave a held sample new geometry with its old noise; the
+# attitude NEES in the detumble reached 250-700 (issue 28). Determination runs at the gyro's 0.1 s.
 DETERMINATION_STEP = 0.1
 DETERMINATION_EVERY = 10
 
@@ -226,7 +229,6 @@ def maneuver_every(phase, truth=False):
     every = {c: SLOW_EVERY for c in slow}
     if not truth:
         every.update({c: SLOW_EVERY for c in having("sense_slow")})
-        every.update({c: SENSOR_EVERY for c in having("sense_vector")})
     return every
 
 

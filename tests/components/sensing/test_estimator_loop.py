@@ -171,6 +171,15 @@ def test_a_held_sample_is_used_once():
     P2 = est.filter.P.copy()
     est.step(again, (0.0, 0.0, 0.0), 0.015)  # new, but 15 ms after the last update: not used
     assert np.trace(est.filter.P[:3, :3]) >= np.trace(P2[:3, :3])
+    # ... nor later: held for 0.09 s it would be 6 steps older than the estimate (dropped)
+    for _ in range(6):
+        P3 = est.filter.P.copy()
+        est.step(again, (0.0, 0.0, 0.0), 0.015)
+        assert np.trace(est.filter.P[:3, :3]) >= np.trace(P3[:3, :3])
+    fresh = ((-1.0, 3e-4, 0.0), True, (3e-4, -1.0, 0.0), True, R_BN, R_SN)
+    P4 = est.filter.P.copy()
+    est.step(fresh, (0.0, 0.0, 0.0), 0.015)  # a sample that has just arrived, 0.1 s after the update: used
+    assert np.trace(est.filter.P[:3, :3]) < np.trace(P4[:3, :3])
     state = est.get_state()
     twin = AttitudeEstimator(inertia=J, update_interval=0.09)
     twin.set_state(state)
