@@ -12,7 +12,9 @@ Two columns beside the thesis':
 - **this mission**: the propellant the mission run itself used (its slew is case 1's).
 The mission run is read from --mission (a mission results folder's summary.json) or run here
 (orbit-averaged, about a minute). The thesis sizes its tank for the 420 km scenario only, so
-the thesis column is empty for the others.
+the thesis column is empty for the others. After the table the command marks both columns
+against the scenario's tank and RCS allowance and prints Tables 8-9, mass and volume
+(system_ssp.neighbor.budgets).
 """
 from components.mission.neighbor import DEFAULT_SCENARIO, SCENARIOS
 from components.orbit import propulsion
