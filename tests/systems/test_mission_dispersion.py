@@ -37,6 +37,8 @@ def test_ten_dispersed_missions_all_deorbit(ssp_paths, tmp_path):
         assert r["reentered"] and r["budget_spent"], r
         assert r["detumble_timeouts"] == 0 and r["slew_timeouts"] == 0 and r["determination_timeouts"] == 0, r
         assert 0.0 < r["knowledge_error_max_rad"] < math.radians(5.0), r  # the estimator flew, and well
+        # and its covariance told the truth: NEES near 3, about 5 % of the steps above its 95 % bound
+        assert 2.0 < r["nees_mean"] < 4.0 and r["nees_over_fraction"] < 0.08, r
         detumble = r["slew_start_s"] - r["detumble_start_s"]
         slew = r["burn_start_s"] - r["slew_start_s"]
         burn = r["monitoring_start_s"] - r["burn_start_s"]
