@@ -102,7 +102,7 @@ class TrackingController(NeighborSlave):
         return self.model.boundary_layer(self.vector("sigma_attitude_B", 3))
 
     def _evaluate(self):
-        self._layer()
+        self.feedthrough(self._layer)  # e for these inputs, before the law uses it
         return self._targeted().evaluate(self.vector("q_BN", 4), self.vector("omega_BN_B", 3))
 
     def _command(self):
