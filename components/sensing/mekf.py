@@ -284,7 +284,7 @@ class AttitudeEstimator:
         self.cov_pending, self.cov_rate = 0.0, (0.0, 0.0, 0.0)  # covariance propagation gathered
         self.held_rate = None  # the gyro sample of the step's start
         self.consistency = NeesMonitor()  # against the truth, where a simulation gives it (check)
-        self.last = {"nadir": (None, -math.inf), "sun": (None, -math.inf), "coarse": (None, -math.inf)}  # (used, when)
+        self.updated = {"nadir": -math.inf, "sun": -math.inf, "coarse": -math.inf}  # sensor -> time of its last update
         self.seen = {}  # sensor -> the sample it gave at the last step
 
     @property
@@ -306,10 +306,10 @@ class AttitudeEstimator:
         vector = tuple(vector)
         arrived = vector != self.seen.get(name)
         self.seen[name] = vector
-        return arrived and self.time - self.last[name][1] >= self.update_interval - 1e-9
+        return arrived and self.time - self.updated[name] >= self.update_interval - 1e-9
 
     def _mark(self, name, vector):
-        self.last[name] = (tuple(vector), self.time)
+        self.updated[name] = self.time
         self.seen[name] = tuple(vector)
 
     def step(self, measurements, omega_meas, h, torque=(0.0, 0.0, 0.0), coarse_sun=None):
@@ -381,8 +381,7 @@ class AttitudeEstimator:
         return {"consistency": self.consistency.get_state(),
                 "filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
                 "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
-                "held_rate": self.held_rate, "last": {k: [None if v is None else list(v), t]
-                                                      for k, (v, t) in self.last.items()},
+                "held_rate": self.held_rate, "updated": dict(self.updated),
                 "seen": {k: list(v) for k, v in self.seen.items()}}
 
     def set_state(self, state):
@@ -392,5 +391,5 @@ class AttitudeEstimator:
         self.time = float(state["time"])
         self.cov_pending, self.cov_rate = float(state["cov_pending"]), tuple(state["cov_rate"])
         self.held_rate = None if state["held_rate"] is None else tuple(state["held_rate"])
-        self.last = {k: (None if v is None else tuple(v), float(t)) for k, (v, t) in state["last"].items()}
+        self.updated = {k: float(t) for k, t in state["updated"].items()}
         self.seen = {k: tuple(v) for k, v in state["seen"].items()}
