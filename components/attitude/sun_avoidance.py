@@ -262,10 +262,11 @@ class BangCoastBang:
         w0, wf, a = self.w0, self.wf, self.a
         # the angles of speeding up from w0 to w_max and slowing down from w_max to wf
         up, down = (w_max - w0) / a, (w_max - wf) / a
-        if self.phi >= w0 * up + 0.5 * a * up * up + w_max * down - 0.5 * a * down * down:
+        ramps = w0 * up + 0.5 * a * up * up + w_max * down - 0.5 * a * down * down
+        if self.phi >= ramps:
             self.triangle = False  # a coast at w_max (the seed's step 2b timing)
             self.t1 = up
-            self.t2 = self.t1 + (self.phi - w0 * up - 0.5 * a * up * up - w_max * down + 0.5 * a * down * down) / w_max
+            self.t2 = self.t1 + (self.phi - ramps) / w_max
             self.tf = self.t2 + down
             self.w_peak = w_max
         else:
