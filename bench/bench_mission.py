@@ -18,7 +18,7 @@ from pathlib import Path
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
 
-from system_ssp import mission  # noqa: E402
+from system_ssp.neighbor import mission  # noqa: E402
 
 
 def main():
