@@ -39,6 +39,7 @@ import math
 import numpy as np
 
 from ..core import rotations
+from ..core.jit import njit
 
 INTEGRATORS = ("euler", "rk4")
 ZERO3 = (0.0, 0.0, 0.0)
@@ -85,6 +86,8 @@ class RigidBody:
         self.max_substep = float(max_substep)
         self.J = tuple(tuple(row) for row in J.tolist())
         self.Jinv = tuple(tuple(row) for row in np.linalg.inv(J).tolist())
+        self._J9 = tuple(x for row in self.J for x in row)  # the RK4 kernel's flat, typed copies
+        self._Ji9 = tuple(x for row in self.Jinv for x in row)
         q0 = tuple(float(x) for x in q0)
         unit_q0 = rotations.normalized(q0, "q0")  # also rejects a zero or non-finite q0
         # The thesis scripts carry q from one maneuver to the next without normalizing it
@@ -138,38 +141,15 @@ class RigidBody:
             self.euler_integrated = tuple(self.euler_integrated[i] + self.omega[i] * h for i in range(3))
             return
         n = max(1, math.ceil(h / self.max_substep - 1e-9))
-        dt = h / n
-        q, w = self.q, self.omega
-        w_start = w
-        angles = self.euler_integrated
-        for k in range(n):
-            q, w, turned = self._rk4(q, w, torque, dt, tw, hw, k * dt)
-            angles = tuple(angles[i] + turned[i] for i in range(3))
+        w_start = self.omega
+        q, w, angles = rk4_steps(self.q, w_start, self.euler_integrated, self._J9, self._Ji9,
+                                 (float(torque[0]), float(torque[1]), float(torque[2])),
+                                 (float(tw[0]), float(tw[1]), float(tw[2])), (float(hw[0]), float(hw[1]), float(hw[2])),
+                                 h / n, n)
         self.euler_integrated = angles
         self.q = rotations.normalized(q)
         self.omega = w
         self.omega_dot = tuple((w[i] - w_start[i]) / h for i in range(3))
-
-    def _rk4(self, q, w, torque, dt, tw, hw, s0):
-        """One RK4 sub-step from s0 (s after the step start); h_w follows the held wheel
-        torque within the step, h_w(s) = h_w + tw s, as the wheel's own exact integration.
-        Returns q, omega and the integral of omega over the sub-step (Eq. 31's increment)."""
-        f_q, f_w = rotations.quaternion_rate, self.angular_acceleration
-        h0, hm, h1 = (tuple(hw[i] + tw[i] * s for i in range(3)) for s in (s0, s0 + 0.5 * dt, s0 + dt))
-        k1q, k1w = f_q(q, w), f_w(w, torque, tw, h0)
-        q2 = tuple(q[i] + 0.5 * dt * k1q[i] for i in range(4))
-        w2 = tuple(w[i] + 0.5 * dt * k1w[i] for i in range(3))
-        k2q, k2w = f_q(q2, w2), f_w(w2, torque, tw, hm)
-        q3 = tuple(q[i] + 0.5 * dt * k2q[i] for i in range(4))
-        w3 = tuple(w[i] + 0.5 * dt * k2w[i] for i in range(3))
-        k3q, k3w = f_q(q3, w3), f_w(w3, torque, tw, hm)
-        q4 = tuple(q[i] + dt * k3q[i] for i in range(4))
-        w4 = tuple(w[i] + dt * k3w[i] for i in range(3))
-        k4q, k4w = f_q(q4, w4), f_w(w4, torque, tw, h1)
-        q = tuple(q[i] + dt / 6.0 * (k1q[i] + 2 * k2q[i] + 2 * k3q[i] + k4q[i]) for i in range(4))
-        turned = tuple(dt / 6.0 * (w[i] + 2 * w2[i] + 2 * w3[i] + w4[i]) for i in range(3))
-        w = tuple(w[i] + dt / 6.0 * (k1w[i] + 2 * k2w[i] + 2 * k3w[i] + k4w[i]) for i in range(3))
-        return q, w, turned
 
     # ---- derived quantities ------------------------------------------------------------
     def euler123(self):
@@ -199,3 +179,71 @@ class RigidBody:
         self.omega = tuple(state["omega"])
         self.omega_dot = tuple(state["omega_dot"])
         self.euler_integrated = tuple(state["euler_integrated"])
+
+
+# ---- the RK4 kernel (numba where installed; the same arithmetic, operation for operation, as
+# the plain-Python path, so both give the same bits) ------------------------------------------
+@njit(cache=True)
+def _acceleration(w0, w1, w2, J, Ji, t, tw, h0, h1, h2):
+    """omega_dot = I^-1 [L - wheel_torque - omega x (I omega + h_w)] (RigidBody.angular_acceleration)."""
+    a0 = J[0] * w0 + J[1] * w1 + J[2] * w2 + h0
+    a1 = J[3] * w0 + J[4] * w1 + J[5] * w2 + h1
+    a2 = J[6] * w0 + J[7] * w1 + J[8] * w2 + h2
+    r0 = t[0] - tw[0] - (w1 * a2 - w2 * a1)
+    r1 = t[1] - tw[1] - (w2 * a0 - w0 * a2)
+    r2 = t[2] - tw[2] - (w0 * a1 - w1 * a0)
+    return (Ji[0] * r0 + Ji[1] * r1 + Ji[2] * r2,
+            Ji[3] * r0 + Ji[4] * r1 + Ji[5] * r2,
+            Ji[6] * r0 + Ji[7] * r1 + Ji[8] * r2)
+
+
+@njit(cache=True)
+def _qrate(q1, q2, q3, q4, w1, w2, w3):
+    """q_dot = 1/2 Xi(q) omega (Eq. 19; rotations.quaternion_rate)."""
+    return (0.5 * (q4 * w1 - q3 * w2 + q2 * w3),
+            0.5 * (q3 * w1 + q4 * w2 - q1 * w3),
+            0.5 * (-q2 * w1 + q1 * w2 + q4 * w3),
+            0.5 * (-q1 * w1 - q2 * w2 - q3 * w3))
+
+
+@njit(cache=True)
+def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
+    """n classical RK4 sub-steps of dt on (q, omega) with the torque held, h_w following the held
+    wheel torque, h_w(s) = h_w + tw s (the wheel's own exact integration); `angles` (Eq. 31) gain
+    the integral of omega. J, Ji: the inertia and its inverse, row-major 9-tuples. Returns
+    (q, omega, angles), q not normalized."""
+    qa, qb, qc, qd = q[0], q[1], q[2], q[3]
+    wa, wb, wc = w[0], w[1], w[2]
+    ea, eb, ec = angles[0], angles[1], angles[2]
+    for k in range(n):
+        s0 = k * dt
+        sm, s1 = s0 + 0.5 * dt, s0 + dt
+        k1q = _qrate(qa, qb, qc, qd, wa, wb, wc)
+        k1w = _acceleration(wa, wb, wc, J, Ji, torque, tw, hw[0] + tw[0] * s0, hw[1] + tw[1] * s0, hw[2] + tw[2] * s0)
+        q2 = (qa + 0.5 * dt * k1q[0], qb + 0.5 * dt * k1q[1], qc + 0.5 * dt * k1q[2], qd + 0.5 * dt * k1q[3])
+        w2 = (wa + 0.5 * dt * k1w[0], wb + 0.5 * dt * k1w[1], wc + 0.5 * dt * k1w[2])
+        k2q = _qrate(q2[0], q2[1], q2[2], q2[3], w2[0], w2[1], w2[2])
+        k2w = _acceleration(w2[0], w2[1], w2[2], J, Ji, torque, tw,
+                            hw[0] + tw[0] * sm, hw[1] + tw[1] * sm, hw[2] + tw[2] * sm)
+        q3 = (qa + 0.5 * dt * k2q[0], qb + 0.5 * dt * k2q[1], qc + 0.5 * dt * k2q[2], qd + 0.5 * dt * k2q[3])
+        w3 = (wa + 0.5 * dt * k2w[0], wb + 0.5 * dt * k2w[1], wc + 0.5 * dt * k2w[2])
+        k3q = _qrate(q3[0], q3[1], q3[2], q3[3], w3[0], w3[1], w3[2])
+        k3w = _acceleration(w3[0], w3[1], w3[2], J, Ji, torque, tw,
+                            hw[0] + tw[0] * sm, hw[1] + tw[1] * sm, hw[2] + tw[2] * sm)
+        q4 = (qa + dt * k3q[0], qb + dt * k3q[1], qc + dt * k3q[2], qd + dt * k3q[3])
+        w4 = (wa + dt * k3w[0], wb + dt * k3w[1], wc + dt * k3w[2])
+        k4q = _qrate(q4[0], q4[1], q4[2], q4[3], w4[0], w4[1], w4[2])
+        k4w = _acceleration(w4[0], w4[1], w4[2], J, Ji, torque, tw,
+                            hw[0] + tw[0] * s1, hw[1] + tw[1] * s1, hw[2] + tw[2] * s1)
+        c = dt / 6.0
+        qa = qa + c * (k1q[0] + 2 * k2q[0] + 2 * k3q[0] + k4q[0])
+        qb = qb + c * (k1q[1] + 2 * k2q[1] + 2 * k3q[1] + k4q[1])
+        qc = qc + c * (k1q[2] + 2 * k2q[2] + 2 * k3q[2] + k4q[2])
+        qd = qd + c * (k1q[3] + 2 * k2q[3] + 2 * k3q[3] + k4q[3])
+        ea = ea + c * (wa + 2 * w2[0] + 2 * w3[0] + w4[0])
+        eb = eb + c * (wb + 2 * w2[1] + 2 * w3[1] + w4[1])
+        ec = ec + c * (wc + 2 * w2[2] + 2 * w3[2] + w4[2])
+        wa, wb, wc = (wa + c * (k1w[0] + 2 * k2w[0] + 2 * k3w[0] + k4w[0]),
+                      wb + c * (k1w[1] + 2 * k2w[1] + 2 * k3w[1] + k4w[1]),
+                      wc + c * (k1w[2] + 2 * k2w[2] + 2 * k3w[2] + k4w[2]))
+    return (qa, qb, qc, qd), (wa, wb, wc), (ea, eb, ec)
