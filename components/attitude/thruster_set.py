@@ -105,6 +105,7 @@ class ThrusterSet:
             f = tuple(self.force * (1.0 + err) * x for x in d)
             self.forces.append(f)
             self.torques.append(rotations.cross(position, f))
+        self.force_norms = [rotations.norm(f) for f in self.forces]  # read at every step's propellant output
         self.pairs = {}  # (axis, sign) -> thruster indices
         for i, (_, _, _, role) in enumerate(self.layout):
             if role != "axial":
@@ -158,7 +159,7 @@ class ThrusterSet:
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
-        impulse = sum(rotations.norm(f) * t for f, t in zip(self.forces, self.fire_time))
+        impulse = sum(n * t for n, t in zip(self.force_norms, self.fire_time))
         return impulse / (self.isp * self.g0)
 
     def get_state(self):
