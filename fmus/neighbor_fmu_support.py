@@ -82,6 +82,56 @@ class NeighborSlave(Fmi2Slave):
         self._model_generation = 0  # counts model builds: a cache key that is never reused
         self._vector_keys = {}
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
+        self._batch = None  # while a get call runs: the vectors its array outputs computed
+        self._accessors = {}  # (type, "getter" or "setter") -> {value reference: function}
+
+    # ---- the FMI get and set calls ----------------------------------------------------------
+    # pythonfmu's own look up each variable and check its type on every call; these read tables
+    # built at the first call (every variable is declared in __init__) and fall back to
+    # pythonfmu's for anything the tables lack, so its errors stay the same.
+    def _accessor_table(self, cls, what):
+        table = self._accessors.get((cls, what))
+        if table is None:
+            table = self._accessors[(cls, what)] = {
+                vr: getattr(var, what) for vr, var in self.vars.items()
+                if isinstance(var, cls) and getattr(var, what) is not None}
+        return table
+
+    def _get(self, cls, kind, vrs, fallback):
+        getters = self._accessor_table(cls, "getter")
+        self._batch = {}
+        try:
+            return [kind(getters[vr]()) for vr in vrs]
+        except KeyError:
+            return fallback(self, vrs)
+        finally:
+            self._batch = None
+
+    def _set(self, cls, vrs, values, fallback):
+        setters = self._accessor_table(cls, "setter")
+        try:
+            for vr, value in zip(vrs, values):
+                setters[vr](value)
+        except KeyError:
+            fallback(self, vrs, values)
+
+    def get_real(self, vrs):
+        return self._get(Real, float, vrs, Fmi2Slave.get_real)
+
+    def get_integer(self, vrs):
+        return self._get(Integer, int, vrs, Fmi2Slave.get_integer)
+
+    def get_boolean(self, vrs):
+        return self._get(Boolean, bool, vrs, Fmi2Slave.get_boolean)
+
+    def set_real(self, vrs, values):
+        self._set(Real, vrs, values, Fmi2Slave.set_real)
+
+    def set_integer(self, vrs, values):
+        self._set(Integer, vrs, values, Fmi2Slave.set_integer)
+
+    def set_boolean(self, vrs, values):
+        self._set(Boolean, vrs, values, Fmi2Slave.set_boolean)
 
     # ---- declarations -------------------------------------------------------------------
     def _register(self, name, kind, causality, variability, unit, description, start=None,
@@ -155,9 +205,20 @@ class NeighborSlave(Fmi2Slave):
                      description: str, kind: type = float, depends_on: Iterable[str] = ()) -> Names:
         """`getter()` returns the whole vector; element i is output as `name[i+1]`."""
         names = element_names(name, n)
-        for i, element in enumerate(names):
-            self.output(element, lambda i=i: getter()[i], unit, f"{description} (component {i + 1})", kind,
-                        depends_on)
+
+        def element(i):
+            def get():
+                batch = self._batch  # inside one get call: the vector is computed once, not per element
+                if batch is None:
+                    return getter()[i]
+                vector = batch.get(name)
+                if vector is None:
+                    vector = batch[name] = getter()
+                return vector[i]
+            return get
+
+        for i, element_name in enumerate(names):
+            self.output(element_name, element(i), unit, f"{description} (component {i + 1})", kind, depends_on)
         return names
 
     def thruster_controller_interface(self, command: Callable[[], Any], done: Callable[[], bool],
