@@ -211,14 +211,23 @@ class ScheduledAlgorithm:
                         grow.append(cj)
             return [ci for ci in order if ci in need]
 
+        # Each condition signal is read once per pick, and only when its component stepped or was
+        # refreshed since the last read (a read is an FMI call); modes test the values held here.
+        self.signals, index = [], {}
+        for m in sch.modes:
+            for ci, var, _ in m.conditions:
+                if (ci, var) not in index:
+                    index[(ci, var)] = len(self.signals)
+                    self.signals.append(_Signal(table, ci, var, KIND[comps[ci].vars[var].type]))
+        self.signal_values = [0] * len(self.signals)
         self.modes = []
         for m in sch.modes:
-            conds = [(_Signal(table, ci, var, KIND[comps[ci].vars[var].type]), vals) for ci, var, vals in m.conditions]
+            conds = [(index[(ci, var)], vals) for ci, var, vals in m.conditions]
             order = [ci for ci in plan.order if m.active[ci]]
             self.modes.append(_Mode(m.mode.name, m.mode.step_size, order, m.mode.record_every, conds, list(m.multiples),
                                     refreshed(order)))
         self.events = [_Signal(table, ci, var, "Real") for ci, var in sch.events]
-        self.cond_comps = sorted({sig.ci for m in self.modes for sig, _ in m.conditions})
+        self.cond_comps = sorted({sig.ci for sig in self.signals})
         self.prod = [sorted(producers[ci]) for ci in range(n)]
         # Times closer than this are the same instant: a few ulps of the largest time in the run
         # (1.5e-5 s at 40 years), far below any step, so that t + (t_event - t) lands on t_event.
@@ -227,13 +236,21 @@ class ScheduledAlgorithm:
         self.mode_time = {m.name: 0.0 for m in self.modes}
         self.mode_steps = {m.name: 0 for m in self.modes}
 
-    def _pick(self):
+    def _pick(self, changed=None):
+        """The first mode whose conditions hold, the signals of the components in `changed` (all
+        when None) read again."""
+        values = self.signal_values
+        for j, sig in enumerate(self.signals):
+            if changed is None or changed[sig.ci]:
+                values[j] = int(sig.read())
         for mode in self.modes:
-            if all(int(sig.read()) in vals for sig, vals in mode.conditions):
+            for j, vals in mode.conditions:
+                if values[j] not in vals:
+                    break
+            else:
                 return mode
         raise SimulationError(f"{self.plan.schedule.origin}: no nc:Mode matches at t={self.table.t:g} s ("
-                              + ", ".join(f"{sig.name}={int(sig.read())}" for mode in self.modes
-                                          for sig, _ in mode.conditions)
+                              + ", ".join(f"{sig.name}={values[j]}" for j, sig in enumerate(self.signals))
                               + "); end the schedule with an unconditional nc:Mode")
 
     def start(self, info):
@@ -300,7 +317,12 @@ class ScheduledAlgorithm:
         for j, sig in enumerate(self.events):
             if changed[sig.ci]:
                 self.ev_values[j] = sig.read()
-        nxt = self._pick() if any(changed[ci] for ci in self.cond_comps) else mode
+        for ci in self.cond_comps:
+            if changed[ci]:
+                nxt = self._pick(changed)
+                break
+        else:
+            nxt = mode
         if nxt is not mode:
             active_now = set(nxt.order)
             for ci in range(self.n):
