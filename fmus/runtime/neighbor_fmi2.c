@@ -45,6 +45,60 @@ static void host_log(HostCallbacks *cb, const char *instance, int status, const 
 static const char *GET_CALLS[] = {"fmi2GetReal", "fmi2GetInteger", "fmi2GetBoolean", "fmi2GetString"};
 static const char *SET_CALLS[] = {"fmi2SetReal", "fmi2SetInteger", "fmi2SetBoolean", "fmi2SetString"};
 
+/* ---- the batched step of system_ssp's master (not an FMI call) -------------------------------
+ * Our master steps a component with its inputs set before and its outputs read after; through the
+ * standard calls that is up to seven entries into Python per step. `step_io` makes the same calls
+ * (set_values, do_step, get_values: the same values, statuses and messages) under one hold of the
+ * GIL, for the Real, Integer and Boolean blocks the master prepared once. Hosts that do not know
+ * it use the standard calls; the master uses it only when the library exports it. */
+typedef struct {
+    double t, h;                       /* the doStep's communication point and step size */
+    size_t n_in[3], n_out[3];          /* per kind (Real, Integer, Boolean): inputs set, outputs read */
+    const unsigned int *in_vr[3];
+    const void *in_val[3];             /* double or int values */
+    const unsigned int *out_vr[3];
+    void *out_val[3];
+    int send[3];                       /* set this kind's inputs in this call (they changed) */
+    int failed;                        /* out: 0 none, 1 + kind a set, 4 the doStep, 5 + kind a get */
+} StepIO;
+
+static Status step_io(void *c, StepIO *io, const char *const set_calls[], const char *const get_calls[],
+                      const char *step_call, size_t bool_size) {
+    Instance *inst = (Instance *)c;
+    if (!inst || !io) return ST_ERROR;
+    if (inst->broken) return ST_FATAL;
+    int gil = py.GILStateEnsure();  /* held across the calls below: theirs nest inside it */
+    Status worst = ST_OK, s;
+    io->failed = 0;
+    for (int k = 0; k < 3; k++) {
+        if (!io->send[k] || !io->n_in[k]) continue;
+        s = set_values(c, k, io->in_vr[k], io->n_in[k], io->in_val[k], io->n_in[k], 0, bool_size, set_calls[k]);
+        if (s > worst) worst = s;
+        if (s > ST_WARNING) {
+            io->failed = 1 + k;
+            goto done;
+        }
+    }
+    s = do_step(c, io->t, io->h, step_call);
+    if (s > worst) worst = s;
+    if (s > ST_WARNING) {
+        io->failed = 4;
+        goto done;
+    }
+    for (int k = 0; k < 3; k++) {
+        if (!io->n_out[k]) continue;
+        s = get_values(c, k, io->out_vr[k], io->n_out[k], io->out_val[k], io->n_out[k], 0, bool_size, get_calls[k]);
+        if (s > worst) worst = s;
+        if (s > ST_WARNING) {
+            io->failed = 5 + k;
+            goto done;
+        }
+    }
+done:
+    py.GILStateRelease(gil);
+    return worst;
+}
+
 /* ---- FMI 2.0 -------------------------------------------------------------------------------- */
 const char *fmi2GetTypesPlatform(void) { return fmi2TypesPlatform; }
 const char *fmi2GetVersion(void) { return fmi2Version; }
@@ -163,6 +217,11 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
                                         const fmi2Integer order[], fmi2Real value[]) {
     (void)vr; (void)nvr; (void)order; (void)value;
     return (fmi2Status)unsupported(c, "fmi2GetRealOutputDerivatives");
+}
+
+/* system_ssp's master: set, doStep and get of one component in one call (step_io above) */
+FMI2_Export fmi2Status neighborStepIO(fmi2Component c, void *io) {
+    return (fmi2Status)step_io(c, (StepIO *)io, SET_CALLS, GET_CALLS, "fmi2DoStep", sizeof(fmi2Boolean));
 }
 
 fmi2Status fmi2DoStep(fmi2Component c, fmi2Real t, fmi2Real h, fmi2Boolean noSetFMUStatePriorToCurrentPoint) {

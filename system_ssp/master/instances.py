@@ -197,17 +197,18 @@ class SetOp:
     sent again when the bytes equal the ones last sent (FMU inputs keep their values, and a call
     into a pythonfmu FMU costs about 10 us, which a byte comparison saves). `run()` does it."""
     __slots__ = ("fn", "c", "vr", "n", "buf", "view", "G", "idx", "factor", "offset", "post", "ci", "call", "names",
-                 "run")
+                 "last", "gather", "run")
 
     def __init__(self, fn, c, vr, n, buf, view, G, idx, factor, offset, post, ci, call, names):
         self.fn, self.c, self.vr, self.n, self.buf, self.view = fn, c, vr, n, buf, view
         self.G, self.idx, self.factor, self.offset, self.post = G, idx, factor, offset, post
         self.ci, self.call, self.names = ci, call, names
-        take, multiply, add = np.take, np.multiply, np.add
-        last = [None]  # the bytes last sent
+        take, multiply, add = G.take, np.multiply, np.add  # the bound method: np.take's wrappers cost ~1 us
+        last = self.last = [None]  # the bytes last sent
 
-        def run():
-            take(G, idx, out=view)
+        def gather():
+            """The values to send into `buf`; False when they equal the ones last sent."""
+            take(idx, out=view)
             if factor is not None:
                 multiply(view, factor, out=view)
                 add(view, offset, out=view)
@@ -215,13 +216,18 @@ class SetOp:
                 post(view)
             sent = view.tobytes()
             if sent == last[0]:
-                return
-            s = fn(c, vr, n, buf)
-            if s > 1:
-                raise StepFailed(ci, call, s, names)
+                return False
             last[0] = sent
+            return True
 
-        self.run = run
+        def run():
+            if gather():
+                s = fn(c, vr, n, buf)
+                if s > 1:
+                    last[0] = None
+                    raise StepFailed(ci, call, s, names)
+
+        self.gather, self.run = gather, run
 
 
 class StringGetOp:
@@ -263,6 +269,39 @@ class StringSetOp:
             last[0] = texts
 
         self.run = run
+
+
+class StepIO(ctypes.Structure):
+    """The block descriptions of our runtime's batched step (fmus/runtime/neighbor_fmi2.c, StepIO):
+    per kind (Real, Integer, Boolean) the inputs to set and the outputs to read."""
+    _fields_ = [("t", ctypes.c_double), ("h", ctypes.c_double),
+                ("n_in", ctypes.c_size_t * 3), ("n_out", ctypes.c_size_t * 3),
+                ("in_vr", ctypes.c_void_p * 3), ("in_val", ctypes.c_void_p * 3),
+                ("out_vr", ctypes.c_void_p * 3), ("out_val", ctypes.c_void_p * 3),
+                ("send", ctypes.c_int * 3), ("failed", ctypes.c_int)]
+
+
+STEP_IO_KIND = {"Real": 0, "Integer": 1, "Boolean": 2}
+
+
+def _step_io_kind(op):
+    """StepIO's index of a GetOp's or SetOp's type (None for String, which StepIO does not carry)."""
+    return STEP_IO_KIND.get(op.call[len("fmi2Get"):])  # fmi2GetReal, fmi2SetBoolean, ...
+
+# Step our runtime's FMUs with its batched call (set inputs, doStep, get outputs in one entry into
+# the FMU) when the library exports it; False: the standard calls only (the tests compare both).
+BATCHED_STEPS = os.environ.get("NEIGHBOR_COSIM_BATCHED_STEPS", "1") != "0"
+
+
+def _step_io_function(inst):
+    """The runtime's `neighborStepIO` of an FMI 2.0 instance's library, or None (another FMU)."""
+    if inst.fmi3 or not BATCHED_STEPS:
+        return None
+    fn = getattr(getattr(inst.fmu, "dll", None), "neighborStepIO", None)
+    if fn is not None:
+        fn.argtypes = [ctypes.c_void_p, ctypes.POINTER(StepIO)]
+        fn.restype = ctypes.c_int
+    return fn
 
 
 def _slot_blocks(slots):
@@ -533,8 +572,12 @@ class InstanceTable:
         return do_step
 
     def _stepper(self, ci):
-        """step(t, dt) of component ci: set its inputs, doStep, read its outputs."""
+        """step(t, dt) of component ci: set its inputs, doStep, read its outputs (in one call into
+        the FMU where our runtime offers it)."""
         inst = self.instances[ci]
+        step_io = _step_io_function(inst)
+        if step_io is not None and all(_step_io_kind(op) is not None for op in self.sets[ci] + self.gets[ci]):
+            return self._batched_stepper(ci, step_io)
         fn, c = inst.fn["fmi2DoStep"], inst.fmu.component
         set_, get = self.setters[ci], self.getters[ci]
 
@@ -544,6 +587,41 @@ class InstanceTable:
             if s > 1:
                 raise StepFailed(ci, "fmi2DoStep", s)
             get()
+
+        return step
+
+    def _batched_stepper(self, ci, step_io):
+        """step(t, dt) of component ci through the runtime's neighborStepIO: the same set, doStep
+        and get calls as `_stepper`'s, made inside the FMU; a failure names the call that failed."""
+        io = StepIO()
+        sets = {_step_io_kind(op): op for op in self.sets[ci]}  # one block per type and component
+        gets = {_step_io_kind(op): op for op in self.gets[ci]}
+        for k, op in sets.items():
+            io.n_in[k], io.in_vr[k], io.in_val[k] = op.n, ctypes.addressof(op.vr), ctypes.addressof(op.buf)
+        for k, op in gets.items():
+            io.n_out[k], io.out_vr[k], io.out_val[k] = op.n, ctypes.addressof(op.vr), ctypes.addressof(op.buf)
+        gathers = [(k, op.gather) for k, op in sets.items()]
+        c, send, ref = self.instances[ci].fmu.component, io.send, ctypes.byref(io)
+
+        def failed(s):
+            where = io.failed  # 1 + type: its set; 4: the doStep; 5 + type: its get
+            if where in (1, 2, 3):
+                op = sets[where - 1]
+                op.last[0] = None  # not sent
+                return StepFailed(ci, op.call, s, op.names)
+            if where in (5, 6, 7):
+                op = gets[where - 5]
+                return StepFailed(ci, op.call, s, op.names)
+            return StepFailed(ci, "fmi2DoStep", s)
+
+        def step(t, dt):
+            for k, gather in gathers:
+                send[k] = gather()
+            io.t = t
+            io.h = dt
+            s = step_io(c, ref)
+            if s > 1:
+                raise failed(s)
 
         return step
 
