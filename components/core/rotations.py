@@ -23,6 +23,12 @@ def dot(a, b):
 
 
 def norm(v):
+    # written out for 3- and 4-vectors (a generator through sum() costs about 1 us a call, and the
+    # mission takes millions); the same additions in the same order, so the same bits
+    if len(v) == 3:
+        return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2])
+    if len(v) == 4:
+        return math.sqrt(v[0] * v[0] + v[1] * v[1] + v[2] * v[2] + v[3] * v[3])
     return math.sqrt(sum(x * x for x in v))
 
 
