@@ -34,8 +34,9 @@ mission.next_event_time and host.next_event_time:
   decay          mode 7 (battery empty: only the orbit left until re-entry): 1 day
   idle           modes 1-2 (idle, grace period): 6 h, only host, mission, power and orbit
 Each maneuver mode comes twice: with truth feedback (estimator.truth_feedback, a parameter the
-nc:When tests) without the sensors, and with estimation, the sensors every step (the estimator
-takes a vector sample about every 0.09 s) and the ephemeris, shadow and GPS every 33rd. With
+nc:When tests) without the sensors, and with estimation, the gyro every step, the vector sensors
+every 6th (0.09 s, the estimator's update interval: each sample is used the step it is taken) and
+the ephemeris, shadow and GPS every 33rd. With
 truth feedback the attitude loop (dynamics, controllers, thrusters) is suspended until the
 detumble starts, so the host's tumble at takeover is the rigid body's initial state at the
 detumble (10 deg/s per axis, Eq. 7); with estimation the host tumbles on, torque-free, through
@@ -100,6 +101,8 @@ FAR_STEP = 240.0
 #   idle     idle and grace period (6 h steps)          bus      awaiting, contact, determination
 #   monitor  monitoring (after the burn)                decay    battery empty, until re-entry
 #   slow     every SLOW_EVERY-th step of the 15 ms maneuvers; slow_burn: so in the burn only
+#   sense    the attitude knowledge (sense_slow: every SLOW_EVERY-th maneuver step, sense_vector:
+#            every SENSOR_EVERY-th), truth: also with truth feedback
 #   a phase (detumble, slew, burn): the controller of that maneuver only; every other component
 #   steps in all three maneuvers.
 # Adding a component to the mission is one row here plus its connections in `system()`.
@@ -123,9 +126,9 @@ COMPONENTS = {
     "sun": ("SunEphemeris", ["mission_sun"], {"sense", "sense_slow"}),
     "shadow": ("EarthShadow", [], {"sense", "sense_slow"}),
     "gps": ("GpsReceiver", ["mission_gps"], {"sense", "sense_slow"}),
-    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense"}),
-    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense"}),
-    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense"}),
+    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense", "sense_vector"}),
+    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense", "sense_vector"}),
+    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense", "sense_vector"}),
     "gyro": ("Gyro", ["mission_gyro"], {"sense"}),
     "estimator": ("AttitudeEstimator", ["mission_estimator"], {"sense", "truth"}),
 }
@@ -142,12 +145,22 @@ MANEUVERS = ("detumble", "slew", "burn")
 ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", "ground", "detumble", "slew",
          "tracking", "selector", "thrusters", "dynamics", "sun", "shadow", "gps", "horizon", "sun_sensor", "coarse_sun",
          "gyro", "estimator"]
-# The sensors and the estimator step every step of the 15 ms maneuvers; the estimator takes a
-# vector sample about every 0.09 s (`update_interval`), each with its own noise. The vector sensors
-# stepped every 7th step made the estimator overconfident while the host turned fast: a held
-# sample that the update interval deferred was used up to 6 steps late (0.09 s at 17 deg/s is
-# 1.5 deg), and a recorded row's refresh gave a held sample new geometry with its old noise; the
-# attitude NEES in the detumble reached 250-700 (issue 28). Determination runs at the gyro's 0.1 s.
+# The estimator takes one vector sample per sensor every UPDATE_INTERVAL (0.09 s), each with its
+# own noise, and uses a sample the step it arrives or never. In the 15 ms maneuvers the gyro and
+# the estimator step every step, the vector sensors (horizon, fine and coarse Sun: "sense_vector")
+# every SENSOR_EVERY-th step, i.e. exactly at the estimator's rate: a sensor samples the rigid
+# body at the end of the step it is stepped in, the estimator stepping after it uses that sample
+# in the same step (its interval has just elapsed), and between two samples the sensor's output
+# is held (a refresh for a recorded row recomputes it from the current geometry; the estimator
+# drops it, its interval not elapsed). Stepped every 7th step, a rate the interval does not
+# divide, the sensors had made the estimator overconfident (held samples used up to 6 steps
+# late, 1.5 deg at 17 deg/s; the attitude NEES in the detumble reached 250-700, issue 28). Every
+# step cost 26 s of a mission for samples the estimator dropped (issue 27). Determination runs
+# at the gyro's 0.1 s, every sample used.
+UPDATE_INTERVAL = 0.09
+MANEUVER_STEP = 0.015
+SENSOR_EVERY = round(UPDATE_INTERVAL / MANEUVER_STEP)
+assert abs(SENSOR_EVERY * MANEUVER_STEP - UPDATE_INTERVAL) < 1e-12
 DETERMINATION_STEP = 0.1
 DETERMINATION_EVERY = 10
 
@@ -229,6 +242,7 @@ def maneuver_every(phase, truth=False):
     every = {c: SLOW_EVERY for c in slow}
     if not truth:
         every.update({c: SLOW_EVERY for c in having("sense_slow")})
+        every.update({c: SENSOR_EVERY for c in having("sense_vector")})
     return every
 
 
@@ -280,9 +294,9 @@ def maneuver_modes():
     modes = []
     for name, phase in (("detumble", Phase.DETUMBLE), ("slew", Phase.SLEW), ("burn", Phase.BURN)):
         when = in_mode(Mode.DEORBIT, phase=phase)
-        modes.append(ScheduleMode(f"{name}_truth", 0.015, maneuver_active(name, truth=True), 20, when + (TRUTH,),
-                                  maneuver_every(name, truth=True)))
-        modes.append(ScheduleMode(name, 0.015, maneuver_active(name), 20, when, maneuver_every(name)))
+        modes.append(ScheduleMode(f"{name}_truth", MANEUVER_STEP, maneuver_active(name, truth=True), 20,
+                                  when + (TRUTH,), maneuver_every(name, truth=True)))
+        modes.append(ScheduleMode(name, MANEUVER_STEP, maneuver_active(name), 20, when, maneuver_every(name)))
     return modes
 
 
@@ -460,7 +474,8 @@ def generate(writer):
                "(vector sensors at about 10 Hz), rate filter trusting the torque model to 2 % of one pair's "
                "acceleration, coarse Sun vectors when the fine sensor has none, attitude valid at 0.25 deg 1-sigma",
                {"nadir_sigma": ad.HORIZON_SIGMA, "sun_sigma": ad.SUN_SIGMA, "gyro_sigma": ad.GYRO_SIGMA,
-                "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": 0.09, "accel_sigma": ACCEL_SIGMA,
+                "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": UPDATE_INTERVAL,
+                "accel_sigma": ACCEL_SIGMA,
                 "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA})
     writer.ssv(GNC_SETS["closed-loop-truth"],
                "Closed-loop guidance and control on the true state (a fidelity choice): the estimator passes the "
