@@ -3,16 +3,20 @@
     python bench/bench_master.py [--steps 4000] [--repeat 3]
 
 Prints, for build/ssp/detumble.ssp (Gauss-Seidel, 15 ms, stop condition off so every run
-takes the same number of steps):
-- communication steps per second, recording every connector and recording nothing extra;
-- the floor: the time spent inside the FMUs' own fmi2Set*/fmi2DoStep/fmi2Get* calls through
-  FMPy's ctypes functions, measured in the same run by timing each call;
-- the master's overhead per step in that same run: its wall time less the time inside the
-  FMU calls and less the timing wrappers' own cost;
+takes the same number of steps), each row measured in this run:
+- communication steps per second, recording every connector and recording one signal, with our
+  runtime's batched step (neighborStepIO: set, doStep and get in one call into the FMU) and with
+  the standard FMI calls only, and their ratio;
+- the floor: the same three models' wrapper objects (the classes inside the FMUs, with the same
+  parameters) called directly in a plain Python loop, set/do_step/get by value reference, no FMI
+  and no master; the master + FMI cost per FMU call over it;
+- the time inside the FMUs' own fmi2Set*/fmi2DoStep/fmi2Get* calls with the standard calls (each
+  call timed), and the master's own overhead per step in that run;
 - the wall time of thesis slew case 3 (three chained 180 deg slews, 11 084 steps).
 Build first: python build_fmus.py
 """
 import argparse
+import re
 import statistics
 import sys
 import time
@@ -23,6 +27,7 @@ sys.path.insert(0, str(ROOT))
 
 import system_ssp  # noqa: E402
 from system_ssp.neighbor import thesis  # noqa: E402
+from system_ssp import builder  # noqa: E402
 from system_ssp.master import instances  # noqa: E402
 
 SSP = ROOT / "build" / "ssp"
@@ -83,6 +88,67 @@ def run_detumble(system, steps, outputs=None):
     return r
 
 
+def _wrapper_class(model_identifier):
+    """The NeighborSlave class an FMU of ours carries (fmus/neighbor_<snake name>.py)."""
+    snake = re.sub(r"(?<!^)(?=[A-Z])", "_", model_identifier).lower()
+    return builder._import_wrapper(builder.FMU_SOURCES / f"neighbor_{snake}.py")
+
+
+def floor_run(system, steps):
+    """The system's models as their wrapper objects, called directly in a plain Python loop in the
+    master's order: each component's connected inputs set from the outputs read last (the same
+    Gauss-Seidel), do_step, its connected outputs read. Returns (wall seconds, FMU-call
+    equivalents per step, the final values {component.variable: value})."""
+    setters = {"Real": "set_real", "Integer": "set_integer", "Enumeration": "set_integer", "Boolean": "set_boolean",
+               "String": "set_string"}
+    slaves = []
+    for comp in system.comps:
+        slave = _wrapper_class(comp.md.coSimulation.modelIdentifier)(instance_name=comp.name,
+                                                                     resources=str(builder.FMU_SOURCES))
+        slave.setup_experiment(0.0, steps * 0.015)
+        slave.enter_initialization_mode()
+        slaves.append(slave)
+    for (ci, var), value in system.collect_parameters().items():
+        v = system.comps[ci].vars[var]
+        getattr(slaves[ci], setters[v.type])([v.valueReference], [value])
+    for slave in slaves:
+        slave.exit_initialization_mode()
+    n = len(slaves)
+    vr = lambda ci, var: system.comps[ci].vars[var].valueReference  # noqa: E731
+    outs = [sorted({vr(ci, lk.src_var) for lk in system.links if lk.src == ci}) for ci in range(n)]
+    ins = [[(vr(ci, lk.dst_var), lk.src, vr(lk.src, lk.src_var)) for lk in system.links if lk.dst == ci]
+           for ci in range(n)]
+    assert all(lk.vtype == "Real" for lk in system.links)  # the detumble system's connections
+    values = [dict(zip(outs[ci], slaves[ci].get_real(outs[ci]))) for ci in range(n)]
+    order = [system.by_name[name] for name in system.default_order()]
+    order = [system.comps.index(c) for c in order]
+    calls = sum(1 + bool(ins[ci]) + bool(outs[ci]) for ci in range(n))
+    t0 = time.perf_counter()
+    for k in range(steps):
+        t = k * 0.015
+        for ci in order:
+            slave = slaves[ci]
+            if ins[ci]:
+                slave.set_real([d for d, _, _ in ins[ci]], [values[src][s] for _, src, s in ins[ci]])
+            slave.do_step(t, 0.015)
+            if outs[ci]:
+                values[ci] = dict(zip(outs[ci], slave.get_real(outs[ci])))
+    wall = time.perf_counter() - t0
+    final = {f"{system.comps[ci].name}.{v.name}": slaves[ci].get_real([v.valueReference])[0]
+             for ci in range(n) for v in system.comps[ci].md.modelVariables if v.causality == "output"
+             and v.type == "Real"}
+    return wall, calls, final
+
+
+def best_of(repeat, run):
+    walls = []
+    for _ in range(repeat):
+        t0 = time.perf_counter()
+        run()
+        walls.append(time.perf_counter() - t0)
+    return min(walls), statistics.median(walls)
+
+
 def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=4000)
@@ -92,17 +158,31 @@ def main():
     print(f"detumble system, Gauss-Seidel, h = 15 ms, {n} steps per run, best of {args.repeat}")
     with system_ssp.System(SSP / "detumble.ssp") as system:
         few = ["dynamics.q_BN[4]"]
+        best = {}
         for label, outputs in (("all connectors recorded", None), ("one signal recorded", few)):
-            walls = []
-            for _ in range(args.repeat):
-                t0 = time.perf_counter()
-                run_detumble(system, n, outputs)
-                walls.append(time.perf_counter() - t0)
-            best = min(walls)
-            print(f"  {label:<26} {n / best:9.0f} steps/s   {best / n * 1e6:7.1f} us/step "
-                  f"(median {statistics.median(walls) / n * 1e6:.1f})")
-        untimed_one = best / n
+            for batched in (True, False):
+                instances.BATCHED_STEPS = batched
+                best[(label, batched)], _ = best_of(args.repeat, lambda o=outputs: run_detumble(system, n, o))
+            instances.BATCHED_STEPS = True
+            fast, slow = best[(label, True)], best[(label, False)]
+            print(f"  {label:<26} {n / fast:9.0f} steps/s batched, {n / slow:7.0f} standard calls: "
+                  f"{slow / fast:.2f}x")
+        one = best[("one signal recorded", True)] / n
 
+        floor_walls = []
+        for _ in range(args.repeat):
+            wall, calls, final = floor_run(system, n)
+            floor_walls.append(wall)
+        floor = min(floor_walls) / n
+        r = run_detumble(system, n, list(final))
+        same = all(r.final[name] == value for name, value in final.items())
+        print(f"  floor: the models called directly in Python {n * 1.0 / (floor * n):9.0f} steps/s, "
+              f"{floor * 1e6:.1f} us/step ({'the same final state' if same else 'final state DIFFERS'} as the master)")
+        print(f"  master + FMI over the floor {(one - floor) * 1e6:9.1f} us/step, "
+              f"{(one - floor) / calls * 1e6:.2f} us per FMU call ({calls} set/doStep/get calls a step), "
+              f"the master's run at {one / floor:.2f}x the floor")
+
+        instances.BATCHED_STEPS = False
         wrapper_cost, inside_cost = clock_cost()
         timer = CallTimer()
         uninstall = timer.install()
@@ -112,17 +192,15 @@ def main():
             timed_wall = time.perf_counter() - t0
         finally:
             uninstall()
+            instances.BATCHED_STEPS = True
         calls_per_step = timer.calls / n
         # time inside the FMU calls, less what the timing itself adds inside the measured span
-        floor = (timer.total - timer.calls * inside_cost) / n
+        inside = (timer.total - timer.calls * inside_cost) / n
         # the rest of the same run, less the wrappers' own cost, is the master's
         overhead = (timed_wall - timer.total - timer.calls * (wrapper_cost - inside_cost)) / n
-        print(f"  FMU calls per step        {calls_per_step:9.1f}")
-        print(f"  floor (inside FMU calls)  {floor * 1e6:9.1f} us/step  "
-              f"({floor / calls_per_step * 1e6:.2f} us per call)")
-        print(f"  master overhead           {overhead * 1e6:9.1f} us/step over the floor, same run "
-              f"(timing wrappers' {wrapper_cost * 1e9:.0f} ns/call taken out)")
-        print(f"  untimed one-signal run    {untimed_one * 1e6:9.1f} us/step")
+        print(f"  standard calls, each timed: {calls_per_step:.1f} FMU calls per step, {inside * 1e6:.1f} us/step "
+              f"inside them ({inside / calls_per_step * 1e6:.2f} us per call), the master {overhead * 1e6:.1f} us/step "
+              "(timing wrappers' cost taken out)")
 
     t0 = time.perf_counter()
     results = thesis.run_cases(SSP, "euler", cases=["slew_case3"])

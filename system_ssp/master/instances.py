@@ -5,7 +5,9 @@ the prepared FMI calls that move values along the connections: connected outputs
 components live in one numpy buffer per type, so setting a component's inputs is one `np.take`
 (plus the affine map when a connection has one) and one fmi2Set* call, and reading its outputs
 is one fmi2Get* call per type straight into that buffer. The calls go to FMPy's loaded ctypes
-functions with value-reference arrays and value buffers built once per run.
+functions with value-reference arrays and value buffers built once per run. A component of ours
+(a library that exports our runtime's `neighborStepIO`) is stepped with one call that makes its
+sets, doStep and gets inside the FMU (`StepIO`); every other FMU with the standard calls.
 """
 import ctypes
 import itertools
@@ -287,6 +289,7 @@ STEP_IO_KIND = {"Real": 0, "Integer": 1, "Boolean": 2}
 def _step_io_kind(op):
     """StepIO's index of a GetOp's or SetOp's type (None for String, which StepIO does not carry)."""
     return STEP_IO_KIND.get(op.call[len("fmi2Get"):])  # fmi2GetReal, fmi2SetBoolean, ...
+
 
 # Step our runtime's FMUs with its batched call (set inputs, doStep, get outputs in one entry into
 # the FMU) when the library exports it; False: the standard calls only (the tests compare both).
@@ -606,8 +609,10 @@ class InstanceTable:
         def failed(s):
             where = io.failed  # 1 + type: its set; 4: the doStep; 5 + type: its get
             if where in (1, 2, 3):
+                for k, other in sets.items():
+                    if k >= where - 1:
+                        other.last[0] = None  # this block and the ones after it were not sent
                 op = sets[where - 1]
-                op.last[0] = None  # not sent
                 return StepFailed(ci, op.call, s, op.names)
             if where in (5, 6, 7):
                 op = gets[where - 5]
