@@ -12,12 +12,15 @@ takes the same number of steps), each row measured in this run:
   and no master; the master + FMI cost per FMU call over it;
 - the time inside the FMUs' own fmi2Set*/fmi2DoStep/fmi2Get* calls with the standard calls (each
   call timed), and the master's own overhead per step in that run;
+- libcosim (libcosimpy, its fixed-step algorithm, nothing observed) on the same .ssp in a
+  second process, and our steps/s over its;
 - the wall time of thesis slew case 3 (three chained 180 deg slews, 11 084 steps).
 Build first: python build_fmus.py
 """
 import argparse
 import re
 import statistics
+import subprocess
 import sys
 import time
 from pathlib import Path
@@ -140,6 +143,34 @@ def floor_run(system, steps):
     return wall, calls, final
 
 
+# libcosim's steps of the same system, timed in its own process (a process holding both libcosim
+# and FMPy instances can abort at exit)
+LIBCOSIM = """
+import sys, time
+from libcosimpy.CosimExecution import CosimExecution
+from libcosimpy.CosimLogging import CosimLogLevel, log_output_level
+log_output_level(CosimLogLevel.WARNING)
+ex = CosimExecution.from_ssp_file(sys.argv[1], step_size=15_000_000)
+ex.step(1)  # initialization happens in the first step
+best = None
+for _ in range(int(sys.argv[3])):
+    t0 = time.perf_counter()
+    ex.step(int(sys.argv[2]))
+    wall = time.perf_counter() - t0
+    best = wall if best is None else min(best, wall)
+print(best)
+"""
+
+
+def libcosim_steps_per_second(steps, repeat):
+    """libcosim's steps/s on detumble.ssp (best of `repeat`), or None without libcosimpy."""
+    proc = subprocess.run([sys.executable, "-c", LIBCOSIM, str(SSP / "detumble.ssp"), str(steps), str(repeat)],
+                          capture_output=True, text=True)
+    if proc.returncode != 0:
+        return None
+    return steps / float(proc.stdout.strip().splitlines()[-1])
+
+
 def best_of(repeat, run):
     walls = []
     for _ in range(repeat):
@@ -201,6 +232,14 @@ def main():
         print(f"  standard calls, each timed: {calls_per_step:.1f} FMU calls per step, {inside * 1e6:.1f} us/step "
               f"inside them ({inside / calls_per_step * 1e6:.2f} us per call), the master {overhead * 1e6:.1f} us/step "
               "(timing wrappers' cost taken out)")
+
+    ours = n / best[("one signal recorded", True)]
+    theirs = libcosim_steps_per_second(n, args.repeat)
+    if theirs is None:
+        print("  libcosim: not installed (pip install libcosimpy)")
+    else:
+        print(f"  libcosim, same .ssp, nothing observed {theirs:9.0f} steps/s; ours (one signal) {ours / theirs:.2f}x "
+              "faster")
 
     t0 = time.perf_counter()
     results = thesis.run_cases(SSP, "euler", cases=["slew_case3"])
