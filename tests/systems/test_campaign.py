@@ -2,6 +2,7 @@
 run index only, identical results with 1 and 2 Dask workers, resume, and a failing run kept as
 a row (timeouts and crashed workers: tests/master/test_master_campaign.py)."""
 import json
+import tomllib
 
 import pyarrow as pa
 import pyarrow.compute as pc
@@ -67,6 +68,44 @@ def test_spec_errors_name_file_key_and_allowed(ssp_paths, tmp_path, change, patt
         _spec(tmp_path, text)
     with pytest.raises(SSPError, match=r"campaign.system = 'nope': no such file"):
         _spec(tmp_path, DETUMBLE.format(system="nope", runs=2))
+
+
+def test_a_spec_extends_another_key_by_key(ssp_paths, tmp_path):
+    """campaign.extends: the base's tables with the extending spec's entries over them (campaign
+    keys, a dispersion and a probability replaced, a metric added); errors name the file and key."""
+    _spec(tmp_path, DETUMBLE.format(system=ssp_paths["detumble"], runs=2), "base.toml")
+    child = _spec(tmp_path, """
+[campaign]
+extends = "base.toml"
+runs = 3
+seed = 11
+[dispersions."dynamics.omega0[1]"]
+distribution = "uniform"
+low = 0.0
+high = 0.2
+[metrics]
+wy = "final:dynamics.omega_BN_B[2]"
+[probabilities]
+slow_x = "wmax > 0.2"
+""", "child.toml")
+    base = load_spec(tmp_path / "base.toml")
+    assert (child.runs, child.seed, child.system, child.parameter_sets, child.stop_time) == (
+        3, 11, base.system, base.parameter_sets, base.stop_time)
+    assert child.parameters == base.parameters == {"dynamics.integrator": "rk4"}
+    by_name = {d.name: d for d in child.dispersions}
+    replaced = by_name["dynamics.omega0[1]"]
+    assert (replaced.kind, replaced.args) == ("uniform", {"low": 0.0, "high": 0.2})
+    assert by_name["detumble.Kp[1]"] == {d.name: d for d in base.dispersions}["detumble.Kp[1]"]
+    assert [m.name for m in child.metrics] == [m.name for m in base.metrics] + ["wy"]
+    assert child.probabilities == [("slow_x", "wmax", ">", 0.2)]
+    assert child.text.startswith("\n[campaign]\nextends") and "# ---- campaign.extends: base.toml" in child.text
+    assert tomllib.loads(child.text) == tomllib.loads((tmp_path / "child.toml").read_text())  # the base as comments
+    for extends, pattern in (('"../base.toml"', r"child2.toml: campaign.extends = '../base.toml': expected the file "
+                                                r"name of a campaign spec"),
+                             ('"gone.toml"', r"campaign.extends = 'gone.toml': no such file"),
+                             ('"child2.toml"', r"extend each other in a cycle")):
+        with pytest.raises(SSPError, match=pattern):
+            _spec(tmp_path, f"[campaign]\nextends = {extends}\n[metrics]\nend_s = \"stop_time\"\n", "child2.toml")
 
 
 def test_draws_depend_on_seed_and_index_only(ssp_paths, tmp_path):

@@ -32,7 +32,7 @@ HELPERS = {"solar_activity": "scales every F10.7 of the space-weather file by @f
                              "orbit's space_weather_file at the scaled copy"}
 PROBABILITY = re.compile(r"^\s*([A-Za-z_][A-Za-z0-9_]*)\s*(<=|>=|<|>|==)\s*([-+0-9.eE]+|true|false)\s*$")
 CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_size", "timeout_s", "helper",
-                 "keep_timeseries",
+                 "keep_timeseries", "extends",
                  "min_success",
                  "description"}
 TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities"}
@@ -153,15 +153,50 @@ def _runs(path, value):
     return runs
 
 
+def _read_doc(path, where):
+    text = read_text_input(path, where, "the campaign spec",
+                           "a campaign spec is TOML, which is UTF-8: save it as UTF-8")
+    try:
+        return tomllib.loads(text), text
+    except tomllib.TOMLDecodeError as exc:
+        raise SSPError(f"{path}: not valid TOML: {exc}") from None
+
+
+def _extended(path, doc, text, seen=()):
+    """A spec whose [campaign] has `extends = "other.toml"` (a spec in the same folder): that
+    spec's tables with this one's entries over them, key by key ([campaign] keys, parameters,
+    dispersions by parameter, metrics, probabilities by name). The text (what a resumed campaign
+    compares, stored as spec.toml) is this file's followed by the base's as comments, so it stays
+    valid TOML and a change to either is seen."""
+    c = doc.get("campaign")
+    base = c.get("extends") if isinstance(c, dict) else None
+    if base is None:
+        return doc, text
+    if not isinstance(base, str) or Path(base).name != base or not base.endswith(".toml"):
+        raise SSPError(f"{path}: campaign.extends = {base!r}: expected the file name of a campaign spec (.toml) in "
+                       "the same folder")
+    base_path = path.parent / base
+    if base_path.resolve() in seen or base_path.resolve() == path.resolve():
+        raise SSPError(f"{path}: campaign.extends = {base!r}: the specs extend each other in a cycle")
+    if not base_path.is_file():
+        raise SSPError(f"{path}: campaign.extends = {base!r}: no such file in {path.parent}")
+    base_doc, base_text = _read_doc(base_path, f"{path}: campaign.extends {base!r}")
+    base_doc, base_text = _extended(base_path, base_doc, base_text, tuple(seen) + (path.resolve(),))
+    merged = {}
+    for key in list(base_doc) + [k for k in doc if k not in base_doc]:
+        below, above = base_doc.get(key), doc.get(key)
+        merged[key] = {**below, **above} if isinstance(below, dict) and isinstance(above, dict) else (
+            above if key in doc else below)
+    merged["campaign"] = {k: v for k, v in merged["campaign"].items() if k != "extends"}
+    quoted = "".join(f"# {line}" if line.strip() else "#\n" for line in base_text.splitlines(keepends=True))
+    return merged, f"{text.rstrip()}\n\n# ---- campaign.extends: {base}, as it was read ----\n{quoted.rstrip()}\n"
+
+
 def load_spec(path):
     """Read and check a campaign spec; SSPError naming the file, the key and what is allowed."""
     path = Path(path)
-    text = read_text_input(path, str(path), "the campaign spec",
-                           "a campaign spec is TOML, which is UTF-8: save it as UTF-8")
-    try:
-        doc = tomllib.loads(text)
-    except tomllib.TOMLDecodeError as exc:
-        raise SSPError(f"{path}: not valid TOML: {exc}") from None
+    doc, text = _read_doc(path, str(path))
+    doc, text = _extended(path, doc, text)
     unknown = sorted(set(doc) - TOP_KEYS)
     if unknown:
         raise SSPError(f"{path}: unknown table(s) {', '.join(unknown)} (allowed: {', '.join(sorted(TOP_KEYS))})")
