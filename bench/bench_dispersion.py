@@ -1,10 +1,10 @@
-"""The mission off the thesis' nominal point: examples/campaigns/mission_dispersion_420km.toml
+"""The mission off the thesis' nominal point: examples/campaigns/mission_dispersion_<scenario>.toml
 (closed-loop guidance and control on the attitude estimator; tumble up to 15 deg/s per axis in
-either sense, mass 10-14 kg, thrusters misaligned, gyro bias and sensor noise) through the
-campaign runner on Dask.
+either sense, mass 10-14 kg, thrusters misaligned, gyro bias and sensor noise; the 475 and 525 km
+campaigns extend the 420 km one) through the campaign runner on Dask.
 
-    python bench/bench_dispersion.py                        # 100 runs (about 80 min on 2 cores)
-    python bench/bench_dispersion.py --runs 20 --workers 16 --out results/dispersion
+    python bench/bench_dispersion.py                        # 100 runs at 420 km (about 80 min on 2 cores)
+    python bench/bench_dispersion.py --scenario 525km --runs 20 --workers 16
 
 Prints the success rate (with its 95 % Wilson interval), the share of runs that burned their
 whole budget and re-entered within 5 years of the burn, and the distribution (min, 5th, 50th,
@@ -26,10 +26,11 @@ sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 from components.core.constants import YEAR  # noqa: E402
 from components.mission.neighbor import DATA_STORAGE_LIMIT_B  # noqa: E402
 from system_ssp.neighbor import budgets  # noqa: E402
+from system_ssp.neighbor.mission import DEFAULT_SCENARIO, SCENARIOS  # noqa: E402
 from system_ssp.tools.campaign import load_spec, run_campaign  # noqa: E402
 from system_ssp.tools.campaign.runner import _read_rows, wilson  # noqa: E402
 
-SPEC = Path(__file__).resolve().parents[1] / "examples" / "campaigns" / "mission_dispersion_420km.toml"
+CAMPAIGNS = Path(__file__).resolve().parents[1] / "examples" / "campaigns"
 PHASES = {"detumble (s)": ("detumble_start_s", "slew_start_s", 1.0),
           "slew (s)": ("slew_start_s", "burn_start_s", 1.0),
           "burn (min)": ("burn_start_s", "monitoring_start_s", 60.0),
@@ -48,9 +49,11 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--runs", type=int, default=100)
     ap.add_argument("--workers", type=int, default=None, help="Dask workers (default: one per core)")
-    ap.add_argument("--out", default="results/dispersion_420km")
+    ap.add_argument("--scenario", choices=SCENARIOS, default=DEFAULT_SCENARIO)
+    ap.add_argument("--out", default=None, help="results folder (default: results/dispersion_<scenario>)")
     args = ap.parse_args()
-    spec = dataclasses.replace(load_spec(SPEC), runs=args.runs)
+    args.out = args.out or f"results/dispersion_{args.scenario}"
+    spec = dataclasses.replace(load_spec(CAMPAIGNS / f"mission_dispersion_{args.scenario}.toml"), runs=args.runs)
     t0 = time.perf_counter()
     summary = run_campaign(spec, args.out, workers=args.workers, progress=True)
     wall = time.perf_counter() - t0
@@ -76,7 +79,7 @@ def main():
     print(distribution("mean attitude NEES (3: consistent)", [r["nees_mean"] for r in ok]))
     print(distribution("steps above the NEES 95 % bound (%)", [100.0 * r["nees_over_fraction"] for r in ok]))
     # the budgets (system_ssp.neighbor.budgets): the 95th percentile against each allowance
-    allowed = budgets.allowance("420km")
+    allowed = budgets.allowance(args.scenario)
     for label, values, limit in (
             ("RCS propellant (g)", [1e3 * r["rcs_propellant_kg"] for r in ok], allowed.rcs_g),
             ("total propellant (kg)", [r["burn_propellant_kg"] + r["rcs_propellant_kg"] for r in ok], allowed.tank_kg),

@@ -88,10 +88,14 @@ def test_tables_8_and_9_from_the_mission_definition():
     assert heavier["total"] > mass["total"] + 1150.0
 
 
-def test_dispersion_campaign_judges_the_same_budgets():
-    spec = load_spec(DISPERSION)
+@pytest.mark.parametrize("scenario", ["420km", "475km", "525km"])
+def test_dispersion_campaign_judges_the_same_budgets(scenario):
+    """Each scenario's dispersion campaign (475 and 525 km extend the 420 km one) judges the RCS
+    propellant against that scenario's allowance and flies that scenario."""
+    spec = load_spec(DISPERSION.with_name(f"mission_dispersion_{scenario}.toml"))
     probabilities = {name: (metric, op, threshold) for name, metric, op, threshold in spec.probabilities}
     assert probabilities["rcs_within_allowance"] == ("rcs_propellant_kg", "<=",
-                                                    pytest.approx(budgets.allowance("420km").rcs_g / 1e3, rel=1e-12))
+                                                    pytest.approx(budgets.allowance(scenario).rcs_g / 1e3, rel=1e-12))
     assert probabilities["storage_within_limit"] == ("max_storage_B", "<=", DATA_STORAGE_LIMIT_B)
+    assert spec.parameter_sets == [f"parameters/neighbor_mission_lifetime_{scenario}.ssv"]
 
