@@ -168,7 +168,7 @@ DETERMINATION_EVERY = 10
 # Flight tolerances sized from the impulse bit: the rate change of one 15 ms firing (the attitude
 # loop's step, the shortest pulse) at the nominal 12 kg, 0.017-0.043 deg/s per axis. They hold for
 # any mass down to 8 kg (the bit grows as the mass falls: 1.5x at 8 kg).
-MIN_ON_TIME = 0.015
+MIN_ON_TIME = MANEUVER_STEP
 INERTIA = rigid_body.box_inertia(SPACECRAFT.mass, *SPACECRAFT.edges)
 BITS = thruster_control.impulse_bit_rates(thruster_control.pair_torques(), [INERTIA[i, i] for i in range(3)],
                                           MIN_ON_TIME)
@@ -388,7 +388,7 @@ def system(orbit_fmu):
         "stop_time": 40.0 * YEAR,
         # The fixed step a master without our nc:Schedule runs at (and `--no-schedule`): the 15 ms of
         # the attitude loop, which every phase is correct at. The schedule only saves the steps.
-        "step_size": 0.015,
+        "step_size": MANEUVER_STEP,
         "schedule": Schedule(modes=(
             *maneuver_modes(),
             ScheduleMode("determination_truth", 1.0, having("bus"), 10, in_mode(Mode.DEORBIT) + (TRUTH,)),
