@@ -123,8 +123,7 @@ def floor_run(system, steps):
            for ci in range(n)]
     assert all(lk.vtype == "Real" for lk in system.links)  # the detumble system's connections
     values = [dict(zip(outs[ci], slaves[ci].get_real(outs[ci]))) for ci in range(n)]
-    order = [system.by_name[name] for name in system.default_order()]
-    order = [system.comps.index(c) for c in order]
+    order = [system.comps.index(system.by_name[name]) for name in system.default_order()]
     calls = sum(1 + bool(ins[ci]) + bool(outs[ci]) for ci in range(n))
     t0 = time.perf_counter()
     for k in range(steps):
