@@ -262,3 +262,44 @@ def test_a_vector_dispersion_in_one_table(ssp_paths, tmp_path):
     bad = _spec(tmp_path, text.replace('[dispersions."detumble.Kd"]', '[dispersions."detumble.Kdd"]'), "bad.toml")
     with pytest.raises(SSPError, match=r"dispersions.detumble.Kdd\[1\]: parameter 'detumble.Kdd\[1\]'"):
         run_campaign(bad, tmp_path / "bad", workers=1)
+
+
+FAULTS = """
+[faults]
+probability = 0.5
+[faults.cases.weak_x]
+"detumble.Kp[1]" = 5.0
+[faults.cases.no_damping]
+"detumble.Kp[2]" = 0.0
+"detumble.Kp[3]" = 0.0
+"""
+
+
+def test_faults_one_case_in_a_share_of_the_runs(ssp_paths, tmp_path):
+    """[faults]: with the probability, one case per run (its parameters over the draws), named in
+    the `fault` column; the other draws are those of the spec without [faults]; a case's bad name
+    is refused before any run, naming the case."""
+    plain = _spec(tmp_path, DETUMBLE.format(system=ssp_paths["detumble"], runs=200), "plain.toml")
+    spec = _spec(tmp_path, (DETUMBLE + FAULTS).format(system=ssp_paths["detumble"], runs=200))
+    draws = [spec.inputs(i) for i in range(spec.total_runs)]
+    faults = [v.pop("fault") for _, v in draws]
+    assert draws == [plain.inputs(i) for i in range(plain.total_runs)]  # adding faults moves no other draw
+    assert set(faults) == {"none", "weak_x", "no_damping"} and 0.4 < faults.count("none") / len(faults) < 0.6
+    i = faults.index("no_damping")
+    params = spec.overrides(spec.inputs(i)[1])
+    assert params["detumble.Kp[2]"] == params["detumble.Kp[3]"] == 0.0 and "fault" not in params
+    assert "detumble.Kp[2]" not in spec.overrides(spec.inputs(faults.index("none"))[1])
+    small = _spec(tmp_path, (DETUMBLE + FAULTS).format(system=ssp_paths["detumble"], runs=2), "small.toml")
+    summary = run_campaign(small, tmp_path / "out", workers=1)
+    rows = _rows(tmp_path / "out")
+    assert [r["fault"] for r in rows] == [small.inputs(i)[1]["fault"] for i in range(4)]
+    assert sum(summary["faults"].values()) == 4
+    for change, pattern in ((("probability = 0.5", "probability = 1.5"), r"probability = 1.5: expected a fraction"),
+                            (("[faults.cases.weak_x]", "[faults.cases.none]"), r"faults.cases.none: \"none\" names")):
+        with pytest.raises(SSPError, match=pattern):
+            _spec(tmp_path, (DETUMBLE + FAULTS.replace(*change)).format(system=ssp_paths["detumble"], runs=2), "b.toml")
+    misnamed = _spec(tmp_path, (DETUMBLE + FAULTS.replace('"detumble.Kp[1]"', '"detumble.Kq[1]"')).format(
+        system=ssp_paths["detumble"], runs=2), "b.toml")
+    with pytest.raises(SSPError, match=r"faults.cases.weak_x: .*Kq"):
+        run_campaign(misnamed, tmp_path / "bad", workers=1)
+    assert not (tmp_path / "bad" / "runs.parquet").exists()

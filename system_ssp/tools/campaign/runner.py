@@ -44,7 +44,7 @@ from ...master.names import near, split_name
 from ...master.planning import make_plan
 from ...master.plotting import TIME_UNITS, read_result
 from ..console import ArgumentParser, positive_int, run_index, add_console_arguments, console_settings
-from .spec import load_spec
+from .spec import FAULT, load_spec
 from . import worker as worker_module
 from .worker import run_batch, run_one
 
@@ -73,7 +73,7 @@ def _write_rows(path, rows, columns):
 
 
 def _columns(spec):
-    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
+    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions] + ([FAULT] if spec.faults else [])
     return ["run", "seed"] + inputs + [m.name for m in spec.metrics] + ["status", "error", "wall_s"]
 
 
@@ -168,13 +168,17 @@ def _client(workers, scheduler):
 
 
 def _spec_key(spec, name):
-    """Where the spec names `name`: parameters.x, dispersions.x, sweep.x or metrics.<metric>."""
+    """Where the spec names `name`: parameters.x, dispersions.x, sweep.x, faults.cases.<case> or
+    metrics.<metric>."""
     if name in spec.parameters:
         return f"parameters.{name}"
     if any(d.name == name or name in d.also for d in spec.dispersions):
         return f"dispersions.{next(d.name for d in spec.dispersions if d.name == name or name in d.also)}"
     if any(n == name for n, _ in spec.sweeps):
         return f"sweep.{name}"
+    case = next((c for c, values in (spec.faults.cases.items() if spec.faults else ()) if name in values), None)
+    if case is not None:
+        return f"faults.cases.{case}"
     metric = next((m.name for m in spec.metrics if m.variable == name), None)
     return f"metrics.{metric}" if metric else None
 
@@ -193,8 +197,14 @@ def check_against_system(spec):
                 raise SSPError(f"{spec.path}: metrics.{m.name}: duration:{m.mode}: "
                                + (f"the system has no nc:Schedule mode {m.mode!r}{near(m.mode, mode_names)} (modes: "
                                   f"{', '.join(mode_names)})" if mode_names else "the system has no nc:Schedule"))
-        for point in range(len(spec.points)):
+        # each sweep point, and each fault case with the first point's draws: a bad name anywhere
+        # is refused before any run
+        cases = [(point, None) for point in range(len(spec.points))]
+        cases += [(0, name) for name in (spec.faults.cases if spec.faults else ())]
+        for point, fault in cases:
             _, values = spec.inputs(point * spec.runs)
+            if fault is not None:
+                values[FAULT] = fault
             options = RunOptions(stop_time=spec.stop_time, step_size=spec.step_size,
                                  parameter_sets=tuple(spec.parameter_sets), parameters=spec.overrides(values),
                                  outputs=record)
@@ -418,6 +428,8 @@ def summarize(spec, rows, units=None):
             s["metrics"][m.name] = {"n": len(ok), "values": values[:20]}
     errors = Counter(r["error"] for r in rows if r["status"] != "ok" and r.get("error"))
     s["errors"] = [{"error": e, "runs": n} for e, n in errors.most_common(3)]
+    if spec.faults:  # runs per fault case ("none": no fault)
+        s["faults"] = dict(sorted(Counter(r.get(FAULT, "none") for r in rows).items()))
     s["min_success"] = spec.min_success
     ops = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal}
     for name, metric, op, threshold in spec.probabilities:
@@ -444,6 +456,8 @@ def table(s):
                      f"({p['k']}/{p['n']})  {name}")
     for e in s.get("errors", []):
         lines.append(f"  {e['runs']} run(s) failed with: {e['error']}")
+    if s.get("faults"):
+        lines.append("  fault cases: " + ", ".join(f"{name} {n}" for name, n in s["faults"].items()))
     return "\n".join(lines)
 
 

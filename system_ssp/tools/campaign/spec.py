@@ -35,7 +35,9 @@ CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_
                  "keep_timeseries", "extends",
                  "min_success",
                  "description"}
-TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities"}
+TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities", "faults"}
+FAULT = "fault"  # the result column naming a run's fault case ("none" without one)
+FAULT_STREAM = 1  # the fault draw's random stream: adding [faults] leaves every other draw as it was
 
 
 @dataclass(frozen=True)
@@ -61,6 +63,21 @@ class Dispersion:
             raise SSPError(f"dispersion {self.name}: truncnormal bounds hold almost no probability")
         values = a["values"]
         return values[int(rng.integers(len(values)))]
+
+
+@dataclass(frozen=True)
+class Faults:
+    """[faults]: in each run, with `probability`, one of the `cases` (equally likely), each a set of
+    parameter values (component.variable = value) that injects it."""
+    probability: float
+    cases: dict  # name -> {parameter: value}
+
+    def draw(self, rng):
+        """The run's case name, or "none"."""
+        if rng.uniform() >= self.probability:
+            return "none"
+        names = list(self.cases)
+        return names[int(rng.integers(len(names)))]
 
 
 @dataclass(frozen=True)
@@ -92,6 +109,7 @@ class CampaignSpec:
     sweeps: list = field(default_factory=list)  # [(name, [values])]
     metrics: list = field(default_factory=list)  # [Metric]
     probabilities: list = field(default_factory=list)  # [(name, metric, op, threshold)]
+    faults: Optional[Faults] = None
     text: str = ""  # the spec file as read (stored beside the results)
 
     @property
@@ -114,6 +132,9 @@ class CampaignSpec:
         rng = np.random.default_rng(ss)
         for d in self.dispersions:
             values[d.name] = d.draw(rng)
+        if self.faults is not None:
+            values[FAULT] = self.faults.draw(np.random.default_rng(
+                np.random.SeedSequence(self.seed, spawn_key=(index, FAULT_STREAM))))
         return int(ss.generate_state(1)[0]), values
 
     def recorded(self):
@@ -127,7 +148,9 @@ class CampaignSpec:
         for d in self.dispersions:
             for other in d.also:
                 out[other] = values[d.name]
-        out.update({k: v for k, v in values.items() if not k.startswith("@")})
+        out.update({k: v for k, v in values.items() if not k.startswith("@") and k != FAULT})
+        if values.get(FAULT, "none") != "none":
+            out.update(self.faults.cases[values[FAULT]])
         return out
 
 
@@ -218,6 +241,8 @@ def load_spec(path):
     twice = sorted({n for n in names if names.count(n) > 1} | (set(names) & set(spec.parameters)))
     if twice:
         raise SSPError(f"{path}: {', '.join(twice)}: set more than once (parameters, dispersions, sweeps)")
+    if "faults" in doc:
+        spec.faults = _faults(path, doc["faults"])
     metrics = doc.get("metrics", {})
     if not metrics:
         raise SSPError(f"{path}: needs a [metrics] table (name = \"stop_time\", \"final:comp.var\", ...)")
@@ -287,6 +312,24 @@ def _campaign_table(path, c, text):
         spec.helper = c["helper"]
     spec.description = str(c.get("description", ""))
     return spec
+
+
+def _faults(path, d):
+    """[faults] probability = p, and [faults.cases.<name>] tables of component.variable = value."""
+    if not isinstance(d, dict) or set(d) != {"probability", "cases"}:
+        raise SSPError(f"{path}: [faults] needs exactly probability = a fraction and [faults.cases.<name>] tables")
+    p = _number(path, "faults.probability", d["probability"], low=0)
+    if p > 1:
+        raise SSPError(f"{path}: faults.probability = {d['probability']!r}: expected a fraction in [0, 1]")
+    cases = d["cases"]
+    if not isinstance(cases, dict) or not cases:
+        raise SSPError(f"{path}: [faults.cases] needs at least one [faults.cases.<name>] table")
+    for name, values in cases.items():
+        if name == "none":
+            raise SSPError(f"{path}: faults.cases.none: \"none\" names the runs without a fault; pick another name")
+        if not isinstance(values, dict) or not values or any(isinstance(v, (dict, list)) for v in values.values()):
+            raise SSPError(f"{path}: [faults.cases.{name}] holds component.variable = value pairs (at least one)")
+    return Faults(p, {name: dict(values) for name, values in cases.items()})
 
 
 def _dispersions(path, name, d, helper):
