@@ -9,8 +9,10 @@ campaigns extend the 420 km one) through the campaign runner on Dask.
 Prints the success rate (with its 95 % Wilson interval), the share of runs that burned their
 whole budget and re-entered within 5 years of the burn, and the distribution (min, 5th, 50th,
 95th percentile, max) of each phase's duration, the RCS propellant and the lifetime after the
-burn; and the wall time per run against the campaign's (parallel efficiency). The results
-folder keeps runs.parquet and the figures; a rerun with the same --out resumes.
+burn; per fault case (one fault in a fifth of the runs) how many de-orbited, ended in the
+documented safe state or neither; and the wall time per run against the campaign's (parallel
+efficiency). The results folder keeps runs.parquet and the figures; a rerun with the same --out
+resumes.
 """
 import argparse
 import dataclasses
@@ -59,14 +61,22 @@ def main():
     wall = time.perf_counter() - t0
     rows = sorted(_read_rows(Path(args.out)), key=lambda r: r["run"])
     ok = [r for r in rows if r["status"] == "ok"]
+    safe = [r for r in ok if r["safe_reason"]]  # the de-orbit abandoned for the safe state (no attitude)
+    ok = [r for r in ok if not r["safe_reason"]]  # the runs that flew the de-orbit
     good = [r for r in ok if r["budget_spent"] and r["reentered"] and not r["detumble_timeouts"]
             and not r["slew_timeouts"] and (r["end_s"] - r["burn_start_s"]) < 5 * YEAR]
     lo, hi = wilson(len(good), len(rows))
     print(f"{len(rows)} runs: {summary['ok']} ran, {summary['failed']} failed, {summary['timeout']} timed out")
     print(f"de-orbit success (burned the budget, no phase timeout, re-entry < 5 years after the burn): "
-          f"{len(good)}/{len(rows)} = {len(good) / len(rows):.1%} (95 % interval {lo:.1%} - {hi:.1%})")
+          f"{len(good)}/{len(rows)} = {len(good) / len(rows):.1%} (95 % interval {lo:.1%} - {hi:.1%}); "
+          f"{len(safe)} in the safe state (no attitude, no burn)")
+    for case in sorted({r["fault"] for r in rows}):
+        runs = [r for r in rows if r["fault"] == case]
+        print(f"  fault {case}: {len(runs)} runs, {sum(r in good for r in runs)} de-orbited, "
+              f"{sum(r in safe for r in runs)} in the safe state, {sum(r['bias_resets'] or 0 for r in runs)} bias "
+              f"resets, {sum(r not in good and r not in safe for r in runs)} neither")
     for r in rows:
-        if r not in good:
+        if r not in good and r not in safe:
             print(f"  run {r['run']}: {r['status']} {r.get('error', '')[:160]}")
     print(f"  {'':<34}{'min':>10}{'p5':>10}{'p50':>10}{'p95':>10}{'max':>10}")
     for label, (start, end, unit) in PHASES.items():

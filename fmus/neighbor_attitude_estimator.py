@@ -13,6 +13,10 @@ sensors, the outputs after the step are the estimate at t + h; in a Jacobi maste
 `truth_feedback` (a fidelity choice, e.g. the thesis' parameter set): the controller-facing
 outputs q_est_BN, omega_est_B and omega_dot_est_B are the truth inputs of the step (the filter
 does not run), so controllers wired to the estimator fly on the true state.
+
+Fault detection (appended last): with `fault_window` > 0 the mean normalized innovation squared
+over that many vector updates is watched once the bias is learned; above `fault_limit` the gyro
+bias is reopened and learned again (mekf.InnovationMonitor), and `bias_resets` counts it.
 """
 import math
 
@@ -94,6 +98,16 @@ class AttitudeEstimator(NeighborSlave):
         self.output("nees_over_fraction", lambda: self.model.consistency.over_fraction, "1",
                     "Share of the steps since the first fix with the NEES above its 95 % bound 7.81 (0.05 when "
                     "consistent)")
+        self.parameter("fault_window", 0, None,
+                       "Fault detection: vector updates over which the mean normalized innovation squared is watched "
+                       "(>= 0; 0: off)", int)
+        self.parameter("fault_limit", 3.64, "1",
+                       "Fault detection: the window's mean normalized innovation squared above which the gyro bias is "
+                       "reopened (> 0; 3.64: probability 1e-6 for a consistent filter and a window of 100)")
+        self.output("bias_resets", lambda: self.model.innovations.detections, None,
+                    "Times the innovations contradicted the filter and the gyro bias was reopened (a bias jump)", int)
+        self.output("innovation_largest", lambda: self.model.innovations.largest, "1",
+                    "Largest window mean of the normalized innovation squared seen while watched (2 when consistent)")
 
     def build_model(self):
         v = self.values
@@ -105,7 +119,8 @@ class AttitudeEstimator(NeighborSlave):
         return mekf.AttitudeEstimator(v["nadir_sigma"], v["sun_sigma"], sigma_v, v["bias_walk"], v["sigma_bias0"],
                                       v["min_separation"], inertia=self.inertia(rigid_body.box_inertia),
                                       accel_sigma=v["accel_sigma"], update_interval=v["update_interval"],
-                                      coarse_sun_sigma=v["coarse_sun_sigma"] if v["use_coarse_sun"] else None)
+                                      coarse_sun_sigma=v["coarse_sun_sigma"] if v["use_coarse_sun"] else None,
+                                      fault_window=v["fault_window"], fault_limit=v["fault_limit"])
 
     def _q(self):
         return self._outputs()["q"]

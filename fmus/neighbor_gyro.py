@@ -1,7 +1,9 @@
 """FMU `Gyro` (instance `gyro`): 3-axis rate gyro with bias and seeded white noise.
 
 Wraps components.sensing.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
-communication step, drawn in do_step; the output depends directly on the true rate.
+communication step, drawn in do_step; the output depends directly on the true rate. A fault
+(appended last): `bias_jump` added to the bias once the gyro has operated `jump_time` seconds (the
+sum of its steps; zero jump: none).
 """
 from neighbor_fmu_support import NeighborSlave
 
@@ -26,10 +28,16 @@ class Gyro(NeighborSlave):
         self.parameter("sigma_sample_time", 0.0, "s",
                        "Sampling step at which sigma holds, >= 0; 0: every sample has sigma. Otherwise a sample at the "
                        "communication step h has sigma sqrt(sigma_sample_time / h) (white noise of fixed density)")
+        self.parameter_array("bias_jump", [0.0, 0.0, 0.0], "rad/s",
+                             "Fault: bias shift added from jump_time on (a shock or temperature step; zero: no fault)")
+        self.parameter("jump_time", 0.0, "s",
+                       "Operating time (the sum of the gyro's steps: its powered time in the mission) from which "
+                       "bias_jump applies (>= 0)")
 
     def build_model(self):
         return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"],
-                            self.values["sigma_sample_time"])
+                            self.values["sigma_sample_time"], self.vector("bias_jump", 3),
+                            self.values["jump_time"])
 
     def _measure(self):
         return self.model.measure(self.vector("omega_BN_B", 3))

@@ -42,6 +42,9 @@ APPENDED_PARAMETERS = (
     ("attitude_determination_timeout", "s", float,
      "After this long in attitude determination without attitude_valid the detumble starts anyway (it needs rates "
      "only; >= 0; 0: wait for a valid attitude)"),
+    ("safe_without_attitude", None, bool,
+     "Never start the slew or the burn without attitude_valid: abandon the de-orbit for the safe state (monitoring, "
+     "no thrust, safe_reason 1)"),
 )
 INPUTS = (
     ("heartbeat", None, bool, "Host spacecraft heartbeat present (HostSpacecraft.heartbeat)"),
@@ -110,6 +113,9 @@ class MissionManager(NeighborSlave):
         self.output("determination_timeouts", lambda: self.model.determination_timeouts, None,
                     "Attitude determinations that ended at attitude_determination_timeout without a valid attitude",
                     int)
+        self.output("safe_reason", lambda: self.model.safe_reason, None,
+                    "Why the de-orbit was abandoned for the safe state: 0 it was not, 1 no valid attitude for the slew "
+                    "or the burn", int)
 
     def _powered(self):
         model = self.model

@@ -8,7 +8,9 @@ the remaining fraction (mass and burn_time exact). Thrust, flow and `burning` de
 `burn_enable` and are held by the master over a step (zero-order hold), so in the crossing step
 the orbit sees full thrust for the whole step, and zero from the next one. `mass`,
 `propellant_used`, `propellant_remaining`, `burn_time` and `budget_spent` are states at the
-communication point. The orbit FMUs take `mass` and `F_thrust_B` as inputs.
+communication point. The orbit FMUs take `mass` and `F_thrust_B` as inputs. `axial_off_time`
+(appended last) is the thruster FMU's running total of off-pulsed thruster-seconds: the thrust
+it took away since the previous step is taken out of this step's thrust and flow (`on_fraction`).
 """
 from neighbor_fmu_support import NeighborSlave
 
@@ -54,6 +56,10 @@ class Propulsion(NeighborSlave):
                     "True once the propellant budget is used up (thrust stays off)", bool)
         self.input("rcs_propellant", 0.0, "kg", "Propellant the RCS thrusters have drawn from the same tank (>= 0), "
                    "from the thruster FMU; lowers the mass")
+        self.input("axial_off_time", 0.0, "s", "Running total of the time these thrusters were switched off for "
+                   "attitude control (off-pulsing), summed over the thrusters, from the thruster FMU")
+        self.output("on_fraction", lambda: self.model.on_fraction, "1",
+                    "Fraction of the thrust and flow applied over the current step (1 unless off-pulsed)")
 
     def build_model(self):
         v = self.values
@@ -61,5 +67,5 @@ class Propulsion(NeighborSlave):
                                         v["propellant_budget"], self.vector("axis_B", 3))
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.values["burn_enable"], step_size)
+        self.model.step(self.values["burn_enable"], step_size, self.values["axial_off_time"])
         return True

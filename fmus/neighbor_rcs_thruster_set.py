@@ -7,7 +7,10 @@ the firing thrusters, the minimum on-time, the propellant thruster by thruster (
 connectors as the pair model `RcsThrusters` (torque_cmd_B in; torque_B, thrust_flag,
 torque_level, fire_time, fire_time_total, propellant_mass out), so a system swaps one for the
 other by replacing the component; in addition the net RCS force, and `axial_firing` (the burn)
-adds the axial thrusters' torque, a disturbance when they are misaligned.
+adds the axial thrusters' torque, a disturbance when they are misaligned. With `off_pulsing` (appended
+last) the y and z torques in the burn come from switching axial thrusters off (the RCS y and z pairs
+stay off); `axial_off_time`, the thruster-seconds switched off, goes to the propulsion, which takes
+that thrust out of the burn.
 """
 from neighbor_fmu_support import NeighborSlave
 
@@ -63,12 +66,17 @@ class RcsThrusterSet(NeighborSlave):
                           "Net force of the firing RCS thrusters in B (zero for aligned pairs; the axial thrusters' "
                           "force is the propulsion's)",
                           depends_on=command + (AXIAL_FIRING,))
+        self.parameter("off_pulsing", False, None,
+                       "In the burn, y and z torques by switching axial thrusters off instead of firing RCS pairs",
+                       bool)
+        self.output("axial_off_time", lambda: self.model.axial_off_time, "s",
+                    "Time the axial thrusters were switched off in the burn (off-pulsing), summed over the thrusters")
 
     def build_model(self):
         v = self.values
         return thruster_set.ThrusterSet(
             v["thrust"], v["edge_a"], v["edge_c"], v["Isp"], v["g0"], v["min_on_time"], self.vector("force_error", N),
-            list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))))
+            list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))), v["off_pulsing"])
 
     def _flags(self):
         return self.model.flags(self.vector("torque_cmd_B", 3))
@@ -77,6 +85,6 @@ class RcsThrusterSet(NeighborSlave):
         return self.model.force_and_torque(self.feedthrough(self._flags), self.values["axial_firing"])
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.feedthrough(self._flags), step_size)
+        self.model.step(self.feedthrough(self._flags), step_size, self.values["axial_firing"])
         self._input_version += 1  # the minimum on-time changed: outputs computed before the step are stale
         return True

@@ -3,7 +3,8 @@ and eclipse.
 
 Wraps components.sensing.sensors.SunSensor (thesis 3.3.1, Solar MEMS nanoSSOC-D60 [43]). The noise
 sample is drawn once per communication step in do_step; outputs depend directly on the
-inputs. The generator state is part of the FMU state.
+inputs. The generator state is part of the FMU state. A fault (appended last): with `failed` the
+sensor gives no valid sample once it has operated `fail_time` seconds (the sum of its steps).
 """
 import math
 
@@ -34,10 +35,15 @@ class SunSensor(NeighborSlave):
                           "Measured unit vector toward the Sun in B (zeros when invalid)", depends_on=deps)
         self.output("valid", lambda: self.feedthrough(self._measure)[1], None,
                     "Sun measurement valid: sunlit and the Sun inside the field of view", bool, depends_on=deps)
+        self.parameter("failed", False, None,
+                       "Fault: the sensor gives no valid sample from fail_time on (dead, or blinded for good)", bool)
+        self.parameter("fail_time", 0.0, "s",
+                       "Operating time (the sum of the sensor's steps: its powered time in the mission) of the "
+                       "failure when failed (>= 0)")
 
     def build_model(self):
         return sensors.SunSensor(self.vector("boresight_B", 3), self.values["half_fov"], self.values["sigma"],
-                                 self.values["seed"])
+                                 self.values["seed"], self.values["fail_time"] if self.values["failed"] else None)
 
     def _measure(self):
         return self.model.measure(self.vector("r_SN_N", 3), self.vector("r_BN_N", 3), self.vector("q_BN", 4),

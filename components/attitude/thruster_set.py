@@ -23,6 +23,18 @@ of its direction, two angles about the axes perpendicular to it), so the torques
 force of a pair are those of real hardware. A thruster, once fired, stays on for at least
 `min_on_time` (the minimum impulse bit); the propellant is m = sum_i F_i t_i / (Isp g0) (Eq. 74
 per thruster; with nominal forces, 2 F t per pair as the thesis counts it).
+
+Off-pulsing (`off_pulsing`, off by default: the thesis fires RCS pairs for every axis). In the
+burn a y or z torque can come from switching axial thrusters off instead of firing an RCS pair:
+an axial thruster at (x, y, z) pushing +x adds (0, z F, -y F) to the torque, so switching it off
+adds (0, -z F, y F). A y command of sign s switches off the two on the z = -s a/2 side, a z
+command the two on the y = s a/2 side (2 (a/2) F = a F about the axis, the y/z pair's F c/3 for
+the thesis' module a = c/3), both together the one thruster on the diagonal (half of that on each
+axis). The RCS y and z pairs then stay off in the burn; x always comes from its pairs. The torque
+is that of the real (misaligned, force-error) thrusters left on. The thrust lost is counted in
+thruster-seconds (`axial_off_time`): the propulsion takes it out of the burn's thrust and flow, so
+the burn lasts a little longer on the same propellant and the RCS spends none on y and z. This is
+how a spacecraft trims a thrust-axis misalignment during a burn at no propellant cost.
 """
 import math
 
@@ -59,6 +71,10 @@ def thesis_layout(a=0.1, c=0.3):
     return out
 
 
+def _sign(x):
+    return (x > 0) - (x < 0)
+
+
 def _misaligned(direction, angles):
     """`direction` turned by the small angles (rad) about the two axes perpendicular to it."""
     d = tuple(direction)
@@ -78,11 +94,12 @@ class ThrusterSet:
 
     force: nominal force of one thruster (N); force_error: per-thruster fraction (16 values, e.g.
     0.02 = 2 % strong); misalignment: per-thruster pair of small angles (rad); min_on_time (s);
-    isp, g0 for the propellant. Commands are -1/0/+1 per axis (the controllers' thrust flags)."""
+    isp, g0 for the propellant; off_pulsing: y and z torques in the burn from the axial thrusters
+    (module docstring). Commands are -1/0/+1 per axis (the controllers' thrust flags)."""
 
     def __init__(self, force=SPACECRAFT.rcs_thrust, a=SPACECRAFT.edge_a, c=SPACECRAFT.edge_c, isp=SPACECRAFT.isp,
                  g0=SPACECRAFT.g0, min_on_time=0.0, force_error=None,
-                 misalignment=None):
+                 misalignment=None, off_pulsing=False):
         self.layout = thesis_layout(a, c)
         n = len(self.layout)
         self.force = checks.positive("thrust", force, "N")
@@ -112,8 +129,12 @@ class ThrusterSet:
                 self.pairs.setdefault(role, []).append(i)
         self.axial = [i for i, (_, _, _, role) in enumerate(self.layout) if role == "axial"]
         self.levels = tc.pair_torques(self.force, a, c)  # the nominal pair torques (Eq. 16)
+        self.off_pulsing = bool(off_pulsing)
+        # (y sign, z sign) of the torque each axial thruster adds when switched off: (-z, y)
+        self._off_signs = {i: (-_sign(self.layout[i][1][2]), _sign(self.layout[i][1][1])) for i in self.axial}
         self.fire_time = [0.0] * n
         self.on_left = [0.0] * n  # minimum on-time still owed after a firing started
+        self.axial_off_time = 0.0  # thruster-seconds the axial thrusters were switched off in the burn
 
     def flags(self, command):
         """-1/0/+1 per axis: nearest available level to the commanded torque."""
@@ -124,38 +145,55 @@ class ThrusterSet:
         return [0.5 * sum(self.fire_time[i] for key, idx in self.pairs.items() if key[0] == axis for i in idx)
                 for axis in range(3)]
 
-    def firing(self, flags):
+    def firing(self, flags, axial=False):
         """Indices of the RCS thrusters the pair flags (-1/0/1 per axis) fire, with the ones still
-        inside their minimum on-time."""
+        inside their minimum on-time; in the burn with off-pulsing, the x pairs only."""
         on = {i for i in range(len(self.layout)) if self.on_left[i] > 0.0}
+        pulsing = axial and self.off_pulsing
         for axis, f in enumerate(flags):
             if f not in (-1, 0, 1):
                 raise ValueError(f"thrust flag {axis + 1} = {f!r} must be -1, 0 or 1")
-            if f:
+            if f and not (pulsing and axis > 0):
                 on.update(self.pairs[(axis, int(f))])
         return sorted(on)
 
+    def axial_off(self, flags, axial=False):
+        """Indices of the axial thrusters switched off for the y and z flags (none unless
+        off-pulsing in the burn): the side pair for one axis, the diagonal one for both."""
+        if not (axial and self.off_pulsing):
+            return ()
+        fy, fz = int(flags[1]), int(flags[2])
+        if not (fy or fz):
+            return ()
+        return tuple(i for i in self.axial
+                     if (not fy or self._off_signs[i][0] == fy) and (not fz or self._off_signs[i][1] == fz))
+
     def force_and_torque(self, flags, axial=False):
         """(net force of the RCS thrusters firing for `flags` (N, B), torque (N.m, B)), the torque
-        with the four axial thrusters' when `axial` (the burn: their force is the propulsion's;
-        their torque, zero when aligned, is a disturbance here)."""
+        with the axial thrusters' left on when `axial` (the burn: their force is the propulsion's;
+        their torque, zero when aligned and all on, is a disturbance here)."""
         fx = fy = fz = tx = ty = tz = 0.0
-        for i in self.firing(flags):
+        for i in self.firing(flags, axial):
             f, t = self.forces[i], self.torques[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
-        for i in self.axial if axial else ():
-            t = self.torques[i]
-            tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
+        if axial:
+            off = self.axial_off(flags, axial)
+            for i in self.axial:
+                if i not in off:
+                    t = self.torques[i]
+                    tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
         return (fx, fy, fz), (tx, ty, tz)
 
-    def step(self, flags, h):
-        """Advance h seconds with `flags` held: firing times and the minimum on-time."""
-        for i in self.firing(flags):
+    def step(self, flags, h, axial=False):
+        """Advance h seconds with `flags` (and `axial`, the burn) held: firing times, the minimum
+        on-time and the axial thrusters' off time."""
+        for i in self.firing(flags, axial):
             started = self.on_left[i] <= 0.0
             self.fire_time[i] += h
             left = (self.min_on_time if started else self.on_left[i]) - h
             self.on_left[i] = max(0.0, left)
+        self.axial_off_time += h * len(self.axial_off(flags, axial))
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
@@ -163,8 +201,9 @@ class ThrusterSet:
         return impulse / (self.isp * self.g0)
 
     def get_state(self):
-        return {"fire_time": list(self.fire_time), "on_left": list(self.on_left)}
+        return {"fire_time": list(self.fire_time), "on_left": list(self.on_left), "axial_off_time": self.axial_off_time}
 
     def set_state(self, state):
         self.fire_time = list(state["fire_time"])
         self.on_left = list(state["on_left"])
+        self.axial_off_time = float(state["axial_off_time"])

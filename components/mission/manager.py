@@ -28,6 +28,11 @@ Modes (`mode`):
                     fully damped, or the burn with the tracking controller pulling the attitude
                     in. Never waiting until the battery is empty; `detumble_timeouts` and
                     `slew_timeouts` count what happened. The thesis' phases end long before.
+                    With `safe_without_attitude`, a slew or burn is never started without
+                    attitude_valid (a burn in an unknown direction may raise the orbit): the
+                    de-orbit is abandoned for MONITORING, the safe state (no thrust, the position
+                    beaconed in contacts for the operators), with `safe_reason` 1. This is where a
+                    determination timeout (no Sun sensor left) ends after the detumble.
   6 MONITORING      microprocessor quiescent; during ground contacts GPS + UHF on to beacon the
                     position (and downlink stored data) until the battery is empty or re-entry.
                     beacon_interval (default 0: every contact, as Appendix I) lets operators
@@ -75,6 +80,7 @@ from .power_bus import LOAD_NAMES
 IDLE, GRACE, AWAITING, CONTACT, DEORBIT, MONITORING, END = MissionMode
 PHASE_NONE, ATTITUDE_DETERMINATION, DETUMBLE, SLEW, BURN = DeorbitPhase
 END_NONE, END_BATTERY, END_REENTERED = EndReason
+SAFE_NONE, SAFE_NO_ATTITUDE = 0, 1  # safe_reason: why the de-orbit was abandoned for the safe state
 
 NO_EVENT = 1e300  # next_event_time when nothing is scheduled
 
@@ -97,6 +103,7 @@ PARAMETER_DEFAULTS = {
     "slew_timeout": 600.0,
     "phase_retries": 1,
     "attitude_determination_timeout": 0.0,
+    "safe_without_attitude": False,
 }
 INPUT_DEFAULTS = {
     "heartbeat": True, "ground_contact": False, "ground_command": False, "detumble_done": False,
@@ -154,6 +161,7 @@ def check_parameters(params):
         raise ValueError(f"initial_phase = {p['initial_phase']!r} must be one of 1..4 ({PHASE_TABLE})")
     p["initial_mode"], p["initial_phase"] = int(p["initial_mode"]), int(p["initial_phase"])
     p["listen_while_awaiting"] = bool(p["listen_while_awaiting"])
+    p["safe_without_attitude"] = bool(p["safe_without_attitude"])
     return p
 
 
@@ -192,6 +200,7 @@ class MissionManager:
         self.heartbeat_lost_at = NO_EVENT  # time of the check that found the heartbeat missing
         self.detumble_timeouts = self.slew_timeouts = 0  # phase timeouts so far (retries included)
         self.determination_timeouts = 0
+        self.safe_reason = SAFE_NONE
         self.attempt = 0  # retries of the current phase
         self.phase_published = t0  # end of the step that first output the current phase
         mode = self.p["initial_mode"]
@@ -284,15 +293,25 @@ class MissionManager:
             if self.phase == ATTITUDE_DETERMINATION and self.att_det_waiting and x["attitude_valid"]:
                 self._enter_phase(DETUMBLE, t)
             elif started and self.phase == DETUMBLE and x["detumble_done"]:
-                self._enter_phase(SLEW, t)
+                self._maneuver(SLEW, t, x["attitude_valid"])
             elif started and self.phase == SLEW and x["slew_done"]:
-                self._enter_phase(BURN, t)
+                self._maneuver(BURN, t, x["attitude_valid"])
             elif started and self.phase == BURN and x["budget_spent"]:
                 self._enter(MONITORING, t)
                 self.contact_seen = False
                 self._monitor_contact(t, x["ground_contact"])
         elif mode == MONITORING:
             self._monitor_contact(t, x["ground_contact"])
+
+    def _maneuver(self, phase, t, attitude_valid):
+        """Into the slew or the burn; without a valid attitude (and safe_without_attitude), the
+        safe state instead."""
+        if self.p["safe_without_attitude"] and not attitude_valid:
+            self._enter(MONITORING, t)
+            self.safe_reason = SAFE_NO_ATTITUDE
+            self.contact_seen = False
+        else:
+            self._enter_phase(phase, t)
 
     def _monitor_contact(self, t, contact):
         """Beacon in this contact? Decided when it starts, from beacon_interval."""
@@ -381,7 +400,7 @@ class MissionManager:
                 if self.attempt < self.p["phase_retries"]:
                     self._enter_phase(self.phase, te, retry=True)
                 else:  # the documented fallback: on with the next phase
-                    self._enter_phase(SLEW if self.phase == DETUMBLE else BURN, te)
+                    self._maneuver(SLEW if self.phase == DETUMBLE else BURN, te, x["attitude_valid"])
         self.t = max(t_end, self.t)
         if self.phase_published is None:
             self.phase_published = self.t
@@ -422,7 +441,7 @@ class MissionManager:
 
     # ---- state -----------------------------------------------------------------------------
     _STATE = ("t", "mode", "phase", "end_reason", "mode_entry", "phase_entry", "awake", "wake_end", "next_wake_k",
-              "attempt", "detumble_timeouts", "slew_timeouts", "determination_timeouts", "grace_end",
+              "attempt", "detumble_timeouts", "slew_timeouts", "determination_timeouts", "safe_reason", "grace_end",
               "att_det_end", "att_det_waiting", "confirmed", "in_contact",
               "contact_seen", "last_beacon", "heartbeat_lost_at", "phase_published")
 

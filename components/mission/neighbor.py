@@ -115,12 +115,13 @@ DEFAULT_GNC = "closed-loop"
 # What the mission records (rows per nc:Schedule mode) for its summary and figures.
 MISSION_RECORD: Tuple[str, ...] = (
     "mission.mode", "mission.phase", "mission.detumble_timeouts", "mission.slew_timeouts",
-    "mission.determination_timeouts", "estimator.initialized", "estimator.attitude_error",
-    "estimator.rate_error", *elements("estimator.sigma_attitude", 3), "estimator.nees_mean",
+    "mission.determination_timeouts", "mission.safe_reason", "estimator.bias_resets", "estimator.initialized",
+    "estimator.attitude_error", "estimator.rate_error", *elements("estimator.sigma_attitude", 3), "estimator.nees_mean",
     "estimator.nees_over_fraction",
     "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
     "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
-    "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "thrusters.propellant_mass",
+    "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "propulsion.on_fraction",
+    "thrusters.propellant_mass", "thrusters.axial_off_time",
     "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
     "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked",
     *elements("dynamics.omega_BN_B", 3), *elements("dynamics.euler123", 3),

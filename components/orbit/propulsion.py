@@ -31,6 +31,15 @@ start of a step and held (zero-order hold) over it: in the step that crosses the
 the full thrust for the whole step, so a connected orbit model receives at most one step's
 excess impulse n F (h - t) (0.05 N s at the thesis' 0.5 s burn step, 0.3 mm/s on 12 kg);
 from the next step on it is zero.
+
+Off-pulsing: the attitude control may switch some de-orbit thrusters off for short times in the
+burn (components.attitude.thruster_set). `step` takes their off time as a running total in
+thruster-seconds (`off_time`, from the thruster model); the fraction of the thrust the total
+took away since the previous step applies to this step's thrust and flow (`on_fraction`), so a
+model stepped more slowly than the attitude loop (every 0.495 s in the mission's burn) burns the
+attitude loop's average with one of its steps' delay, and the burn lasts longer on the same
+propellant. The off time of the step in which the budget runs out is not charged (at most one
+step's worth, a fraction of 0.5 s of thrust).
 """
 import math
 
@@ -238,6 +247,9 @@ class MainThrusters:
         self.used = 0.0
         self.burn_time = 0.0
         self.spent = False
+        self.on_fraction = 1.0  # of the thrust and flow, over the current step (off-pulsing)
+        self.off_seen = 0.0  # the thrusters' off time (thruster-seconds) at the previous step
+        self.last_h = 0.0  # the previous step's length: the window of the off time's change
 
     @property
     def thrust(self):
@@ -270,21 +282,30 @@ class MainThrusters:
         """Force on the spacecraft in B (N): n F axis_B while burning, else zero."""
         if not self.burning(burn_enable):
             return (0.0, 0.0, 0.0)
-        f = self.thrust
+        f = self.thrust * self.on_fraction
         return tuple(f * x for x in self.axis_B)
 
     def mdot(self, burn_enable):
         """Propellant flow (kg/s, >= 0) while burning, else 0."""
-        return self.mdot_burning if self.burning(burn_enable) else 0.0
+        return self.mdot_burning * self.on_fraction if self.burning(burn_enable) else 0.0
 
-    def step(self, burn_enable, h):
-        """Advance by h seconds with `burn_enable` held over the step."""
+    def step(self, burn_enable, h, off_time=None):
+        """Advance by h seconds with `burn_enable` held over the step; `off_time`: the thrusters'
+        running total of off-pulsed thruster-seconds (None: unchanged since the last step)."""
         h = float(h)
         if not (math.isfinite(h) and h >= 0.0):
             raise ValueError(f"step size h = {h!r} s must be finite and >= 0")
+        off = self.off_seen if off_time is None else float(off_time)
+        if not (math.isfinite(off) and off >= self.off_seen - 1e-9):
+            raise ValueError(f"off_time = {off_time!r} s must be a finite running total (>= {self.off_seen!r})")
+        window = self.n_thrusters * self.last_h
+        self.on_fraction = min(1.0, max(0.0, 1.0 - (off - self.off_seen) / window)) if window > 0.0 else 1.0
+        self.off_seen, self.last_h = off, h
         if not self.burning(burn_enable) or h == 0.0:
             return
-        rate = self.mdot_burning
+        rate = self.mdot_burning * self.on_fraction
+        if rate == 0.0:
+            return
         if rate * h >= self.remaining:
             self.burn_time += self.remaining / rate
             self.used = self.budget  # Appendix F: burn until m0 - m >= m_p
@@ -294,9 +315,13 @@ class MainThrusters:
             self.burn_time += h
 
     def get_state(self):
-        return {"used": self.used, "burn_time": self.burn_time, "spent": self.spent}
+        return {"used": self.used, "burn_time": self.burn_time, "spent": self.spent, "on_fraction": self.on_fraction,
+                "off_seen": self.off_seen, "last_h": self.last_h}
 
     def set_state(self, state):
         self.used = float(state["used"])
         self.burn_time = float(state["burn_time"])
         self.spent = bool(state["spent"])
+        self.on_fraction = float(state["on_fraction"])
+        self.off_seen = float(state["off_seen"])
+        self.last_h = float(state["last_h"])

@@ -92,7 +92,8 @@ class AttitudeMEKF:
         self.P = phi @ self.P @ phi.T + Qd
 
     def update(self, b_meas, r_ref, sigma):
-        """Fuse one measured unit vector b_meas (B) of the reference direction r_ref (N)."""
+        """Fuse one measured unit vector b_meas (B) of the reference direction r_ref (N). Returns
+        (normalized innovation squared y^T S^-1 y, |y|^2) of the update, y = b_meas - b_hat."""
         self._need()
         b = np.array(triad._unit(b_meas, "measured vector"))
         r = triad._unit(r_ref, "reference vector")
@@ -102,13 +103,27 @@ class AttitudeMEKF:
         H[:, :3] = _skew(b_hat)
         R = np.eye(3) * s * s
         S = H @ self.P @ H.T + R
-        K = self.P @ H.T @ np.linalg.inv(S)
-        dx = K @ (b - b_hat)
+        S_inv = np.linalg.inv(S)
+        K = self.P @ H.T @ S_inv
+        y = b - b_hat
+        dx = K @ y
         dq = rotations.quaternion_rate(self.q, dx[:3])  # 1/2 Xi(q) dtheta
         self.q = rotations.normalized(tuple(qi + di for qi, di in zip(self.q, dq)), "q")
         self.bias = self.bias + dx[3:]
         IKH = np.eye(6) - K @ H
         self.P = IKH @ self.P @ IKH.T + K @ R @ K.T
+        return float(y @ S_inv @ y), float(y @ y)
+
+    def reopen_bias(self, sigma_bias, attitude_variance=0.0):
+        """Forget what the filter learned of the bias (a fault changed it): its covariance back to
+        sigma_bias (rad/s) per axis, uncorrelated with the attitude, whose variance per axis grows
+        by attitude_variance (rad^2), the error the wrong bias has left."""
+        self._need()
+        sb = _sigma("sigma_bias", sigma_bias, "rad/s", positive=True)
+        self.P[3:, :] = 0.0
+        self.P[:, 3:] = 0.0
+        self.P[3:, 3:] = np.eye(3) * sb * sb
+        self.P[:3, :3] += np.eye(3) * _sigma("attitude_variance", attitude_variance, "rad^2")
 
     def attitude_sigma(self):
         """1-sigma attitude errors (rad) about the body axes: sqrt of the diagonal of P."""
@@ -243,6 +258,61 @@ class NeesMonitor:
 COVARIANCE_STEP = 0.1
 
 
+BIAS_LEARNED = 0.2  # of sigma_bias0: the fault monitor watches once every axis' bias sigma is below it
+
+
+class InnovationMonitor:
+    """Fault detection from the filter's own innovations (a gyro bias that jumps): the mean of the
+    normalized innovation squared (NIS, y^T S^-1 y) over the last `window` vector updates. A
+    sensor's error here is a rotation of N(0, sigma) about a random axis across the vector, so a
+    consistent filter's NIS is 2 chi-square(1) (mean 2; a Gaussian error per axis would give the
+    lighter-tailed chi-square(2)), and the mean of 100 of them exceeds `limit` = 3.64 with
+    probability 1e-6. A mean above the limit is a model the data contradict: the estimator then
+    reopens the bias (AttitudeMEKF.reopen_bias) and starts a new window. window 0: off."""
+
+    def __init__(self, window=0, limit=3.64):
+        if isinstance(window, bool) or int(window) != window or int(window) < 0:
+            raise ValueError(f"fault window = {window!r} must be an integer >= 0 (vector updates; 0: off)")
+        self.window = int(window)
+        self.limit = _sigma("fault limit", limit, "mean NIS", positive=True)
+        self.nis, self.squared = [], []
+        self.detections = 0
+        self.largest = 0.0  # the largest window mean seen (how close nominal flight comes to the limit)
+
+    def add(self, nis, squared, armed=True):
+        """Record one update; True when armed and the window's mean is above the limit (a
+        detection)."""
+        if not self.window:
+            return False
+        self.nis.append(nis)
+        self.squared.append(squared)
+        if len(self.nis) > self.window:
+            del self.nis[0], self.squared[0]
+        if len(self.nis) < self.window or not armed:
+            return False
+        mean = sum(self.nis) / self.window
+        self.largest = max(self.largest, mean)
+        if mean <= self.limit:
+            return False
+        self.detections += 1
+        return True
+
+    def error_variance(self):
+        """The mean |y|^2 / 2 over the window (rad^2 per axis): the attitude error behind it."""
+        return 0.5 * sum(self.squared) / max(1, len(self.squared))
+
+    def restart(self):
+        self.nis, self.squared = [], []
+
+    def get_state(self):
+        return {"nis": list(self.nis), "squared": list(self.squared), "detections": self.detections,
+                "largest": self.largest}
+
+    def set_state(self, state):
+        self.nis, self.squared = list(state["nis"]), list(state["squared"])
+        self.detections, self.largest = int(state["detections"]), float(state["largest"])
+
+
 class AttitudeEstimator:
     """TRIAD to start, then the MEKF (thesis section 3.3.1), and the rate filter: the estimator
     the controllers fly on.
@@ -261,13 +331,16 @@ class AttitudeEstimator:
        stands in for the fine one whenever the fine sensor does not see the Sun, in the fix and
        in the updates: on a tumbling host one narrow-field sensor may never see it;
     3. the gyro sample of now corrects the rate estimate and is held for the next step.
+    With `fault_window` > 0 the innovations are watched (InnovationMonitor): when the data
+    contradict the filter, the bias is reopened to sigma_bias0 and learned again (`innovations.detections`).
     So the estimate refers to the time of the measurements: the end of the step when the
     sensors were read after the truth advanced (a Gauss-Seidel master with the estimator after
     the rigid body and the sensors), its start otherwise (one step of latency)."""
 
     def __init__(self, nadir_sigma=math.radians(0.25), sun_sigma=math.radians(0.5) / 3.0,
                  sigma_v=5.5e-4 * math.sqrt(0.1), sigma_u=1e-6, sigma_bias0=1e-3, min_separation=math.radians(5.0),
-                 inertia=None, accel_sigma=5e-4, update_interval=0.0, coarse_sun_sigma=None):
+                 inertia=None, accel_sigma=5e-4, update_interval=0.0, coarse_sun_sigma=None, fault_window=0,
+                 fault_limit=3.64):
         self.triad = triad.AttitudeDetermination(nadir_sigma, sun_sigma, min_separation=min_separation)
         self.coarse_triad = None if coarse_sun_sigma is None else \
             triad.AttitudeDetermination(nadir_sigma, coarse_sun_sigma, min_separation=min_separation)
@@ -284,6 +357,7 @@ class AttitudeEstimator:
         self.cov_pending, self.cov_rate = 0.0, (0.0, 0.0, 0.0)  # covariance propagation gathered
         self.held_rate = None  # the gyro sample of the step's start
         self.consistency = NeesMonitor()  # against the truth, where a simulation gives it (check)
+        self.innovations = InnovationMonitor(fault_window, fault_limit)
         self.updated = {"nadir": -math.inf, "sun": -math.inf, "coarse": -math.inf}  # sensor -> time of its last update
         self.seen = {}  # sensor -> the sample it gave at the last step
 
@@ -339,9 +413,13 @@ class AttitudeEstimator:
                 updates.append(("coarse", coarse[0], sun_N, self.coarse_sigma))
             if updates or self.cov_pending >= COVARIANCE_STEP - 1e-9:
                 self._propagate_covariance()  # the covariance must be current before an update
+            # watched once the bias is learned (while it is being learned the filter adapts anyway)
+            armed = max(f.bias_sigma()) < BIAS_LEARNED * self.sigma_bias0
             for name, b, r, sigma in updates:
                 self._mark(name, b)
-                f.update(b, r, sigma)
+                if self.innovations.add(*f.update(b, r, sigma), armed):
+                    f.reopen_bias(self.sigma_bias0, self.innovations.error_variance())
+                    self.innovations.restart()
         self.held_rate = tuple(float(x) for x in omega_meas)
         self.rates.update(f.rate(self.held_rate), h)
 
@@ -378,7 +456,7 @@ class AttitudeEstimator:
         return nees
 
     def get_state(self):
-        return {"consistency": self.consistency.get_state(),
+        return {"consistency": self.consistency.get_state(), "innovations": self.innovations.get_state(),
                 "filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
                 "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
                 "held_rate": self.held_rate, "updated": dict(self.updated),
@@ -386,6 +464,7 @@ class AttitudeEstimator:
 
     def set_state(self, state):
         self.consistency.set_state(state["consistency"])
+        self.innovations.set_state(state["innovations"])
         self.filter.set_state(state["filter"])
         self.rates.set_state(state["rates"])
         self.time = float(state["time"])

@@ -138,10 +138,13 @@ class HorizonSensor(_VectorSensor):
 
 class SunSensor(_VectorSensor):
     """Sun vector in B from a digital sun sensor (thesis 3.3.1, Solar MEMS nanoSSOC-D60 [43]:
-    +-60 deg field of view, accuracy < 0.5 deg 3 sigma)."""
+    +-60 deg field of view, accuracy < 0.5 deg 3 sigma).
+
+    A fault: once the sensor has operated `fail_time` seconds (the sum of its steps; None: never),
+    no valid sample (a dead sensor, or one blinded for good, e.g. a degraded detector)."""
 
     def __init__(self, boresight_B=(1.0, 0.0, 0.0), half_fov=math.radians(60.0), sigma=math.radians(0.5) / 3.0,
-                 seed=0):
+                 seed=0, fail_time=None):
         b = finite_vector(boresight_B, 3, "boresight_B")
         if rotations.norm(b) == 0.0:
             raise ValueError("boresight_B must be a non-zero vector")
@@ -151,7 +154,26 @@ class SunSensor(_VectorSensor):
             raise ValueError(f"half_fov = {half_fov!r} must be in (0, pi] rad")
         self.half_fov = half_fov
         self.cos_half_fov = math.cos(half_fov)
+        self.fail_time = None if fail_time is None else check_sigma("fail_time", fail_time, "s")
+        self.time = 0.0
         super().__init__(sigma, seed)
+
+    @property
+    def failed(self):
+        return self.fail_time is not None and self.time >= self.fail_time - 1e-9
+
+    def step(self, h=None):
+        """The next noise sample, h seconds of operation after the last."""
+        if h is not None:
+            self.time += h
+        super().step(h)
+
+    def get_state(self):
+        return {**super().get_state(), "time": self.time}
+
+    def set_state(self, state):
+        super().set_state(state)
+        self.time = float(state["time"])
 
     def true_sun(self, r_SN_N, r_BN_N, q_BN):
         s = finite_vector(r_SN_N, 3, "r_SN_N")
@@ -167,9 +189,10 @@ class SunSensor(_VectorSensor):
         return rotations.dot(sun_B, self.boresight) >= self.cos_half_fov
 
     def measure(self, r_SN_N, r_BN_N, q_BN, sunlit=True):
-        """(sun_B, valid): valid when sunlit and the true Sun is inside the field of view."""
+        """(sun_B, valid): valid when sunlit, the true Sun is inside the field of view and the
+        sensor has not failed."""
         true_B = self.true_sun(r_SN_N, r_BN_N, q_BN)
-        if not sunlit or true_B is None or not self.in_fov(true_B):
+        if not sunlit or true_B is None or self.failed or not self.in_fov(true_B):
             return (0.0, 0.0, 0.0), False
         return self._measure(true_B), True
 
@@ -181,21 +204,37 @@ class Gyro(_Seeded):
     sampling step, and a sample at the communication step h has sigma sqrt(sigma_sample_time / h)
     (white rate noise of a fixed density over the Nyquist band): the same gyro sampled at 15 ms
     or 0.1 s has the same angle random walk, sigma sqrt(sigma_sample_time) in rad/s^0.5. Until
-    the first step (h unknown) the sample has sigma."""
+    the first step (h unknown) the sample has sigma.
 
-    def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0, sigma_sample_time=0.0):
+    A fault: `bias_jump` (rad/s) is added to the bias once the gyro has operated `jump_time`
+    seconds (the sum of its steps: a host that steps it only while it is powered counts its
+    powered time), a sudden bias shift such as a shock or a temperature step gives a MEMS gyro.
+    Zero (the default) is no fault."""
+
+    def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0, sigma_sample_time=0.0, bias_jump=(0.0, 0.0, 0.0),
+                 jump_time=0.0):
         self.bias = finite_vector(bias, 3, "bias")
         self.sigma = check_sigma("sigma", sigma, "rad/s")
         self.sigma_sample_time = check_sigma("sigma_sample_time", sigma_sample_time, "s")
+        self.bias_jump = finite_vector(bias_jump, 3, "bias_jump")
+        self.jump_time = check_sigma("jump_time", jump_time, "s")
         self.scale = self.sigma
+        self.time = 0.0
+        self.jumped = False
         super().__init__(seed)
 
     def _draw(self):
         return tuple(float(x) for x in self.rng.standard_normal(3))
 
     def step(self, h=None):
+        """The next sample, h seconds of operation after the last."""
         if self.sigma_sample_time > 0.0 and h is not None and h > 0.0:
             self.scale = self.sigma * math.sqrt(self.sigma_sample_time / h)
+        if h is not None:
+            self.time += h
+        if not self.jumped and any(self.bias_jump) and self.time >= self.jump_time - 1e-9:
+            self.jumped = True
+            self.bias = tuple(b + j for b, j in zip(self.bias, self.bias_jump))
         super().step(h)
 
     def measure(self, omega_BN_B):
@@ -204,11 +243,14 @@ class Gyro(_Seeded):
         return (w[0] + b[0] + s * n[0], w[1] + b[1] + s * n[1], w[2] + b[2] + s * n[2])
 
     def get_state(self):
-        return {**super().get_state(), "scale": self.scale}
+        return {**super().get_state(), "scale": self.scale, "time": self.time, "jumped": self.jumped,
+                "bias": list(self.bias)}
 
     def set_state(self, state):
         super().set_state(state)
-        self.scale = float(state.get("scale", self.sigma))
+        self.scale = float(state["scale"])
+        self.time, self.jumped = float(state["time"]), bool(state["jumped"])
+        self.bias = tuple(float(x) for x in state["bias"])
 
 
 class GpsReceiver(_Seeded):

@@ -182,7 +182,19 @@ def summarize(r, scenario, orbit):
     if int(d["mission.determination_timeouts"][-1]):
         faults.insert(0, "the attitude determination timed out without a valid attitude: the detumble started "
                          "anyway (it needs rates only)")
+    resets = int(d["estimator.bias_resets"][-1])
+    s["bias_resets"] = resets
+    if resets:
+        faults.append(f"the estimator's innovations contradicted it {resets} time(s) (a gyro bias jump): the bias "
+                      "was reopened and learned again")
+    safe = int(d["mission.safe_reason"][-1])
+    if safe:
+        faults.append("no valid attitude for the slew or the burn: the de-orbit was abandoned for the safe state "
+                      "(monitoring: no thrust, the position beaconed in ground contacts)")
     s["fault_management"] = "; ".join(faults) or "none needed"
+    if safe:
+        s["error"] = "the de-orbit was abandoned for the safe state: no valid attitude (no Sun sensor left?)"
+        return s
 
     def phase_start(p):
         i = _first((mode == MissionMode.DEORBIT) & (phase == p))
@@ -210,6 +222,9 @@ def summarize(r, scenario, orbit):
     s["detumble_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.SLEW][0]] - rcs[starts[DeorbitPhase.DETUMBLE][0]])
     s["slew_propellant_g"] = 1e3 * float(rcs[starts[DeorbitPhase.BURN][0]] - rcs[starts[DeorbitPhase.SLEW][0]])
     s["tracking_propellant_g"] = 1e3 * float(rcs[i_mon] - rcs[starts[DeorbitPhase.BURN][0]])
+    # y and z torques in the burn from switching axial thrusters off: the share of their thrust given up
+    off = float(d["thrusters.axial_off_time"][i_mon])
+    s["axial_off_percent"] = 100.0 * off / (SPACECRAFT.n_deorbit_thrusters * 60.0 * s["burn_time_min"])
     # the thrust axis against the tracked burn attitude, after the first 10 s of the burn (the
     # tracking's own transient from the slew's end state)
     burning = (t >= starts[DeorbitPhase.BURN][1] + 10.0) & (t < t_mon)
@@ -266,6 +281,7 @@ def table(s):
             ("detumble propellant (g)", "detumble_propellant_g", "{:.3f}"),
             ("slew propellant (g)", "slew_propellant_g", "{:.3f}"),
             ("tracking propellant during the burn (g)", "tracking_propellant_g", "{:.3f}"),
+            ("axial thrust given up to off-pulsing for y/z torques in the burn (%)", "axial_off_percent", "{:.2f}"),
             ("largest thrust-axis pointing error in the burn (deg, after 10 s)", "burn_pointing_error_deg", "{:.3f}"),
             ("attitude-knowledge error in the burn, RMS (deg, estimator vs truth; 0: truth feedback)",
              "burn_knowledge_error_rms_deg", "{:.3f}"),

@@ -33,6 +33,9 @@ def test_ten_dispersed_missions_all_deorbit(ssp_paths, tmp_path):
     assert min(masses) < 11.0 and max(masses) > 13.0
     # sensor noise on, a noise sequence per run
     assert len({(r["gyro.seed"], r["horizon.seed"], r["sun_sensor.seed"]) for r in rows}) == RUNS
+    # one fault in a fifth of the runs: among these ten, run 4's fine Sun sensor is dead (the coarse
+    # sensors stand in, and it flies as the others do); the other faults: test_mission_system.py
+    assert [r["fault"] for r in rows] == ["none"] * 4 + ["fine_sun_sensor_dead"] + ["none"] * 5
     for r in rows:
         assert r["reentered"] and r["budget_spent"], r
         assert r["detumble_timeouts"] == 0 and r["slew_timeouts"] == 0 and r["determination_timeouts"] == 0, r
@@ -43,7 +46,11 @@ def test_ten_dispersed_missions_all_deorbit(ssp_paths, tmp_path):
         slew = r["burn_start_s"] - r["slew_start_s"]
         burn = r["monitoring_start_s"] - r["burn_start_s"]
         assert 0.0 < detumble < 60.0 and 0.0 < slew < 120.0, r
-        assert burn / 60.0 == pytest.approx(38.74, abs=0.1)  # the budget at 0.1 N: the same for any mass
+        # the budget at 0.1 N, the same for any mass, less the thrust the off-pulsing gave up (y/z
+        # torques from switching axial thrusters off): full-thrust time the same within a step
+        assert 0.0 < r["axial_off_s"] < 0.1 * 4 * burn, r
+        assert (burn - r["axial_off_s"] / 4.0) / 60.0 == pytest.approx(38.74, abs=0.1)
+        assert r["bias_resets"] == 0 and r["safe_reason"] == 0, r  # no false fault detection
         assert r["burn_propellant_kg"] == pytest.approx(0.5641, abs=1e-4)
         # within the thesis' attitude-control allowance (23.14 g: system_ssp/neighbor/budgets.py)
         assert r["rcs_propellant_kg"] <= budgets.allowance("420km").rcs_g / 1e3, r

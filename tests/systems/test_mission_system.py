@@ -7,9 +7,11 @@ import subprocess
 import sys
 import time
 
+import numpy as np
 import pytest
 
 from browser import open_page
+from components.mission.modes import MissionMode
 from paths import REPO
 from system_ssp.master.plotting import read_result
 from system_ssp import SimulationError, SSPError, System, cli
@@ -235,3 +237,24 @@ def test_off_nominal_mission_finishes_through_phase_timeouts(ssp_paths, tmp_path
     verdicts = {b["name"]: b["within"] for b in s["budgets"]}
     assert not verdicts["attitude-control (RCS) propellant"] and not verdicts["total propellant"]
     assert "| OVER |" in mission.table(s)
+
+
+def test_without_sun_sensors_the_mission_ends_in_the_safe_state(ssp_paths):
+    """Both Sun sensors dead (fault parameters of the sensors): the estimator never gets an
+    attitude, the determination times out (here after 700 s instead of the mission's 6000 s, to
+    keep the test short), the detumble runs on the gyro's rates, and then no slew or burn starts
+    without an attitude: the de-orbit is abandoned for the safe state (monitoring, no thrust) and
+    the summary says so. Before, the mission waited in determination until the battery was empty."""
+    s, r = mission.run_mission("420km", ssp_dir=ssp_paths["neighbor_mission"].parent,
+                               parameters={"sun_sensor.failed": True, "coarse_sun.failed": True,
+                                           "mission.attitude_determination_timeout": 700.0})
+    assert r.final["mission.safe_reason"] == 1 and r.final["mission.determination_timeouts"] == 1
+    assert not r.final["estimator.initialized"]
+    assert r.final["propulsion.propellant_used"] == 0.0 and r.final["thrusters.propellant_mass"] > 0.0
+    d = r.data
+    assert not np.any(d["propulsion.burning"])
+    detumbled = np.linalg.norm([d[f"dynamics.omega_BN_B[{i}]"][-1] for i in (1, 2, 3)])
+    assert detumbled < np.radians(0.5)  # from the 10 deg/s tumble, on rates alone
+    assert "safe state" in s["error"] and "safe state" in s["fault_management"]
+    assert "the attitude determination timed out" in s["fault_management"]
+    assert int(d["mission.mode"][-1]) == MissionMode.END and s["reentered"]  # decayed, as without NEIGHBOR

@@ -27,7 +27,8 @@ FAMILIES = [
 # Connectors a family member may have beyond the family's (its own outputs; the tracking law's
 # desired-attitude signals)
 EXTRAS = {"attitude_error", "pointing_error", "sliding_vector[1]", "sliding_vector[2]", "sliding_vector[3]",
-          "axial_firing", "force_B[1]", "force_B[2]", "force_B[3]",  # the thruster set's burn torque and net force
+          "axial_firing", "force_B[1]", "force_B[2]", "force_B[3]", "axial_off_time",  # the thruster set's burn
+          # torque, net force and off-pulsing
           # the tracking law's boundary layer sized for the estimate: the knowledge it reads, the e it uses
           "sigma_attitude_B[1]", "sigma_attitude_B[2]", "sigma_attitude_B[3]",
           "boundary_layer[1]", "boundary_layer[2]", "boundary_layer[3]"}

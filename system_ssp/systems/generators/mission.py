@@ -119,7 +119,7 @@ COMPONENTS = {
     "slew": ("SlewController", ["slew_gains", "mission_slew"], {"slew"}),
     "tracking": ("TrackingController", ["mission_tracking"], {"burn"}),
     "selector": ("TorqueSelector", [], set()),
-    "thrusters": ("RcsThrusterSet", ["thrusters"], set()),
+    "thrusters": ("RcsThrusterSet", ["thrusters", "mission_thrusters"], set()),
     "power": ("Power", ["mission_power"], {"idle", "bus", "monitor", "slow"}),
     "data": ("DataStorage", ["mission_data"], {"bus", "monitor", "slow"}),
     # attitude knowledge: ephemeris, shadow, sensors and the estimator (truth feedback: the estimator only)
@@ -158,6 +158,13 @@ ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", 
 # step cost 26 s of a mission for samples the estimator dropped (issue 27). Determination runs
 # at the gyro's 0.1 s, every sample used.
 UPDATE_INTERVAL = 0.09
+# The estimator's fault detection watches the mean normalized innovation squared over this many
+# vector updates (components.sensing.mekf.InnovationMonitor: 1e-6 false alarms per window at 3.64)
+FAULT_WINDOW = 100
+# Without a valid attitude this long into the determination (an orbit and its 10 minutes: an
+# eclipse is over and the Sun seen by then; the nominal fix takes about 25 min) no Sun sensor is
+# left: the detumble runs on rates, then the mission manager's safe state.
+DETERMINATION_TIMEOUT = 6000.0
 MANEUVER_STEP = 0.015
 SENSOR_EVERY = round(UPDATE_INTERVAL / MANEUVER_STEP)
 assert abs(SENSOR_EVERY * MANEUVER_STEP - UPDATE_INTERVAL) < 1e-12
@@ -195,6 +202,8 @@ TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e
 # changes appears here.
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
               "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
+              "thrusters.off_pulsing": False, "estimator.fault_window": 0,
+              "mission.attitude_determination_timeout": 0.0, "mission.safe_without_attitude": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
               **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
@@ -340,6 +349,7 @@ def system(orbit_fmu):
              ("selector", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
              ("thrusters", "propellant_mass", "propulsion", "rcs_propellant", 0),
              ("propulsion", "burning", "thrusters", "axial_firing", 0),
+             ("thrusters", "axial_off_time", "propulsion", "axial_off_time", 0),
              ("thrusters", "torque_B", "dynamics", "torque_B", 3),
              ("mission", "data_recording", "data", "data_recording", 0),
              ("mission", "downlink_enable", "data", "downlink_enable", 0),
@@ -415,9 +425,12 @@ def generate(writer):
                {"heartbeat_loss_time": IDLE_DAYS * DAY, "heartbeat_return_times": ""})
     writer.ssv("mission_manager",
                "Operating modes (Section 3.4): 30-day grace period, 5 s daily wake, 10 min attitude determination; "
-               "in monitoring one GPS beacon contact a day (operators choose the frequency, Section 3.6)",
+               "in monitoring one GPS beacon contact a day (operators choose the frequency, Section 3.6); without a "
+               "valid attitude after one orbit (no Sun sensor left) the detumble on rates, then the safe state "
+               "instead of a slew or burn",
                {"grace_period": GRACE_DAYS * DAY, "wake_period": DAY, "wake_duration": 5.0,
-               "attitude_determination_duration": 600.0, "beacon_interval": DAY})
+               "attitude_determination_duration": 600.0, "beacon_interval": DAY,
+                "attitude_determination_timeout": DETERMINATION_TIMEOUT, "safe_without_attitude": True})
     h_base = takeover_altitudes[base.name]
     writer.ssv("mission_orbit",
                f"Host orbit at deployment ({MISSION_EPOCH}, {HOST_ORBIT.inclination_deg:g} deg; {h_base:.2f} km decays "
@@ -444,6 +457,9 @@ def generate(writer):
                "one impulse bit, desired attitude and rate from the burn guidance",
                {"k": 1.0, **vec("G", [0.1] * 3), **vec("e", [0.001] * 3), "q_d_from_measured": True,
                 "target_from_input": True, **TRACKING_LAYER})
+    writer.ssv("mission_thrusters",
+               "In the burn, y and z torques by switching axial thrusters off (off-pulsing): no RCS propellant "
+               "for the thrust axis' misalignment torque", {"off_pulsing": True})
     writer.ssv("mission_detumble",
                "Detumble flight settle criterion: rate window 0.75 impulse bit per axis held for 1 s", DETUMBLE_FLIGHT)
     writer.ssv("mission_slew",
@@ -472,11 +488,13 @@ def generate(writer):
                {**vec("bias", GYRO_BIAS), "sigma": ad.GYRO_SIGMA, "sigma_sample_time": ad.STEP, "seed": 13})
     writer.ssv("mission_estimator", "Attitude estimator: the sensors' accuracies, each vector sample used once "
                "(vector sensors at about 10 Hz), rate filter trusting the torque model to 2 % of one pair's "
-               "acceleration, coarse Sun vectors when the fine sensor has none, attitude valid at 0.25 deg 1-sigma",
+               "acceleration, coarse Sun vectors when the fine sensor has none, attitude valid at 0.25 deg 1-sigma, "
+               "a gyro bias jump detected from the innovations over 100 updates (9 s) and the bias learned again",
                {"nadir_sigma": ad.HORIZON_SIGMA, "sun_sigma": ad.SUN_SIGMA, "gyro_sigma": ad.GYRO_SIGMA,
                 "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": UPDATE_INTERVAL,
                 "accel_sigma": ACCEL_SIGMA,
-                "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA})
+                "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA,
+                "fault_window": FAULT_WINDOW})
     writer.ssv(GNC_SETS["closed-loop-truth"],
                "Closed-loop guidance and control on the true state (a fidelity choice): the estimator passes the "
                "rigid body's attitude, rate and acceleration through; the sensors are not stepped",

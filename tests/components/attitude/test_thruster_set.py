@@ -74,3 +74,57 @@ def test_minimum_on_time_holds_a_firing():
     assert s.axis_fire_time()[0] == pytest.approx(0.06)
     s.set_state(ThrusterSet().get_state())
     assert s.propellant_mass() == 0.0
+
+
+def test_off_pulsing_gives_y_and_z_torque_from_the_axial_thrusters():
+    levels = tc.pair_torques()
+    plain, pulsing = ThrusterSet(), ThrusterSet(off_pulsing=True)
+    for flags in ([0, 1, 0], [0, -1, 0], [0, 0, 1], [0, 0, -1], [1, 1, -1], [0, 0, 0]):
+        assert pulsing.force_and_torque(flags) == plain.force_and_torque(flags)  # outside the burn: RCS pairs
+    for axis in (1, 2):
+        for sign in (1, -1):
+            flags = [0, 0, 0]
+            flags[axis] = sign
+            off = pulsing.axial_off(flags, axial=True)
+            assert len(off) == 2
+            force, torque = pulsing.force_and_torque(flags, axial=True)
+            expected = [0.0, 0.0, 0.0]
+            expected[axis] = sign * levels[axis]  # a F = F c/3 for the thesis' a = c/3
+            assert torque == pytest.approx(expected, abs=1e-15)
+            assert force == (0.0, 0.0, 0.0)  # no RCS thruster fires
+    # both axes: the one diagonal thruster, half the level on each; x still from its pair
+    assert len(pulsing.axial_off([1, 1, -1], axial=True)) == 1
+    _, torque = pulsing.force_and_torque([1, 1, -1], axial=True)
+    assert torque == pytest.approx([levels[0], 0.5 * levels[1], -0.5 * levels[2]], abs=1e-15)
+    # the thrust lost is counted in thruster-seconds, no RCS propellant for y and z
+    pulsing.step([0, 1, 0], 0.015, axial=True)
+    pulsing.step([0, 1, 1], 0.015, axial=True)
+    pulsing.step([0, 1, 0], 0.015, axial=False)  # outside the burn: the y pair fires
+    assert pulsing.axial_off_time == pytest.approx(3 * 0.015)
+    assert pulsing.axis_fire_time() == pytest.approx([0.0, 0.015, 0.0])
+    restored = ThrusterSet(off_pulsing=True)
+    restored.set_state(pulsing.get_state())
+    assert restored.axial_off_time == pulsing.axial_off_time
+
+
+def test_off_pulsing_cancels_a_tilted_thrust_axis_without_rcs_propellant():
+    """The burn's misalignment torque about y trimmed by switching axial thrusters off for part of
+    the time: the same torque on average as the RCS pair's, no RCS propellant."""
+    tilt = math.radians(1.0)
+    kwargs = {"misalignment": [(0.0, 0.0)] * 12 + [(tilt, 0.0)] * 4}
+    disturbance = ThrusterSet(**kwargs).force_and_torque([0, 0, 0], axial=True)[1]
+    axis = int(np.argmax(np.abs(disturbance)))
+    assert axis in (1, 2)
+    flags = [0, 0, 0]
+    flags[axis] = -int(np.sign(disturbance[axis]))
+    for pulsing in (False, True):
+        s = ThrusterSet(off_pulsing=pulsing, **kwargs)
+        on = s.force_and_torque(flags, axial=True)[1][axis]
+        duty = -disturbance[axis] / (on - disturbance[axis])  # fraction of the time at `flags` for zero mean
+        assert 0.0 < duty < 0.2
+        s.step(flags, duty * 100.0, axial=True)
+        s.step([0, 0, 0], (1 - duty) * 100.0, axial=True)
+        if pulsing:
+            assert s.propellant_mass() == 0.0 and s.axial_off_time == pytest.approx(2 * duty * 100.0)
+        else:
+            assert s.propellant_mass() > 0.0 and s.axial_off_time == 0.0

@@ -368,7 +368,8 @@ def test_mission_fmu(build_one, tmp_path):
     path = build_one("neighbor_mission_manager.py")
     deps = check_declarations(path)
     assert set(deps) == {"mode", "phase", "end_reason", "next_event_time", "time_in_mode", "time_in_phase",
-                         "detumble_timeouts", "slew_timeouts", "determination_timeouts", *LOAD_NAMES, *mm.COMMANDS}
+                         "detumble_timeouts", "slew_timeouts", "determination_timeouts", "safe_reason", *LOAD_NAMES,
+                         *mm.COMMANDS}
     assert all(d == [] for d in deps.values())  # state outputs: no direct feedthrough
     fmu, vr = instantiate(path, tmp_path, "mission", start_time=1000.0)
     fmu.setReal([vr["grace_period"]], [100.0])
@@ -469,3 +470,35 @@ def test_attitude_determination_waits_for_a_valid_attitude_then_times_out():
     assert m.get_state() == state
     with pytest.raises(ValueError, match=r"attitude_determination_timeout = -5.0 s must be >= 0"):
         _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=-5.0)
+
+
+def test_without_attitude_no_slew_or_burn_starts_the_safe_state_instead():
+    """No Sun sensor left: the determination times out, the detumble runs on rates, and then, with
+    safe_without_attitude, the de-orbit is abandoned for monitoring (no burn in an unknown
+    direction) instead of slewing blind; the burn needs a valid attitude too."""
+    m = _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=3000.0, safe_without_attitude=True)
+    m.step(0.0, 3000.0, {"attitude_valid": False})
+    assert (m.phase, m.determination_timeouts) == (mm.DETUMBLE, 1)
+    m.step(3000.0, 10.0, {"attitude_valid": False, "detumble_done": True})
+    assert m.mode == mm.DEORBIT  # the detumble has had no whole step yet
+    m.step(3010.0, 10.0, {"attitude_valid": False, "detumble_done": True})
+    assert (m.mode, m.safe_reason, m.phase) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE, mm.PHASE_NONE)
+    assert not any(m.powered()[c] for c in ("burn_enable", "slew_enable", "tracking_enable", "propulsion"))
+    # a detumble that times out (biased rates never meet its window) ends there too
+    m = _in_phase(mm.DETUMBLE, detumble_timeout=100.0, phase_retries=0, safe_without_attitude=True)
+    m.step(0.0, 100.0, {"attitude_valid": False})
+    assert (m.mode, m.safe_reason) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE)
+    # the burn needs it as well; with a valid attitude nothing changes
+    m = _in_phase(mm.SLEW, safe_without_attitude=True)
+    m.step(0.0, 1.0, {})
+    m.step(1.0, 1.0, {"slew_done": True, "attitude_valid": False})
+    assert (m.mode, m.safe_reason) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE)
+    m = _in_phase(mm.SLEW, safe_without_attitude=True)
+    m.step(0.0, 1.0, {})
+    m.step(1.0, 1.0, {"slew_done": True, "attitude_valid": True})
+    assert (m.mode, m.phase, m.safe_reason) == (mm.DEORBIT, mm.BURN, mm.SAFE_NONE)
+    # off (the default, the thesis): the mission goes on as before
+    m = _in_phase(mm.SLEW)
+    m.step(0.0, 1.0, {})
+    m.step(1.0, 1.0, {"slew_done": True, "attitude_valid": False})
+    assert (m.mode, m.phase) == (mm.DEORBIT, mm.BURN)

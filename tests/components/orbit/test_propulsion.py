@@ -221,3 +221,25 @@ def test_the_rcs_draws_from_the_same_tank():
     for bad in (-0.001, math.nan, 12.0):
         with pytest.raises(ValueError, match="rcs_propellant"):
             m.mass_with(bad)
+
+
+def test_off_pulsed_thrust_is_taken_out_of_the_next_step_and_the_burn_lasts_longer():
+    budget = 0.05
+    full, pulsed = p.MainThrusters(mass0=12.0, propellant_budget=budget), p.MainThrusters(mass0=12.0,
+                                                                                          propellant_budget=budget)
+    h, off, steps = 0.5, 0.0, 0
+    while pulsed.burning(True):
+        pulsed.step(True, h, off)
+        steps += 1
+        if steps > 1 and pulsed.burning(True):  # one of four thrusters off 25 % of each step: 1/16 of the thrust
+            assert pulsed.on_fraction == pytest.approx(1.0 - 0.25 / 4.0)
+            assert pulsed.force_B(True)[0] == pytest.approx(0.1 * pulsed.on_fraction)
+            assert pulsed.mdot(True) == pytest.approx(full.mdot_burning * pulsed.on_fraction)
+        off += 0.25 * h
+    t_full = budget / full.mdot_burning
+    assert pulsed.used == budget and pulsed.burn_time == pytest.approx(t_full / (1 - 1 / 16.0), rel=1e-3)
+    with pytest.raises(ValueError, match="off_time"):
+        pulsed.step(True, h, off - 1.0)  # a running total never falls
+    restored = p.MainThrusters(mass0=12.0, propellant_budget=budget)
+    restored.set_state(pulsed.get_state())
+    assert (restored.on_fraction, restored.off_seen, restored.last_h) == (pulsed.on_fraction, pulsed.off_seen, h)

@@ -353,6 +353,15 @@ def test_fmus_simulate_alone(ad_fmus):
                                         **{f"boresight_B[{i}]": v for i, v in enumerate(rot(q, sun_N), 1)},
                                         "sigma": 0.0})
     assert r["valid"].all() and np.allclose([r[f"sun_B[{i}]"][-1] for i in (1, 2, 3)], rot(q, sun_N), atol=1e-15)
+    # faults: the Sun sensor dead from 0.2 s on, the gyro's bias jumping at 0.5 s
+    r = fmpy.simulate_fmu(x["SunSensor"], stop_time=0.4, output_interval=0.1,
+                          start_values={**qv, **{f"r_SN_N[{i}]": v for i, v in enumerate(r_sun, 1)},
+                                        **{f"boresight_B[{i}]": v for i, v in enumerate(rot(q, sun_N), 1)},
+                                        "failed": True, "fail_time": 0.2})
+    assert list(r["valid"]) == [True, True, False, False, False] and r["sun_B[1]"][-1] == 0.0
+    r = fmpy.simulate_fmu(x["Gyro"], stop_time=1.0, output_interval=0.1,
+                          start_values={"sigma": 0.0, "bias_jump[3]": 0.002, "jump_time": 0.5})
+    assert list(r["omega_meas_B[3]"]) == [0.0] * 5 + [0.002] * 6
 
 
 def test_fmu_seed_reproducibility(ad_fmus):

@@ -184,3 +184,60 @@ def test_a_held_sample_is_used_once():
     twin = AttitudeEstimator(inertia=J, update_interval=0.09)
     twin.set_state(state)
     assert twin.get_state() == state
+
+
+def _fly_bias_jump(window, jump, t_jump=80.0, seconds=150.0, h=0.015, seed=3):
+    """Track a slow turn (the burn's orbit rate) with nadir and Sun; the gyro's bias jumps at
+    t_jump. Per step (t, error deg, NEES) after the first fix, and the estimator."""
+    body = rigid_body.RigidBody(J, q0=rotations.from_axis_angle((0.3, -0.5, 0.8), 2.0), omega0=(0.0, 1.1e-3, 0.0))
+    horizon = sensors.HorizonSensor(math.radians(0.25), seed=seed)
+    sun_sensor = sensors.SunSensor((1.0, 0.0, 0.0), math.pi, math.radians(0.5) / 3.0, seed=seed + 1)
+    gyro = sensors.Gyro((1e-3, -5e-4, 2e-4), GYRO_SIGMA, seed=seed + 3, sigma_sample_time=GYRO_STEP, bias_jump=jump,
+                        jump_time=t_jump)
+    est = AttitudeEstimator(sigma_v=GYRO_SIGMA * math.sqrt(GYRO_STEP), inertia=J, accel_sigma=1e-3,
+                            update_interval=0.09, fault_window=window)
+    rows, detected = [], []
+    for k in range(int(round(seconds / h))):
+        body.step((0.0, 0.0, 0.0), h)
+        for s in (horizon, sun_sensor, gyro):
+            s.step(h)
+        nadir, nadir_ok = horizon.measure(R_BN, body.q)
+        sun, sun_ok = sun_sensor.measure(R_SN, R_BN, body.q, True)
+        est.step((nadir, nadir_ok, sun, sun_ok, R_BN, R_SN), gyro.measure(body.omega), h)
+        if est.filter.initialized:
+            rows.append(((k + 1) * h, math.degrees(triad.error_angle(est.filter.q, body.q)), est.check(body.q)))
+        if est.innovations.detections > len(detected):
+            detected.append((k + 1) * h)
+    return np.array(rows), detected, est
+
+
+def test_a_gyro_bias_jump_is_detected_from_the_innovations_and_learned_again():
+    jump = (2e-3, -1e-3, 1e-3)  # 0.14 deg/s: twice the calibration residual
+    rows, detected, est = _fly_bias_jump(100, jump)
+    assert len(detected) == 1 and 80.0 < detected[0] < 90.0  # within 10 s, and no false alarm before
+    late = rows[rows[:, 0] > 120.0]
+    assert late[:, 1].max() < 0.15  # deg: the bias learned again
+    np.testing.assert_allclose(est.filter.bias, np.add((1e-3, -5e-4, 2e-4), jump), atol=2e-4)
+    assert late[:, 2].mean() < 6.0  # consistent again (3 when perfect)
+    # without the monitor the filter stays sure of the old bias: the errors it cannot explain
+    plain, none, _ = _fly_bias_jump(0, jump)
+    assert none == []
+    assert plain[plain[:, 0] > 120.0][:, 2].mean() > 10 * late[:, 2].mean()
+    # the same gyro without a fault: never a detection, the window mean well inside the limit
+    _, quiet, est = _fly_bias_jump(100, (0.0, 0.0, 0.0))
+    assert quiet == [] and 1.0 < est.innovations.largest < est.innovations.limit
+
+
+def test_the_gyro_bias_jumps_after_its_operating_time():
+    gyro = sensors.Gyro((1e-3, 0.0, 0.0), 0.0, bias_jump=(0.0, 2e-3, 0.0), jump_time=10.0)
+    gyro.step(5.0)
+    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 0.0, 0.0)
+    saved = gyro.get_state()
+    gyro.step(5.0)  # 10 s of operation, whatever the host's clock says (the mission powers it in the de-orbit)
+    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 2e-3, 0.0)
+    gyro.step(1.0)
+    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 2e-3, 0.0)  # once
+    gyro.set_state(saved)
+    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 0.0, 0.0) and gyro.time == 5.0
+    with pytest.raises(ValueError, match="bias_jump"):
+        sensors.Gyro(bias_jump=(0.0, math.nan, 0.0))
