@@ -293,25 +293,27 @@ class MissionManager:
             if self.phase == ATTITUDE_DETERMINATION and self.att_det_waiting and x["attitude_valid"]:
                 self._enter_phase(DETUMBLE, t)
             elif started and self.phase == DETUMBLE and x["detumble_done"]:
-                self._maneuver(SLEW, t, x["attitude_valid"])
+                self._maneuver(SLEW, t, x)
             elif started and self.phase == SLEW and x["slew_done"]:
-                self._maneuver(BURN, t, x["attitude_valid"])
+                self._maneuver(BURN, t, x)
             elif started and self.phase == BURN and x["budget_spent"]:
-                self._enter(MONITORING, t)
-                self.contact_seen = False
-                self._monitor_contact(t, x["ground_contact"])
+                self._enter_monitoring(t, x["ground_contact"])
         elif mode == MONITORING:
             self._monitor_contact(t, x["ground_contact"])
 
-    def _maneuver(self, phase, t, attitude_valid):
+    def _maneuver(self, phase, t, x):
         """Into the slew or the burn; without a valid attitude (and safe_without_attitude), the
         safe state instead."""
-        if self.p["safe_without_attitude"] and not attitude_valid:
-            self._enter(MONITORING, t)
+        if self.p["safe_without_attitude"] and not x["attitude_valid"]:
+            self._enter_monitoring(t, x["ground_contact"])
             self.safe_reason = SAFE_NO_ATTITUDE
-            self.contact_seen = False
         else:
             self._enter_phase(phase, t)
+
+    def _enter_monitoring(self, t, contact):
+        self._enter(MONITORING, t)
+        self.contact_seen = False
+        self._monitor_contact(t, contact)
 
     def _monitor_contact(self, t, contact):
         """Beacon in this contact? Decided when it starts, from beacon_interval."""
@@ -400,7 +402,7 @@ class MissionManager:
                 if self.attempt < self.p["phase_retries"]:
                     self._enter_phase(self.phase, te, retry=True)
                 else:  # the documented fallback: on with the next phase
-                    self._maneuver(SLEW if self.phase == DETUMBLE else BURN, te, x["attitude_valid"])
+                    self._maneuver(SLEW if self.phase == DETUMBLE else BURN, te, x)
         self.t = max(t_end, self.t)
         if self.phase_published is None:
             self.phase_published = self.t

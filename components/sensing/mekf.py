@@ -19,6 +19,7 @@ its bias random walk (rad/s^1.5). A gyro with white rate noise of standard devia
 sample at step h has sigma_v = s sqrt(h). With R = sigma^2 I the 3-vector update is the usual
 approximation (the component along b_hat carries no information and H has no part there).
 """
+from collections import deque
 import math
 
 import numpy as np
@@ -275,7 +276,7 @@ class InnovationMonitor:
             raise ValueError(f"fault window = {window!r} must be an integer >= 0 (vector updates; 0: off)")
         self.window = int(window)
         self.limit = _sigma("fault limit", limit, "mean NIS", positive=True)
-        self.nis, self.squared = [], []
+        self.restart()
         self.detections = 0
         self.largest = 0.0  # the largest window mean seen (how close nominal flight comes to the limit)
 
@@ -286,8 +287,6 @@ class InnovationMonitor:
             return False
         self.nis.append(nis)
         self.squared.append(squared)
-        if len(self.nis) > self.window:
-            del self.nis[0], self.squared[0]
         if len(self.nis) < self.window or not armed:
             return False
         mean = sum(self.nis) / self.window
@@ -302,14 +301,16 @@ class InnovationMonitor:
         return 0.5 * sum(self.squared) / max(1, len(self.squared))
 
     def restart(self):
-        self.nis, self.squared = [], []
+        self.nis, self.squared = deque(maxlen=self.window), deque(maxlen=self.window)
 
     def get_state(self):
         return {"nis": list(self.nis), "squared": list(self.squared), "detections": self.detections,
                 "largest": self.largest}
 
     def set_state(self, state):
-        self.nis, self.squared = list(state["nis"]), list(state["squared"])
+        self.restart()
+        self.nis.extend(state["nis"])
+        self.squared.extend(state["squared"])
         self.detections, self.largest = int(state["detections"]), float(state["largest"])
 
 
@@ -414,7 +415,7 @@ class AttitudeEstimator:
             if updates or self.cov_pending >= COVARIANCE_STEP - 1e-9:
                 self._propagate_covariance()  # the covariance must be current before an update
             # watched once the bias is learned (while it is being learned the filter adapts anyway)
-            armed = max(f.bias_sigma()) < BIAS_LEARNED * self.sigma_bias0
+            armed = bool(updates and self.innovations.window) and max(f.bias_sigma()) < BIAS_LEARNED * self.sigma_bias0
             for name, b, r, sigma in updates:
                 self._mark(name, b)
                 if self.innovations.add(*f.update(b, r, sigma), armed):
