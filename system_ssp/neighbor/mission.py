@@ -102,7 +102,7 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
                            parameters=parameters or {},
                            outputs=RECORD, profile=profile, progress=progress)
-        s = summarize(r, scenario, orbit)
+        s = summarize(r, scenario, orbit, gnc)
         s["gnc"] = gnc
         if staged is not None:
             write_result(r.data, staged.path / series, r.units)
@@ -166,7 +166,21 @@ def _altitude_at(d, i, orbit):
     return float(a[i] - R_EQ) / 1e3, "osculating"
 
 
-def summarize(r, scenario, orbit):
+def _x_axis_in_n(d, q, rows):
+    """The body x axis in N on `rows` (a mask) from the recorded quaternion `q` (q_BN, scalar last):
+    the first row of A(q), which maps N to B."""
+    q1, q2, q3, q4 = (np.asarray(d[f"{q}[{i}]"])[rows] for i in (1, 2, 3, 4))
+    x = np.array([q1 * q1 - q2 * q2 - q3 * q3 + q4 * q4, 2.0 * (q1 * q2 + q3 * q4), 2.0 * (q1 * q3 - q2 * q4)])
+    return x / np.linalg.norm(x, axis=0)
+
+
+def _x_axis_angle(d, q_a, q_b, rows):
+    """Angle (rad) between the body x axes of two recorded attitudes on `rows`."""
+    cos = np.sum(_x_axis_in_n(d, q_a, rows) * _x_axis_in_n(d, q_b, rows), axis=0)
+    return np.arccos(np.clip(cos, -1.0, 1.0))
+
+
+def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     d = r.data
     t = d["time"]
     mode, phase = d["mission.mode"], d["mission.phase"]
@@ -230,6 +244,12 @@ def summarize(r, scenario, orbit):
     burning = (t >= starts[DeorbitPhase.BURN][1] + 10.0) & (t < t_mon)
     pointing = np.degrees(d["tracking.pointing_error"][burning])
     s["burn_pointing_error_deg"] = float(pointing.max()) if pointing.size else None
+    # the true thrust axis (the rigid body's x) against the burn guidance's (x along -v): what the
+    # burn gets, knowledge error included; the thesis set thrusts along -v whatever the attitude
+    if gnc != "thesis":
+        axis = np.degrees(_x_axis_angle(d, "dynamics.q_BN", "guidance.q_target_BN", burning))
+        s["burn_thrust_axis_error_deg"] = float(axis.max()) if axis.size else None
+        s["burn_thrust_axis_error_rms_deg"] = float(np.sqrt(np.mean(axis ** 2))) if axis.size else None
     # attitude knowledge: the estimator against the rigid body (zero with truth feedback)
     knowledge = np.degrees(d["estimator.attitude_error"][burning])
     s["burn_knowledge_error_deg"] = float(knowledge.max()) if knowledge.size else None
@@ -282,7 +302,12 @@ def table(s):
             ("slew propellant (g)", "slew_propellant_g", "{:.3f}"),
             ("tracking propellant during the burn (g)", "tracking_propellant_g", "{:.3f}"),
             ("axial thrust given up to off-pulsing for y/z torques in the burn (%)", "axial_off_percent", "{:.2f}"),
-            ("largest thrust-axis pointing error in the burn (deg, after 10 s)", "burn_pointing_error_deg", "{:.3f}"),
+            ("largest thrust-axis pointing error in the burn (deg, after 10 s; the tracking law's, on its estimate)",
+             "burn_pointing_error_deg", "{:.3f}"),
+            ("true thrust axis against the guidance's in the burn, largest (deg, after 10 s)",
+             "burn_thrust_axis_error_deg", "{:.3f}"),
+            ("true thrust axis against the guidance's in the burn, RMS (deg)", "burn_thrust_axis_error_rms_deg",
+             "{:.3f}"),
             ("attitude-knowledge error in the burn, RMS (deg, estimator vs truth; 0: truth feedback)",
              "burn_knowledge_error_rms_deg", "{:.3f}"),
             ("attitude-knowledge error in the burn, largest (deg, after 10 s)", "burn_knowledge_error_deg", "{:.3f}"),

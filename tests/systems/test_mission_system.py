@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from browser import open_page
+from components.core import rotations
 from components.mission.modes import MissionMode
 from paths import REPO
 from system_ssp.master.plotting import read_result
@@ -31,6 +32,7 @@ def test_mission_reaches_reentry_through_every_mode(run):
     s, r, _ = run
     assert s["reentered"] and "error" not in s
     assert s["phase_timeouts"] == {"detumble": 0, "slew": 0} and s["fault_management"] == "none needed"
+    assert "burn_thrust_axis_error_deg" not in s  # the thesis set thrusts along -v whatever the attitude
     # the thesis set: truth feedback, so the schedule's truth-feedback modes (no sensors)
     for mode in ("idle", "awaiting", "contact", "determination_truth", "detumble_truth", "slew_truth", "burn_truth",
                  "monitoring", "decay"):
@@ -258,3 +260,24 @@ def test_without_sun_sensors_the_mission_ends_in_the_safe_state(ssp_paths):
     assert "safe state" in s["error"] and "safe state" in s["fault_management"]
     assert "the attitude determination timed out" in s["fault_management"]
     assert int(d["mission.mode"][-1]) == MissionMode.END and s["reentered"]  # decayed, as without NEIGHBOR
+
+
+def test_the_true_thrust_axis_error_is_the_angle_between_body_x_axes():
+    """The summary's true thrust-axis error (the rigid body's x against the guidance's, closed
+    loop only: the thesis set thrusts along -v whatever the attitude) from recorded quaternions."""
+    rng = np.random.default_rng(5)
+    qs = rng.normal(size=(50, 4))
+    qs /= np.linalg.norm(qs, axis=1)[:, None]
+    turn = [rotations.circle_cross(rotations.from_axis_angle((0.0, 0.3, -1.0), 0.01 * k), tuple(q))
+            for k, q in enumerate(qs)]
+    d = {**{f"a[{i}]": qs[:, i - 1] for i in range(1, 5)}, **{f"b[{i}]": np.array(turn)[:, i - 1] for i in range(1, 5)}}
+    rows = np.ones(50, dtype=bool)
+    rows[0] = False
+    x = mission._x_axis_in_n(d, "a", rows)
+    for k, q in enumerate(qs[1:]):
+        np.testing.assert_allclose(x[:, k], np.array(rotations.attitude_matrix(tuple(q))).T @ (1.0, 0.0, 0.0),
+                                   atol=1e-14)
+    # a turn by 0.01 k rad about an axis at angle b to x moves x by 2 asin(sin(0.01 k / 2) sin b)
+    sin_b = np.linalg.norm(np.cross((1.0, 0.0, 0.0), (0.0, 0.3, -1.0))) / np.linalg.norm((0.0, 0.3, -1.0))
+    expected = 2 * np.arcsin(np.sin(0.005 * np.arange(1, 50)) * sin_b)
+    np.testing.assert_allclose(mission._x_axis_angle(d, "a", "b", rows), expected, atol=1e-9)
