@@ -29,10 +29,13 @@ Modes (`mode`):
                     in. Never waiting until the battery is empty; `detumble_timeouts` and
                     `slew_timeouts` count what happened. The thesis' phases end long before.
                     With `safe_without_attitude`, a slew or burn is never started without
-                    attitude_valid (a burn in an unknown direction may raise the orbit): the
-                    de-orbit is abandoned for MONITORING, the safe state (no thrust, the position
-                    beaconed in contacts for the operators), with `safe_reason` 1. This is where a
-                    determination timeout (no Sun sensor left) ends after the detumble.
+                    attitude_valid (a burn in an unknown direction may raise the orbit): a
+                    detumble or slew that is done goes on (its controller holding the spacecraft)
+                    until the attitude is valid, e.g. while the estimate settles after a fast
+                    detumble; if it times out without one, the de-orbit is abandoned for
+                    MONITORING, the safe state (no thrust, the position beaconed in contacts for
+                    the operators), with `safe_reason` 1. This is where a determination timeout
+                    (no Sun sensor left) ends after the detumble.
   6 MONITORING      microprocessor quiescent; during ground contacts GPS + UHF on to beacon the
                     position (and downlink stored data) until the battery is empty or re-entry.
                     beacon_interval (default 0: every contact, as Appendix I) lets operators
@@ -292,23 +295,27 @@ class MissionManager:
             started = self.phase_published is not None and self.phase_published < t - time_tol(t)
             if self.phase == ATTITUDE_DETERMINATION and self.att_det_waiting and x["attitude_valid"]:
                 self._enter_phase(DETUMBLE, t)
-            elif started and self.phase == DETUMBLE and x["detumble_done"]:
-                self._maneuver(SLEW, t, x)
-            elif started and self.phase == SLEW and x["slew_done"]:
-                self._maneuver(BURN, t, x)
+            elif started and self.phase == DETUMBLE and x["detumble_done"] and self._attitude_ok(x):
+                self._enter_phase(SLEW, t)
+            elif started and self.phase == SLEW and x["slew_done"] and self._attitude_ok(x):
+                self._enter_phase(BURN, t)
             elif started and self.phase == BURN and x["budget_spent"]:
                 self._enter_monitoring(t, x["ground_contact"])
         elif mode == MONITORING:
             self._monitor_contact(t, x["ground_contact"])
 
+    def _attitude_ok(self, x):
+        """A slew or burn may start: the attitude is valid, or safe_without_attitude is off."""
+        return x["attitude_valid"] or not self.p["safe_without_attitude"]
+
     def _maneuver(self, phase, t, x):
-        """Into the slew or the burn; without a valid attitude (and safe_without_attitude), the
-        safe state instead."""
-        if self.p["safe_without_attitude"] and not x["attitude_valid"]:
+        """Into the slew or the burn after a phase timeout; without a valid attitude (and
+        safe_without_attitude), the safe state instead."""
+        if self._attitude_ok(x):
+            self._enter_phase(phase, t)
+        else:
             self._enter_monitoring(t, x["ground_contact"])
             self.safe_reason = SAFE_NO_ATTITUDE
-        else:
-            self._enter_phase(phase, t)
 
     def _enter_monitoring(self, t, contact):
         self._enter(MONITORING, t)

@@ -191,8 +191,9 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
         s["profile_s"] = r.profile
     timeouts = {"detumble": int(d["mission.detumble_timeouts"][-1]), "slew": int(d["mission.slew_timeouts"][-1])}
     s["phase_timeouts"] = timeouts
-    faults = [f"the {name} timed out {n} time(s): retried, then the mission went on with the next phase"
-              for name, n in timeouts.items() if n]
+    safe = int(d["mission.safe_reason"][-1])
+    then = "the safe state (no valid attitude)" if safe else "the mission went on with the next phase"
+    faults = [f"the {name} timed out {n} time(s): retried, then {then}" for name, n in timeouts.items() if n]
     if int(d["mission.determination_timeouts"][-1]):
         faults.insert(0, "the attitude determination timed out without a valid attitude: the detumble started "
                          "anyway (it needs rates only)")
@@ -201,7 +202,6 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     if resets:
         faults.append(f"the estimator's innovations contradicted it {resets} time(s) (a gyro bias jump): the bias "
                       "was reopened and learned again")
-    safe = int(d["mission.safe_reason"][-1])
     if safe:
         faults.append("no valid attitude for the slew or the burn: the de-orbit was abandoned for the safe state "
                       "(monitoring: no thrust, the position beaconed in ground contacts)")

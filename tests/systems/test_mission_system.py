@@ -243,14 +243,19 @@ def test_off_nominal_mission_finishes_through_phase_timeouts(ssp_paths, tmp_path
 
 def test_without_sun_sensors_the_mission_ends_in_the_safe_state(ssp_paths):
     """Both Sun sensors dead (fault parameters of the sensors): the estimator never gets an
-    attitude, the determination times out (here after 700 s instead of the mission's 6000 s, to
-    keep the test short), the detumble runs on the gyro's rates, and then no slew or burn starts
-    without an attitude: the de-orbit is abandoned for the safe state (monitoring, no thrust) and
-    the summary says so. Before, the mission waited in determination until the battery was empty."""
+    attitude, the determination times out (here after 700 s instead of the mission's 6000 s, and
+    the detumble after 60 s instead of 600, to keep the test short), the detumble runs on the
+    gyro's rates and then waits for an attitude until it times out (twice: one retry), and no slew
+    or burn starts without one: the de-orbit is abandoned for the safe state (monitoring, no
+    thrust) and the summary says so. Before, the mission waited in determination until the battery
+    was empty."""
     s, r = mission.run_mission("420km", ssp_dir=ssp_paths["neighbor_mission"].parent,
                                parameters={"sun_sensor.failed": True, "coarse_sun.failed": True,
-                                           "mission.attitude_determination_timeout": 700.0})
+                                           "mission.attitude_determination_timeout": 700.0,
+                                           "mission.detumble_timeout": 60.0})
     assert r.final["mission.safe_reason"] == 1 and r.final["mission.determination_timeouts"] == 1
+    assert r.final["mission.detumble_timeouts"] == 2
+    assert "the detumble timed out 2 time(s): retried, then the safe state" in s["fault_management"]
     assert not r.final["estimator.initialized"]
     assert r.final["propulsion.propellant_used"] == 0.0 and r.final["thrusters.propellant_mass"] > 0.0
     d = r.data

@@ -474,29 +474,36 @@ def test_attitude_determination_waits_for_a_valid_attitude_then_times_out():
 
 def test_without_attitude_no_slew_or_burn_starts_the_safe_state_instead():
     """No Sun sensor left: the determination times out, the detumble runs on rates, and then, with
-    safe_without_attitude, the de-orbit is abandoned for monitoring (no burn in an unknown
-    direction) instead of slewing blind; the burn needs a valid attitude too."""
-    m = _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=3000.0, safe_without_attitude=True)
+    safe_without_attitude, no slew starts without an attitude: the done detumble goes on until one
+    is valid (an estimate settling after a fast detumble), and if the phase times out first the
+    de-orbit is abandoned for monitoring (no burn in an unknown direction); the burn likewise."""
+    m = _in_phase(mm.ATTITUDE_DETERMINATION, attitude_determination_timeout=3000.0, safe_without_attitude=True,
+                  detumble_timeout=100.0, phase_retries=1)
     m.step(0.0, 3000.0, {"attitude_valid": False})
     assert (m.phase, m.determination_timeouts) == (mm.DETUMBLE, 1)
     m.step(3000.0, 10.0, {"attitude_valid": False, "detumble_done": True})
-    assert m.mode == mm.DEORBIT  # the detumble has had no whole step yet
     m.step(3010.0, 10.0, {"attitude_valid": False, "detumble_done": True})
-    assert (m.mode, m.safe_reason, m.phase) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE, mm.PHASE_NONE)
+    assert (m.mode, m.phase) == (mm.DEORBIT, mm.DETUMBLE)  # done, waiting for the attitude
+    m.step(3020.0, 80.0, {"attitude_valid": False, "detumble_done": True})
+    assert (m.phase, m.detumble_timeouts, m.attempt) == (mm.DETUMBLE, 1, 1)  # retried with a fresh timer
+    m.step(3100.0, 100.0, {"attitude_valid": False, "detumble_done": True})
+    assert (m.mode, m.safe_reason, m.phase, m.detumble_timeouts) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE,
+                                                                     mm.PHASE_NONE, 2)
     assert not any(m.powered()[c] for c in ("burn_enable", "slew_enable", "tracking_enable", "propulsion"))
-    # a detumble that times out (biased rates never meet its window) ends there too
-    m = _in_phase(mm.DETUMBLE, detumble_timeout=100.0, phase_retries=0, safe_without_attitude=True)
-    m.step(0.0, 100.0, {"attitude_valid": False})
-    assert (m.mode, m.safe_reason) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE)
-    # the burn needs it as well; with a valid attitude nothing changes
-    m = _in_phase(mm.SLEW, safe_without_attitude=True)
+    # the attitude valid a little after the detumble is done: the slew follows, no safe state
+    m = _in_phase(mm.DETUMBLE, safe_without_attitude=True)
+    m.step(0.0, 1.0, {"detumble_done": True, "attitude_valid": False})
+    m.step(1.0, 1.0, {"detumble_done": True, "attitude_valid": False})
+    assert m.phase == mm.DETUMBLE
+    m.step(2.0, 1.0, {"detumble_done": True, "attitude_valid": True})
+    assert (m.mode, m.phase, m.safe_reason) == (mm.DEORBIT, mm.SLEW, mm.SAFE_NONE)
+    # the burn needs it as well: a slew that times out without it ends in the safe state
+    m = _in_phase(mm.SLEW, safe_without_attitude=True, slew_timeout=50.0, phase_retries=0)
     m.step(0.0, 1.0, {})
     m.step(1.0, 1.0, {"slew_done": True, "attitude_valid": False})
+    assert m.phase == mm.SLEW
+    m.step(2.0, 48.0, {"slew_done": True, "attitude_valid": False})
     assert (m.mode, m.safe_reason) == (mm.MONITORING, mm.SAFE_NO_ATTITUDE)
-    m = _in_phase(mm.SLEW, safe_without_attitude=True)
-    m.step(0.0, 1.0, {})
-    m.step(1.0, 1.0, {"slew_done": True, "attitude_valid": True})
-    assert (m.mode, m.phase, m.safe_reason) == (mm.DEORBIT, mm.BURN, mm.SAFE_NONE)
     # off (the default, the thesis): the mission goes on as before
     m = _in_phase(mm.SLEW)
     m.step(0.0, 1.0, {})
