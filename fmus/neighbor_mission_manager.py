@@ -43,8 +43,8 @@ APPENDED_PARAMETERS = (
      "After this long in attitude determination without attitude_valid the detumble starts anyway (it needs rates "
      "only; >= 0; 0: wait for a valid attitude)"),
     ("safe_without_attitude", None, bool,
-     "Never start the slew or the burn without attitude_valid: abandon the de-orbit for the safe state (monitoring, "
-     "no thrust, safe_reason 1)"),
+     "Never start the slew or the burn without attitude_valid: a done detumble or slew waits for it, and at its "
+     "timeout the de-orbit is abandoned for the safe state (monitoring, no thrust, safe_reason 1)"),
 )
 INPUTS = (
     ("heartbeat", None, bool, "Host spacecraft heartbeat present (HostSpacecraft.heartbeat)"),
