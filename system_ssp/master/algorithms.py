@@ -6,12 +6,42 @@ a stop condition and calls the observers after every macro step; `finish` at the
 `refresh_for_record` brings the values a recorded row shows up to date."""
 import ctypes
 import math
+import time
 from typing import Callable, Dict, List, Optional, Protocol, Sequence
 
+import numpy as np
+
 from ..errors import SimulationError
+from . import compiled
 from .connections import KIND
 from .instances import CTYPE, GET, StepFailed
 from .observers import StepInfo
+
+# The compiled loop returns to Python after at most this many steps, and sooner where steps are
+# slow: each span is sized to take about SPAN_SECONDS of wall time, so that the observers (an
+# interruption, the wall-clock limit, the progress bar) see the run that often
+SPAN_STEPS = 2000
+SPAN_SECONDS = 0.05
+
+
+class SpanSize:
+    """The steps the next span may take: doubled while spans take under half SPAN_SECONDS,
+    halved when one took over twice that."""
+
+    def __init__(self):
+        self.steps = min(16, SPAN_STEPS)
+        self.t0 = 0.0
+
+    def start(self):
+        self.t0 = time.perf_counter()
+        return self.steps
+
+    def took(self):
+        spent = time.perf_counter() - self.t0
+        if spent < 0.5 * SPAN_SECONDS:
+            self.steps = min(2 * self.steps, SPAN_STEPS)
+        elif spent > 2.0 * SPAN_SECONDS:
+            self.steps = max(1, self.steps // 2)
 
 Stepper = Callable[[float, float], None]  # (t, h): set a component's inputs, doStep, get its outputs
 
@@ -20,6 +50,11 @@ class Algorithm(Protocol):
     """What the execution asks of a master algorithm (FixedStepAlgorithm, ScheduledAlgorithm)."""
 
     steppers: List[Stepper]  # per component, in SSD order (a profiler may wrap them)
+
+    def compile(self, stop_ops: Sequence, rows) -> bool:
+        """Take the steps in the compiled loop (system_ssp.master.compiled) when it can serve the
+        run; `stop_ops` are the stop conditions' reads, `rows` the Recorder, whose rows the loop
+        records on the way. False: the Python loop only."""
 
     def start(self, info: StepInfo) -> None:
         """After initialization: set the start time and the recording interval in `info`."""
@@ -59,6 +94,16 @@ class FixedStepAlgorithm:
         self.n = len(table.instances)
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
 
+        self.loop = self.rows = None  # the compiled loop, when compile() takes it
+
+    def compile(self, stop_ops, rows):
+        if self.jacobi or not compiled.eligible(self.table, range(self.n), rows):
+            return False
+        self.loop = compiled.Loop(self.table, rows, stop_ops=stop_ops)
+        self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
+        self.order_array, self.mult_array = np.array(self.order, dtype=np.int64), np.array(self.mult, dtype=np.int64)
+        return True
+
     def start(self, info):
         self.table.t = info.t = self.plan.start
         info.record_every = self.plan.record_every
@@ -79,7 +124,11 @@ class FixedStepAlgorithm:
         do_steps, steppers = table.do_steps, self.steppers
         setters, getters, has_ft = table.setters, table.getters, table.has_ft
         jacobi = self.jacobi
+        loop = self.loop
         while info.fired is None and info.steps < N:
+            if loop is not None:
+                self._span(info, loop, observe)
+                continue
             k = info.steps
             t = start + k * h
             table.t = t
@@ -110,6 +159,26 @@ class FixedStepAlgorithm:
             for f in observe:
                 f(info)
 
+    def _span(self, info, loop, observe):
+        """Steps up to the recorder's next row in the compiled loop, then the observers once."""
+        p, table = self.plan, self.table
+        k0, N = info.steps, p.n_steps
+        rows, times = loop.enter(info.record_every)
+        steps, flags = compiled.fixed_span(loop.T, self.order_array, self.mult_array, self.all_one, p.start, p.stop,
+                                           p.step_size, N, k0, self.span.start(), loop.changed, loop.status, rows,
+                                           times, loop.rec)
+        self.span.took()
+        loop.leave()
+        k = k0 + steps
+        if flags & compiled.FAILED:
+            table.t = info.t = p.start + k * p.step_size  # the step that failed
+            raise loop.failure(stop_ops=self.stop_ops)
+        info.steps = k
+        info.t = table.t = p.start + k * p.step_size if k < N else p.stop
+        info.last = k == N
+        for f in observe:
+            f(info)
+
     def refresh_for_record(self):
         pass
 
@@ -123,11 +192,12 @@ class FixedStepAlgorithm:
 
 class _Mode:
     """A schedule mode prepared for the loop."""
-    __slots__ = ("name", "h", "order", "record_every", "conditions", "mult", "refresh")
+    __slots__ = ("name", "h", "order", "record_every", "conditions", "mult", "refresh", "arrays")
 
     def __init__(self, name, h, order, record_every, conditions, mult, refresh):
         self.name, self.h, self.order, self.record_every = name, h, order, record_every
         self.conditions, self.mult, self.refresh = conditions, mult, refresh
+        self.arrays = None  # (order, mult, refresh) for the compiled loop
 
 
 class _Signal:
@@ -235,6 +305,17 @@ class ScheduledAlgorithm:
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
         self.mode_time = {m.name: 0.0 for m in self.modes}
         self.mode_steps = {m.name: 0 for m in self.modes}
+        self.loop = self.rows = None  # the compiled loop, when compile() takes it
+
+    def compile(self, stop_ops, rows):
+        if not compiled.eligible(self.table, range(self.n), rows):
+            return False
+        self.loop = compiled.Loop(self.table, rows, self.signals, self.events, stop_ops)
+        self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
+        for m in self.modes:
+            m.arrays = (np.array(m.order, dtype=np.int64), np.array(m.mult, dtype=np.int64),
+                        np.array(m.refresh, dtype=np.int64))
+        return True
 
     def _pick(self, changed=None):
         """The first mode whose conditions hold, the signals of the components in `changed` (all
@@ -243,6 +324,11 @@ class ScheduledAlgorithm:
         for j, sig in enumerate(self.signals):
             if changed is None or changed[sig.ci]:
                 values[j] = int(sig.read())
+        return self._choose()
+
+    def _choose(self):
+        """The first mode whose conditions hold for the signal values held."""
+        values = self.signal_values
         for mode in self.modes:
             for j, vals in mode.conditions:
                 if values[j] not in vals:
@@ -270,11 +356,50 @@ class ScheduledAlgorithm:
         """Step until the stop time or a stop condition, calling `observe` (the observers' step
         functions) after every macro step."""
         end = self.plan.stop - self.tol
-        advance = self._advance
+        advance, loop = self._advance, self.loop
         while info.fired is None and self.t < end:
-            advance(info)
+            if loop is None:
+                advance(info)
+            else:
+                self._span(info, loop)  # the observers see the span's last step
             for f in observe:
                 f(info)
+
+    def _span(self, info, loop):
+        """Steps of the next mode in the compiled loop until the recorder's next row, a condition
+        signal's change, a stop signal or the end (what _advance does, step by step); returns
+        the steps taken."""
+        table, tol, stop = self.table, self.tol, self.plan.stop
+        mode = self.mode = self.next_mode
+        self.active_order = mode.order
+        t, tc, suspended = self.t, self.tc, self.suspended
+        for ci in mode.order:
+            if suspended[ci]:
+                tc[ci] = t  # back from suspension: the clock jumps to now
+                suspended[ci] = False
+        T = loop.T
+        T.ev_buf[:] = self.ev_values
+        T.sig_values[:] = self.signal_values
+        clocks = np.array(tc, dtype=np.float64)
+        order, mult, refresh = mode.arrays
+        rows, times = loop.enter(mode.record_every)
+        steps, t1, spent, flags = compiled.scheduled_span(
+            T, order, mult, refresh, mode.h, t, stop, tol, self.span.start(), self.mode_time[mode.name], clocks,
+            loop.changed, loop.status, rows, times, loop.rec)
+        self.span.took()
+        loop.leave()
+        self.tc = clocks.tolist()
+        self.ev_values = T.ev_buf.tolist()
+        self.signal_values = T.sig_values.tolist()
+        self.mode_time[mode.name] = spent
+        self.mode_steps[mode.name] += steps
+        self.t = table.t = t1
+        info.steps += steps
+        if flags & compiled.FAILED:
+            raise loop.failure(self.signals, self.events, self.stop_ops)
+        self._next(info, mode, self._choose() if flags & compiled.CONDITION_CHANGED else mode,
+                   loop.changed.tolist(), t1)
+        return steps
 
     def _advance(self, info):
         table, tol, stop = self.table, self.tol, self.plan.stop
@@ -323,14 +448,18 @@ class ScheduledAlgorithm:
                 break
         else:
             nxt = mode
+        info.steps += 1
+        self._next(info, mode, nxt, changed, t1)
+
+    def _next(self, info, mode, nxt, changed, t1):
+        """After a step of `mode` to t1: the mode `nxt` the next step takes, in `info` too."""
         if nxt is not mode:
             active_now = set(nxt.order)
             for ci in range(self.n):
                 if ci not in active_now:
-                    suspended[ci] = True
+                    self.suspended[ci] = True
         self.next_mode = nxt
         info.t = t1
-        info.steps += 1
         info.changed = changed
         if nxt is not mode:
             info.mode_changed = True
@@ -338,7 +467,7 @@ class ScheduledAlgorithm:
         else:
             info.mode_changed = False
         info.record_every = mode.record_every
-        info.last = t1 >= stop
+        info.last = t1 >= self.plan.stop
 
     def refresh_for_record(self):
         # every active component's inputs and feedthrough outputs as they stand now (the step

@@ -66,8 +66,9 @@ class _Run:
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
         observers: List[Observer] = [recorder]
-        if plan.stops:  # first: the recorder records a row where a stop condition fires
-            observers.insert(0, StopConditions(table, plan.stops))
+        stops = StopConditions(table, plan.stops) if plan.stops else None
+        if stops is not None:  # first: the recorder records a row where a stop condition fires
+            observers.insert(0, stops)
         bar = ProgressBar(plan) if progress else None
         if bar is not None:
             observers.append(bar)
@@ -82,6 +83,9 @@ class _Run:
         if timeout is not None:
             observers.append(WallClockLimit(timeout))
         observers.append(Interruption(watch))  # last: the row of this step is recorded first
+        # the profiler and a caller's step() watch every step: the Python loop
+        if profiler is None and all(type(obs).step is Observer.step for obs in callers):
+            algorithm.compile(stops.ops if stops is not None else [], recorder)
         info = StepInfo(plan.start, plan.record_every)
         self.recorder, self.info, self.algorithm = recorder, info, algorithm
         algorithm.start(info)

@@ -534,6 +534,14 @@ class InstanceTable:
         by_dst = {}
         for lk in sysm.links:
             by_dst.setdefault((lk.dst, lk.vtype), []).append(lk)
+        # every component's inputs of one type live in one buffer too (the values last sent, which
+        # the compiled step loop reads and writes in place: system_ssp.master.compiled)
+        sizes = {}
+        for (_, kind), lks in by_dst.items():
+            sizes[kind] = sizes.get(kind, 0) + len(lks)
+        self.IN = {kind: np.zeros(max(sizes.get(kind, 0), 1), dtype=t) for kind, t in NPTYPE.items()}
+        self.in_start = {}  # SetOp -> its first position in self.IN[kind]
+        filled = dict.fromkeys(NPTYPE, 0)
         for (ci, kind), lks in sorted(by_dst.items()):
             m = len(lks)
             if kind == "String":
@@ -544,20 +552,26 @@ class InstanceTable:
                                                  tuple(lk.dst_var for lk in lks)))
                 continue
             vr = (ctypes.c_uint * m)(*[comps[ci].vars[lk.dst_var].valueReference for lk in lks])
-            buf = (CTYPE[kind] * m)()
+            store, first = self.IN[kind], filled[kind]
+            filled[kind] += m
+            buf = (CTYPE[kind] * m).from_address(store.ctypes.data + first * store.itemsize)
             idx = np.array([slots[kind][(lk.src, lk.src_var)] for lk in lks], dtype=np.intp)
             fac = np.array([lk.factor for lk in lks])
             off = np.array([lk.offset for lk in lks])
             affine = kind == "Real" and (np.any(fac != 1.0) or np.any(off != 0.0))
             inst = self.instances[ci]
-            self.sets[ci].append(SetOp(inst.function(SET[kind], vr, m), inst.fmu.component, vr, m, buf,
-                                       np.ctypeslib.as_array(buf), self.G[kind], idx, fac if affine else None,
-                                       off if affine else None, _mapper(kind, lks), ci, SET[kind],
-                                       tuple(lk.dst_var for lk in lks)))
+            op = SetOp(inst.function(SET[kind], vr, m), inst.fmu.component, vr, m, buf, store[first:first + m],
+                       self.G[kind], idx, fac if affine else None, off if affine else None, _mapper(kind, lks), ci,
+                       SET[kind], tuple(lk.dst_var for lk in lks))
+            self.sets[ci].append(op)
+            self.in_start[op] = first
         # the hot loop's calls, one function per component
         self.getters = [_sequence([op.run for op in ops]) for ops in self.gets]
         self.setters = [_sequence([op.run for op in ops]) for ops in self.sets]
         self.do_steps = [self._do_step(ci) for ci in range(n)]
+        self.step_ios = (StepIO * n)()  # the batched step's blocks, one per component (read by the compiled loop)
+        self.step_io_functions = [None] * n  # per component: its library's neighborStepIO, or None
+        self.step_failures = [None] * n  # per component: status -> the StepFailed of a failed batched step
         self.steppers = [self._stepper(ci) for ci in range(n)]
         # components whose connected outputs change when their inputs are set
         self.has_ft = [bool(sysm.graph.feedthrough_outputs[ci]) and bool(self.gets[ci]) for ci in range(n)]
@@ -596,7 +610,7 @@ class InstanceTable:
     def _batched_stepper(self, ci, step_io):
         """step(t, dt) of component ci through the runtime's neighborStepIO: the same set, doStep
         and get calls as `_stepper`'s, made inside the FMU; a failure names the call that failed."""
-        io = StepIO()
+        io = self.step_ios[ci]
         sets = {_step_io_kind(op): op for op in self.sets[ci]}  # one block per type and component
         gets = {_step_io_kind(op): op for op in self.gets[ci]}
         for k, op in sets.items():
@@ -618,6 +632,8 @@ class InstanceTable:
                 op = gets[where - 5]
                 return StepFailed(ci, op.call, s, op.names)
             return StepFailed(ci, "fmi2DoStep", s)
+
+        self.step_io_functions[ci], self.step_failures[ci] = step_io, failed
 
         def step(t, dt):
             for k, gather in gathers:

@@ -197,6 +197,7 @@ class ProgressBar(Observer):
         self.chunk = 1 if plan.schedule is not None else max(1, plan.n_steps // 500)
         self.mode, self.mode_t0 = None, plan.start
         self.posted, self.posted_steps = 0.0, 0
+        self.drawn_steps = 0  # steps at the last update (the compiled loop reports several steps at once)
 
     def start(self, info):
         try:
@@ -224,8 +225,9 @@ class ProgressBar(Observer):
 
     def step(self, info):
         bar = self.bar
-        if bar is None or info.steps % self.chunk:
+        if bar is None or info.steps - self.drawn_steps < self.chunk:
             return
+        self.drawn_steps = info.steps
         if info.mode != self.mode:  # the scheduled algorithm names the next step's mode
             self.mode, self.mode_t0 = info.mode, info.t
         now = time.perf_counter()

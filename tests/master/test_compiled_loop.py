@@ -1,0 +1,106 @@
+"""The compiled step loop (issue 27, system_ssp.master.compiled): many macro steps per call from
+Python, the FMI functions called through their addresses. It must give the Python loop's results
+bit for bit (the same calls with the same values in the same order), in fixed-step and scheduled
+runs, with stop conditions, Boolean connections, schedule modes and events; and be used only
+where it can serve the run."""
+import numpy as np
+import pytest
+
+from system_ssp import Observer
+from system_ssp.master import algorithms, compiled
+from system_ssp.master.system import simulate
+
+SPAN = compiled.scheduled_span, compiled.fixed_span
+
+
+def _run(path, loop, monkeypatch, **options):
+    """simulate(path) with the compiled loop on or off; also how many spans it ran."""
+    monkeypatch.setattr(compiled, "ENABLED", loop)
+    spans = []
+
+    def counted(function):
+        def span(*args):
+            spans.append(1)
+            return function(*args)
+        return span
+
+    monkeypatch.setattr(compiled, "scheduled_span", counted(SPAN[0]))
+    monkeypatch.setattr(compiled, "fixed_span", counted(SPAN[1]))
+    return simulate(path, **options), len(spans)
+
+
+def _same(a, b):
+    assert list(a.names) == list(b.names)
+    assert a.to_pandas().equals(b.to_pandas())  # every recorded value, bit for bit
+    assert a.final == b.final and a.stop_reason == b.stop_reason and a.steps == b.steps
+    assert a.modes == b.modes  # scheduled: steps and simulated time per mode
+
+
+# detumble: Real connections and a stop condition (fixed step); attitude_determination: Boolean
+# connections and feedthrough sensors; sun_avoidance_slew: the slew guidance chain
+@pytest.mark.parametrize("system", ["detumble", "attitude_determination", "sun_avoidance_slew"])
+def test_compiled_fixed_step_loop_equals_the_python_loop(ssp_paths, monkeypatch, system):
+    python, spans_off = _run(ssp_paths[system], False, monkeypatch)
+    fast, spans = _run(ssp_paths[system], True, monkeypatch)
+    assert spans_off == 0 and 0 < spans < fast.steps / 5  # many steps per call
+    _same(fast, python)
+
+
+def test_compiled_loop_records_every_kth_step_and_at_the_end(ssp_paths, monkeypatch):
+    """record_every 7 over a run that ends between rows: the rows on the way come from the
+    compiled loop, the last from Python's recorder."""
+    options = {"record_every": 7, "stop_time": 2.0, "stop_when": []}
+    python, _ = _run(ssp_paths["detumble"], False, monkeypatch, **options)
+    fast, _ = _run(ssp_paths["detumble"], True, monkeypatch, **options)
+    assert len(fast.data) == len(python.data) > 10
+    _same(fast, python)
+
+
+def test_compiled_scheduled_loop_equals_the_python_loop(ssp_paths, monkeypatch):
+    """The de-orbit system's schedule: 0.5 s steps while the propulsion's `burning` signal is
+    true (a 39-minute burn, recorded every 60th step), then hour-long coast steps (the mode
+    changes where the signal does, mid-span)."""
+    options = {"stop_time": 3 * 3600.0, "stop_when": [], "parameters": {"propulsion.burn_enable": True}}
+    python, _ = _run(ssp_paths["deorbit"], False, monkeypatch, **options)
+    fast, spans = _run(ssp_paths["deorbit"], True, monkeypatch, **options)
+    assert 0 < spans < 200 and python.modes["burn"]["steps"] > 4000 and python.modes["coast"]["steps"] > 0
+    _same(fast, python)
+
+
+class _Steps(Observer):
+    def __init__(self):
+        self.seen = []
+
+    def step(self, info):
+        self.seen.append(info.steps)
+
+
+class _End(Observer):
+    def finish(self, info):
+        self.t = info.t
+
+
+def test_python_loop_where_the_compiled_one_cannot_serve(ssp_paths, monkeypatch):
+    """The profiler times each component's step and a caller's observer with a step() sees
+    every step: the Python loop runs them; one that only watches the end leaves the compiled loop."""
+    watcher, end = _Steps(), _End()
+    r, spans = _run(ssp_paths["detumble"], True, monkeypatch, stop_time=0.3, observers=[watcher])
+    assert spans == 0 and watcher.seen == list(range(1, 21))
+    r, spans = _run(ssp_paths["detumble"], True, monkeypatch, stop_time=0.3, observers=[end])
+    assert 0 < spans < 20 and end.t == r.stop_time == 0.3
+    options = {"stop_time": 600.0, "stop_when": [], "parameters": {"propulsion.burn_enable": True}}
+    r, spans = _run(ssp_paths["deorbit"], True, monkeypatch, profile=True, **options)
+    assert spans == 0 and r.profile is not None and r.modes["burn"]["steps"] == 1200
+
+
+def test_span_steps_bound_what_one_call_takes(monkeypatch, ssp_paths):
+    """Python sees the run at least every SPAN_STEPS steps, and about every SPAN_SECONDS where
+    steps are slow (interruptions, the wall-clock limit)."""
+    monkeypatch.setattr(algorithms, "SPAN_STEPS", 10)
+    r, spans = _run(ssp_paths["detumble"], True, monkeypatch, stop_time=3.0, stop_when=[], record_every=1000)
+    assert spans >= 20 and r.steps == 200  # none longer than SPAN_STEPS
+    assert np.array_equal(r.data["time"], [0.0, 3.0])
+    monkeypatch.setattr(algorithms, "SPAN_STEPS", 2000)
+    monkeypatch.setattr(algorithms, "SPAN_SECONDS", 1e-9)  # every span "too long": down to one step each
+    r, spans = _run(ssp_paths["detumble"], True, monkeypatch, stop_time=3.0, stop_when=[], record_every=1000)
+    assert r.steps == 200 and spans > 150  # 16, 8, 4, 2, then one step per span
