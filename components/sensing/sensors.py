@@ -81,23 +81,30 @@ def perturb(b, angle, azimuth):
 
 
 class _Seeded:
-    """Random generator plus the current sample; subclasses define _draw()."""
+    """Random generator plus the current sample; subclasses define _draw(). `operating_time`:
+    the sum of the steps taken (a host that steps a sensor only while it is powered counts its
+    powered time), which the sensors' faults are timed by."""
 
     def __init__(self, seed):
         self.seed = check_seed(seed)
         self.rng = np.random.default_rng(self.seed)
+        self.operating_time = 0.0
         self.sample = self._draw()
 
     def step(self, h=None):
-        """Advance to the next communication point: draw a new noise sample."""
+        """Advance to the next communication point, h seconds of operation after the last: draw
+        a new noise sample."""
+        if h is not None:
+            self.operating_time += h
         self.sample = self._draw()
 
     def get_state(self):
-        return {"rng": self.rng.bit_generator.state, "sample": list(self.sample)}
+        return {"rng": self.rng.bit_generator.state, "sample": list(self.sample), "operating_time": self.operating_time}
 
     def set_state(self, state):
         self.rng.bit_generator.state = state["rng"]
         self.sample = tuple(float(x) for x in state["sample"])
+        self.operating_time = float(state["operating_time"])
 
 
 class _VectorSensor(_Seeded):
@@ -155,25 +162,11 @@ class SunSensor(_VectorSensor):
         self.half_fov = half_fov
         self.cos_half_fov = math.cos(half_fov)
         self.fail_time = None if fail_time is None else check_sigma("fail_time", fail_time, "s")
-        self.time = 0.0
         super().__init__(sigma, seed)
 
     @property
     def failed(self):
-        return self.fail_time is not None and self.time >= self.fail_time - 1e-9
-
-    def step(self, h=None):
-        """The next noise sample, h seconds of operation after the last."""
-        if h is not None:
-            self.time += h
-        super().step(h)
-
-    def get_state(self):
-        return {**super().get_state(), "time": self.time}
-
-    def set_state(self, state):
-        super().set_state(state)
-        self.time = float(state["time"])
+        return self.fail_time is not None and self.operating_time >= self.fail_time - 1e-9
 
     def true_sun(self, r_SN_N, r_BN_N, q_BN):
         s = finite_vector(r_SN_N, 3, "r_SN_N")
@@ -219,7 +212,6 @@ class Gyro(_Seeded):
         self.bias_jump = finite_vector(bias_jump, 3, "bias_jump")
         self.jump_time = check_sigma("jump_time", jump_time, "s")
         self.scale = self.sigma
-        self.time = 0.0
         self.jumped = False
         super().__init__(seed)
 
@@ -230,12 +222,10 @@ class Gyro(_Seeded):
         """The next sample, h seconds of operation after the last."""
         if self.sigma_sample_time > 0.0 and h is not None and h > 0.0:
             self.scale = self.sigma * math.sqrt(self.sigma_sample_time / h)
-        if h is not None:
-            self.time += h
-        if not self.jumped and any(self.bias_jump) and self.time >= self.jump_time - 1e-9:
+        super().step(h)
+        if not self.jumped and any(self.bias_jump) and self.operating_time >= self.jump_time - 1e-9:
             self.jumped = True
             self.bias = tuple(b + j for b, j in zip(self.bias, self.bias_jump))
-        super().step(h)
 
     def measure(self, omega_BN_B):
         w = finite_vector(omega_BN_B, 3, "omega_BN_B")
@@ -243,13 +233,12 @@ class Gyro(_Seeded):
         return (w[0] + b[0] + s * n[0], w[1] + b[1] + s * n[1], w[2] + b[2] + s * n[2])
 
     def get_state(self):
-        return {**super().get_state(), "scale": self.scale, "time": self.time, "jumped": self.jumped,
-                "bias": list(self.bias)}
+        return {**super().get_state(), "scale": self.scale, "jumped": self.jumped, "bias": list(self.bias)}
 
     def set_state(self, state):
         super().set_state(state)
         self.scale = float(state["scale"])
-        self.time, self.jumped = float(state["time"]), bool(state["jumped"])
+        self.jumped = bool(state["jumped"])
         self.bias = tuple(float(x) for x in state["bias"])
 
 

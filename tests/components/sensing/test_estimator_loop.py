@@ -238,6 +238,6 @@ def test_the_gyro_bias_jumps_after_its_operating_time():
     gyro.step(1.0)
     assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 2e-3, 0.0)  # once
     gyro.set_state(saved)
-    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 0.0, 0.0) and gyro.time == 5.0
+    assert gyro.measure((0.0, 0.0, 0.0)) == (1e-3, 0.0, 0.0) and gyro.operating_time == 5.0
     with pytest.raises(ValueError, match="bias_jump"):
         sensors.Gyro(bias_jump=(0.0, math.nan, 0.0))
