@@ -92,6 +92,35 @@ def mission_420km(ssp_paths, tmp_path_factory):
     return summary, result, out
 
 
+# The longest tests first: with pytest-xdist they run beside the many short ones instead of alone
+# at the end (the ten dispersed missions are the suite's critical path)
+LONG_FIRST = ("tests/systems/test_mission_dispersion.py", "tests/systems/test_mission_system.py",
+              "tests/systems/test_budgets.py")
+
+# The validation table's guard: the test node ids that ran (their reports reach this process,
+# also from pytest-xdist's workers) and, per published number, the ids of the tests that checked
+# it (system_ssp.neighbor.validation.CHECKED, filled in the process that ran the test: a worker
+# sends its own at its end)
+RAN = set()
+CHECKED_BY_WORKERS = {}
+
+
+def pytest_collection_modifyitems(config, items):
+    items.sort(key=lambda item: 0 if item.nodeid.startswith(LONG_FIRST) else 1)  # stable: the rest keep their order
+
+
+def pytest_runtest_logreport(report):
+    if report.when == "call":
+        RAN.add(report.nodeid.split("[")[0])
+
+
+@pytest.hookimpl(optionalhook=True)
+def pytest_testnodedown(node, error):
+    """pytest-xdist: a worker's checked numbers, merged here."""
+    for key, nodeids in getattr(node, "workeroutput", {}).get("validation_checked", {}).items():
+        CHECKED_BY_WORKERS.setdefault(key, set()).update(nodeids)
+
+
 def pytest_sessionfinish(session, exitstatus):
     """The validation table's guard: every published number whose guarding test ran in this
     session must have been checked by that test (system_ssp.neighbor.validation.assert_reproduces)."""
@@ -99,12 +128,18 @@ def pytest_sessionfinish(session, exitstatus):
 
     if session.config.option.collectonly:
         return  # nothing ran (pytest --co)
-    ran = {item.nodeid.split("[")[0] for item in session.items}
+    workeroutput = getattr(session.config, "workeroutput", None)
+    if workeroutput is not None:  # a pytest-xdist worker: the controller checks
+        workeroutput["validation_checked"] = {key: sorted(ids) for key, ids in validation.CHECKED.items()}
+        return
+    checked = {key: set(ids) for key, ids in validation.CHECKED.items()}
+    for key, ids in CHECKED_BY_WORKERS.items():
+        checked.setdefault(key, set()).update(ids)
     missing = []
     for number in validation.NUMBERS:
-        if number.test not in ran:
+        if number.test not in RAN:
             continue  # a partial run (-k, one file): not this session's business
-        if not any(nodeid.split("[")[0] == number.test for nodeid in validation.CHECKED.get(number.key, ())):
+        if not any(nodeid.split("[")[0] == number.test for nodeid in checked.get(number.key, ())):
             missing.append(f"{number.key} (by {number.test})")
     if missing:
         session.config.get_terminal_writer().line(
