@@ -153,26 +153,27 @@ def _gather(T, m):
                 if T.scratch_bits[0] != T.in_real_bits[j]:
                     differ = True
                     T.in_real[j] = x
-        else:
-            for j in range(s, s + L):
-                b = T.g_real_bits[T.idx_real[j]]
-                if b != T.in_real_bits[j]:
-                    differ = True
-                    T.in_real_bits[j] = b
+        elif _take_changed(T.g_real_bits, T.idx_real, T.in_real_bits, s, L):  # the bits: "the same bytes"
+            differ = True
     elif kind == 1:
-        for j in range(s, s + L):
-            v = T.g_int[T.idx_int[j]]
-            if v != T.in_int[j]:
-                differ = True
-                T.in_int[j] = v
-    else:
-        for j in range(s, s + L):
-            v = T.g_bool[T.idx_bool[j]]
-            if v != T.in_bool[j]:
-                differ = True
-                T.in_bool[j] = v
+        if _take_changed(T.g_int, T.idx_int, T.in_int, s, L):
+            differ = True
+    elif _take_changed(T.g_bool, T.idx_bool, T.in_bool, s, L):
+        differ = True
     T.set_valid[m] = True
     return differ
+
+
+@njit(cache=True)
+def _take_changed(source, idx, sent, s, L):
+    """sent[s:s+L] = source[idx[s:s+L]]; True when a value changed."""
+    changed = False
+    for j in range(s, s + L):
+        v = source[idx[j]]
+        if v != sent[j]:
+            changed = True
+            sent[j] = v
+    return changed
 
 
 @njit(cache=True)
