@@ -102,6 +102,7 @@ class FixedStepAlgorithm:
         self.loop = compiled.Loop(self.table, rows, stop_ops=stop_ops)
         self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
         self.order_array, self.mult_array = np.array(self.order, dtype=np.int64), np.array(self.mult, dtype=np.int64)
+        self.loop.load(fixed=(self.order_array, self.mult_array))
         return True
 
     def start(self, info):
@@ -164,9 +165,9 @@ class FixedStepAlgorithm:
         p, table = self.plan, self.table
         k0, N = info.steps, p.n_steps
         rows, times = loop.enter(info.record_every)
-        steps, flags = compiled.fixed_span(loop.T, self.order_array, self.mult_array, self.all_one, p.start, p.stop,
-                                           p.step_size, N, k0, self.span.start(), loop.changed, loop.status, rows,
-                                           times, loop.rec)
+        steps, flags = compiled.fixed_span(loop.T, self.order_array, self.mult_array, bool(self.all_one),
+                                           float(p.start), float(p.stop), float(p.step_size), int(N), int(k0),
+                                           self.span.start(), loop.changed, loop.status, rows, times, loop.rec)
         self.span.took()
         loop.leave()
         k = k0 + steps
@@ -315,6 +316,7 @@ class ScheduledAlgorithm:
         for m in self.modes:
             m.arrays = (np.array(m.order, dtype=np.int64), np.array(m.mult, dtype=np.int64),
                         np.array(m.refresh, dtype=np.int64))
+        self.loop.load(mode_arrays=self.modes[0].arrays)
         return True
 
     def _pick(self, changed=None):
@@ -384,8 +386,8 @@ class ScheduledAlgorithm:
         order, mult, refresh = mode.arrays
         rows, times = loop.enter(mode.record_every)
         steps, t1, spent, flags = compiled.scheduled_span(
-            T, order, mult, refresh, mode.h, t, stop, tol, self.span.start(), self.mode_time[mode.name], clocks,
-            loop.changed, loop.status, rows, times, loop.rec)
+            T, order, mult, refresh, float(mode.h), float(t), float(stop), float(tol), self.span.start(),
+            float(self.mode_time[mode.name]), clocks, loop.changed, loop.status, rows, times, loop.rec)
         self.span.took()
         loop.leave()
         self.tc = clocks.tolist()

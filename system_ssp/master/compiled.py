@@ -358,7 +358,7 @@ def scheduled_span(T, order, mult, refresh, h_mode, t, stop, tol, max_steps, spe
     steps, flags = 0, 0
     status_out[0] = 0
     end_time = stop - tol
-    while True:
+    while max_steps > 0:  # 0: nothing (Loop.load)
         h = h_mode
         for j in range(len(T.ev_buf)):
             te = T.ev_buf[j]
@@ -528,6 +528,18 @@ class Loop:
         self.set_ops = [op for ci in range(len(table.instances)) for op in table.sets[ci]]
         self.status = np.zeros(3, dtype=np.int64)
         self.changed = np.zeros(len(table.instances), dtype=np.bool_)
+
+    def load(self, mode_arrays=None, fixed=None):
+        """Call the span function once without a step, so that numba loads (or compiles) it now,
+        before the run's clock starts: `mode_arrays` (order, mult, refresh) of a scheduled run,
+        or `fixed` (order, mult) of a fixed-step one."""
+        rows, times = self.rows.rows, self.rows.times
+        if fixed is not None:
+            fixed_span(self.T, fixed[0], fixed[1], False, 0.0, 1.0, 1.0, 1, 0, 0, self.changed, self.status, rows,
+                       times, self.rec)
+        else:
+            scheduled_span(self.T, mode_arrays[0], mode_arrays[1], mode_arrays[2], 1.0, 0.0, 1.0, 0.0, 0, 0.0,
+                           np.zeros(len(self.changed)), self.changed, self.status, rows, times, self.rec)
 
     def enter(self, record_every):
         """Before a span: which inputs the Python loop has sent (its SetOp.last), the recorder's

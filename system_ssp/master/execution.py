@@ -80,12 +80,14 @@ class _Run:
         for obs in callers:
             obs.attach(view)
             observers.append(obs)
+        # the profiler and a caller's step() watch every step: the Python loop. Before the
+        # wall-clock limit starts: the compiled loop loads its code here (about a second in a
+        # new process), which is not the run's time
+        if profiler is None and all(type(obs).step is Observer.step for obs in callers):
+            algorithm.compile(stops.ops if stops is not None else [], recorder)
         if timeout is not None:
             observers.append(WallClockLimit(timeout))
         observers.append(Interruption(watch))  # last: the row of this step is recorded first
-        # the profiler and a caller's step() watch every step: the Python loop
-        if profiler is None and all(type(obs).step is Observer.step for obs in callers):
-            algorithm.compile(stops.ops if stops is not None else [], recorder)
         info = StepInfo(plan.start, plan.record_every)
         self.recorder, self.info, self.algorithm = recorder, info, algorithm
         algorithm.start(info)

@@ -75,7 +75,7 @@ class WallClockLimit(Observer):
     def __init__(self, seconds):
         self.deadline = time.perf_counter() + seconds
         self.seconds = seconds
-        self.check_at = 0
+        self.check_at = 16
 
     def step(self, info):
         if info.steps >= self.check_at:  # every 16 steps (the compiled loop reports several at once)
