@@ -311,7 +311,7 @@ class ScheduledAlgorithm:
     def compile(self, stop_ops, rows):
         if not compiled.eligible(self.table, range(self.n), rows):
             return False
-        self.loop = compiled.Loop(self.table, rows, self.signals, self.events, stop_ops)
+        self.loop = compiled.Loop(self.table, rows, self.signals, self.events, stop_ops, self.prod)
         self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
         for m in self.modes:
             m.arrays = (np.array(m.order, dtype=np.int64), np.array(m.mult, dtype=np.int64),

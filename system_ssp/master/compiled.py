@@ -429,11 +429,13 @@ def _address(fn):
     return 0 if fn is None else ctypes.cast(fn, ctypes.c_void_p).value
 
 
-def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=()):
+def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=(), producers=None):
     """The Tables of an InstanceTable whose every component has a batched step and no mapped
     or String input (`eligible`): its prepared operations, the schedule's signals
-    (`_Signal`s) and the stop conditions' ReadOps."""
+    (`_Signal`s), the stop conditions' and the recorder's ReadOps and the components'
+    producers (ScheduledAlgorithm.prod; a fixed-step run refreshes without them)."""
     n = len(table.instances)
+    prod = producers if producers is not None else [[] for _ in range(n)]
     kinds = {"Real": 0, "Integer": 1, "Boolean": 2}
     set_ops = [op for ci in range(n) for op in table.sets[ci]]
     index = {id(op): m for m, op in enumerate(set_ops)}
@@ -459,7 +461,6 @@ def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=()):
     layout = _i64([size // 8, size // 4, io_type.t.offset // 8, io_type.h.offset // 8, io_type.send.offset // 4,
                    io_type.failed.offset // 4])
     io_base = ctypes.addressof(table.step_ios)
-    prod = [sorted({lk.src for lk in table.system.links if lk.dst == ci}) for ci in range(n)]
     stop_lens = [op.n for op in stop_ops]
     scratch = np.zeros(1)
     rec_cols = np.cumsum([0] + [op.n for op in record_ops]).astype(np.int64)
@@ -520,10 +521,10 @@ class Loop:
     """The compiled loop of one run: its tables and the Python side's bookkeeping around a span
     (the set operations' "last sent" kept in step with the Python loop's)."""
 
-    def __init__(self, table, rows, signals=(), events=(), stop_ops=()):
+    def __init__(self, table, rows, signals=(), events=(), stop_ops=(), producers=None):
         self.table = table
         self.rows = rows  # the Recorder (its numeric ops only: eligible() refuses recorded Strings)
-        self.T = build_tables(table, signals, events, stop_ops, rows.ops)
+        self.T = build_tables(table, signals, events, stop_ops, rows.ops, producers)
         self.rec = np.zeros(3, dtype=np.int64)
         self.set_ops = [op for ci in range(len(table.instances)) for op in table.sets[ci]]
         self.status = np.zeros(3, dtype=np.int64)
