@@ -94,13 +94,12 @@ class FixedStepAlgorithm:
         self.n = len(table.instances)
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
 
-        self.loop = self.rows = None  # the compiled loop, when compile() takes it
+        self.loop = None  # the compiled loop, when compile() takes it
 
     def compile(self, stop_ops, rows):
         if self.jacobi or not compiled.eligible(self.table, range(self.n), rows):
             return False
-        self.loop = compiled.Loop(self.table, rows, stop_ops=stop_ops)
-        self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
+        self.loop, self.span = compiled.Loop(self.table, rows, stop_ops=stop_ops), SpanSize()
         self.order_array, self.mult_array = np.array(self.order, dtype=np.int64), np.array(self.mult, dtype=np.int64)
         self.loop.load(fixed=(self.order_array, self.mult_array))
         return True
@@ -161,7 +160,8 @@ class FixedStepAlgorithm:
                 f(info)
 
     def _span(self, info, loop, observe):
-        """Steps up to the recorder's next row in the compiled loop, then the observers once."""
+        """A span of steps in the compiled loop (rows recorded on the way), then the observers
+        once, on its last step."""
         p, table = self.plan, self.table
         k0, N = info.steps, p.n_steps
         rows, times = loop.enter(info.record_every)
@@ -173,7 +173,7 @@ class FixedStepAlgorithm:
         k = k0 + steps
         if flags & compiled.FAILED:
             table.t = info.t = p.start + k * p.step_size  # the step that failed
-            raise loop.failure(stop_ops=self.stop_ops)
+            raise loop.failure()
         info.steps = k
         info.t = table.t = p.start + k * p.step_size if k < N else p.stop
         info.last = k == N
@@ -306,13 +306,13 @@ class ScheduledAlgorithm:
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
         self.mode_time = {m.name: 0.0 for m in self.modes}
         self.mode_steps = {m.name: 0 for m in self.modes}
-        self.loop = self.rows = None  # the compiled loop, when compile() takes it
+        self.loop = None  # the compiled loop, when compile() takes it
 
     def compile(self, stop_ops, rows):
         if not compiled.eligible(self.table, range(self.n), rows):
             return False
         self.loop = compiled.Loop(self.table, rows, self.signals, self.events, stop_ops, self.prod)
-        self.stop_ops, self.rows, self.span = stop_ops, rows, SpanSize()
+        self.span = SpanSize()
         for m in self.modes:
             m.arrays = (np.array(m.order, dtype=np.int64), np.array(m.mult, dtype=np.int64),
                         np.array(m.refresh, dtype=np.int64))
@@ -368,9 +368,9 @@ class ScheduledAlgorithm:
                 f(info)
 
     def _span(self, info, loop):
-        """Steps of the next mode in the compiled loop until the recorder's next row, a condition
-        signal's change, a stop signal or the end (what _advance does, step by step); returns
-        the steps taken."""
+        """Steps of the next mode in the compiled loop (what _advance does, step by step, rows
+        recorded on the way) until a condition signal's change, a stop signal, the end or the
+        span's size."""
         table, tol, stop = self.table, self.tol, self.plan.stop
         mode = self.mode = self.next_mode
         self.active_order = mode.order
@@ -398,10 +398,9 @@ class ScheduledAlgorithm:
         self.t = table.t = t1
         info.steps += steps
         if flags & compiled.FAILED:
-            raise loop.failure(self.signals, self.events, self.stop_ops)
+            raise loop.failure()
         self._next(info, mode, self._choose() if flags & compiled.CONDITION_CHANGED else mode,
                    loop.changed.tolist(), t1)
-        return steps
 
     def _advance(self, info):
         table, tol, stop = self.table, self.tol, self.plan.stop

@@ -429,15 +429,15 @@ def _address(fn):
     return 0 if fn is None else ctypes.cast(fn, ctypes.c_void_p).value
 
 
-def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=(), producers=None):
+def build_tables(table, set_ops, get_ops, signals=(), events=(), stop_ops=(), record_ops=(), producers=None):
     """The Tables of an InstanceTable whose every component has a batched step and no mapped
-    or String input (`eligible`): its prepared operations, the schedule's signals
-    (`_Signal`s), the stop conditions' and the recorder's ReadOps and the components'
-    producers (ScheduledAlgorithm.prod; a fixed-step run refreshes without them)."""
+    or String input (`eligible`): its prepared operations (`set_ops` and `get_ops`: every
+    component's, in component order), the schedule's signals (`_Signal`s), the stop conditions'
+    and the recorder's ReadOps and the components' producers (ScheduledAlgorithm.prod; a
+    fixed-step run refreshes without them)."""
     n = len(table.instances)
     prod = producers if producers is not None else [[] for _ in range(n)]
     kinds = {"Real": 0, "Integer": 1, "Boolean": 2}
-    set_ops = [op for ci in range(n) for op in table.sets[ci]]
     index = {id(op): m for m, op in enumerate(set_ops)}
     set_ptr, set_list, by_kind = [0], [], np.full((n, 3), -1, dtype=np.int64)
     for ci in range(n):
@@ -453,9 +453,7 @@ def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=(), produ
         idx[kind][s:s + op.n] = op.idx
         if op.factor is not None:
             factor[s:s + op.n], offset[s:s + op.n] = op.factor, op.offset
-    get_ops = [table.gets[ci] for ci in range(n)]
-    get_ptr = np.cumsum([0] + [len(ops) for ops in get_ops]).astype(np.int64)
-    flat_gets = [op for ops in get_ops for op in ops]
+    get_ptr = np.cumsum([0] + [len(table.gets[ci]) for ci in range(n)]).astype(np.int64)
     size = ctypes.sizeof(table.step_ios) // max(n, 1)
     io_type = type(table.step_ios[0]) if n else None
     layout = _i64([size // 8, size // 4, io_type.t.offset // 8, io_type.h.offset // 8, io_type.send.offset // 4,
@@ -477,9 +475,9 @@ def build_tables(table, signals=(), events=(), stop_ops=(), record_ops=(), produ
         set_fn=_i64(_address(op.fn) for op in set_ops), set_vr=_i64(ctypes.addressof(op.vr) for op in set_ops),
         set_buf=_i64(ctypes.addressof(op.buf) for op in set_ops),
         set_ptr=_i64(set_ptr), set_list=_i64(set_list), set_by_kind=by_kind,
-        get_ptr=get_ptr, get_fn=_i64(_address(op.fn) for op in flat_gets),
-        get_vr=_i64(ctypes.addressof(op.vr) for op in flat_gets), get_len=_i64(op.n for op in flat_gets),
-        get_buf=_i64(ctypes.addressof(op.buf) for op in flat_gets),
+        get_ptr=get_ptr, get_fn=_i64(_address(op.fn) for op in get_ops),
+        get_vr=_i64(ctypes.addressof(op.vr) for op in get_ops), get_len=_i64(op.n for op in get_ops),
+        get_buf=_i64(ctypes.addressof(op.buf) for op in get_ops),
         idx_real=idx["Real"], idx_int=idx["Integer"], idx_bool=idx["Boolean"], factor=factor, offset=offset,
         g_real=G["Real"], g_real_bits=G["Real"].view(np.int64), g_int=G["Integer"], g_bool=G["Boolean"],
         in_real=IN["Real"], in_real_bits=IN["Real"].view(np.int64), in_int=IN["Integer"], in_bool=IN["Boolean"],
@@ -510,9 +508,9 @@ def eligible(table, components, rows):
     for ci in components:
         if table.step_io_functions[ci] is None or table.instances[ci].fmi3:
             return False
-        if any(not hasattr(op, "post") or op.post is not None for op in table.sets[ci]):
+        if any(op.call == "fmi2SetString" or op.post is not None for op in table.sets[ci]):
             return False
-        if any(not hasattr(op, "buf") or op.call == "fmi2GetString" for op in table.gets[ci]):
+        if any(op.call == "fmi2GetString" for op in table.gets[ci]):
             return False
     return True
 
@@ -524,9 +522,12 @@ class Loop:
     def __init__(self, table, rows, signals=(), events=(), stop_ops=(), producers=None):
         self.table = table
         self.rows = rows  # the Recorder (its numeric ops only: eligible() refuses recorded Strings)
-        self.T = build_tables(table, signals, events, stop_ops, rows.ops, producers)
+        self.signals, self.events, self.stop_ops = signals, events, stop_ops
+        n = len(table.instances)
+        self.set_ops = [op for ci in range(n) for op in table.sets[ci]]  # the tables' order
+        self.get_ops = [op for ci in range(n) for op in table.gets[ci]]
+        self.T = build_tables(table, self.set_ops, self.get_ops, signals, events, stop_ops, rows.ops, producers)
         self.rec = np.zeros(3, dtype=np.int64)
-        self.set_ops = [op for ci in range(len(table.instances)) for op in table.sets[ci]]
         self.status = np.zeros(3, dtype=np.int64)
         self.changed = np.zeros(len(table.instances), dtype=np.bool_)
 
@@ -561,20 +562,16 @@ class Loop:
             op.last[0] = op.view.tobytes() if valid[m] else None
         self.rows.count, self.rows.since = int(self.rec[0]), int(self.rec[1])
 
-    def failure(self, signals=(), events=(), stop_ops=()):
+    def failure(self):
         """The StepFailed the Python loop would have raised for the span's failed call."""
         s, what, i = (int(x) for x in self.status)
-        table = self.table
         if what == ERROR_STEP:
-            return table.step_failures[i](s)
-        if what == ERROR_SET:
-            op = self.set_ops[i]
+            return self.table.step_failures[i](s)
+        if what in (ERROR_SET, ERROR_GET):
+            op = (self.set_ops if what == ERROR_SET else self.get_ops)[i]
             return StepFailed(op.ci, op.call, s, op.names)
-        if what == ERROR_GET:
-            op = [g for ci in range(len(table.instances)) for g in table.gets[ci]][i]
-            return StepFailed(op.ci, op.call, s, op.names)
-        sig = {ERROR_SIGNAL: signals, ERROR_EVENT: events}.get(what)
+        sig = {ERROR_SIGNAL: self.signals, ERROR_EVENT: self.events}.get(what)
         if sig is not None:
             return StepFailed(sig[i].ci, sig[i].call, s, (sig[i].var,))
-        op = stop_ops[i] if what == ERROR_STOP else self.rows.ops[i]
+        op = self.stop_ops[i] if what == ERROR_STOP else self.rows.ops[i]
         return StepFailed(op.ci, op.call, s, op.vars)

@@ -3,12 +3,14 @@ Python, the FMI functions called through their addresses. It must give the Pytho
 bit for bit (the same calls with the same values in the same order), in fixed-step and scheduled
 runs, with stop conditions, Boolean connections, schedule modes and events; and be used only
 where it can serve the run."""
+from master_fixtures import helpers as h
 import numpy as np
 import pytest
 
-from system_ssp import Observer
+from system_ssp import Observer, SimulationError
 from system_ssp.master import algorithms, compiled
 from system_ssp.master.system import simulate
+from test_master_core import loop_system
 
 SPAN = compiled.scheduled_span, compiled.fixed_span
 
@@ -104,3 +106,26 @@ def test_span_steps_bound_what_one_call_takes(monkeypatch, ssp_paths):
     monkeypatch.setattr(algorithms, "SPAN_SECONDS", 1e-9)  # every span "too long": down to one step each
     r, spans = _run(ssp_paths["detumble"], True, monkeypatch, stop_time=3.0, stop_when=[], record_every=1000)
     assert r.steps == 200 and spans > 150  # 16, 8, 4, 2, then one step per span
+
+
+def test_a_failure_in_the_compiled_loop_is_the_python_loops(monkeypatch, tmp_path, tmp_path_factory):
+    """An FMU raising in its step from t = 0.5 s: the same error, naming the component, and the
+    same rows kept up to the last communication point reached, from both loops."""
+    ssd = loop_system(tmp_path, h.build_fixture_fmus(tmp_path_factory.mktemp("master_fmus")))
+    errors, spans = [], []
+
+    def counted(*args):
+        spans.append(1)
+        return SPAN[1](*args)
+
+    monkeypatch.setattr(compiled, "fixed_span", counted)
+    for on in (False, True):
+        monkeypatch.setattr(compiled, "ENABLED", on)
+        with pytest.raises(SimulationError, match=r"component 'integ'.*fixture failure at t=0.5 s") as err:
+            simulate(ssd, step_size=0.1, stop_time=1.0, outputs=["integ.x"], parameters={"integ.fail_at": 0.5})
+        errors.append(err.value)
+    python, fast = errors
+    assert spans  # the second run's steps and its failure came from the compiled loop
+    assert str(fast) == str(python)
+    assert fast.result.stop_reason == python.result.stop_reason
+    assert fast.result.to_pandas().equals(python.result.to_pandas()) and len(fast.result.data) == 6
