@@ -25,11 +25,93 @@ import math
 import numpy as np
 
 from ..core import rotations
+from ..core import jit
+from ..core.jit import njit
 from . import triad
 
 
-def _skew(v):
-    return np.array([[0.0, -v[2], v[1]], [v[2], 0.0, -v[0]], [-v[1], v[0], 0.0]])
+# ---- the filter's matrix arithmetic (numba where installed: components.core.jit) ------------
+# Written out element by element: for 6 x 6 matrices numpy's calls cost more than the arithmetic
+# (the estimator runs at every 15 ms step of the mission). In plain Python the products are
+# numpy's (the loops would be slower there); the two paths agree to rounding.
+
+def _numpy_product(A, B, transpose_b):
+    return A @ (B.T if transpose_b else B)
+
+
+@njit(cache=True)
+def _looped_product(A, B, transpose_b):
+    """A B, or A B^T with transpose_b."""
+    n, m = A.shape[0], B.shape[0] if transpose_b else B.shape[1]
+    out = np.empty((n, m))
+    for i in range(n):
+        for j in range(m):
+            total = 0.0
+            for k in range(A.shape[1]):
+                total += A[i, k] * (B[j, k] if transpose_b else B[k, j])
+            out[i, j] = total
+    return out
+
+
+_product = _looped_product if jit.ENABLED else _numpy_product
+
+
+@njit(cache=True)
+def _propagated_covariance(P, w0, w1, w2, h, qv, qu):
+    """Phi P Phi^T + Q h: Phi = I + F h, F = [[-[w x], -I], [0, 0]]; Q = diag(qv I, qu I) (G Q G^T = Q
+    for G = diag(-I, I))."""
+    phi = np.eye(6)
+    phi[0, 1], phi[0, 2], phi[1, 0] = w2 * h, -w1 * h, -w2 * h
+    phi[1, 2], phi[2, 0], phi[2, 1] = w0 * h, w1 * h, -w0 * h
+    for i in range(3):
+        phi[i, i + 3] = -h
+    out = _product(_product(phi, P, False), phi, True)
+    for i in range(3):
+        out[i, i] += qv * h
+        out[i + 3, i + 3] += qu * h
+    return out
+
+
+@njit(cache=True)
+def _vector_update(P, b_hat, y, r):
+    """One vector measurement: H = [[b_hat x], 0], S = H P H^T + r I, K = P H^T S^-1, dx = K y,
+    P <- (I - K H) P (I - K H)^T + r K K^T (Joseph form). Returns (P, dx, y^T S^-1 y)."""
+    H = np.zeros((3, 6))
+    H[0, 1], H[0, 2], H[1, 0] = -b_hat[2], b_hat[1], b_hat[2]
+    H[1, 2], H[2, 0], H[2, 1] = -b_hat[0], -b_hat[1], b_hat[0]
+    PHt = _product(P, H, True)
+    S = _product(H, PHt, False)
+    for i in range(3):
+        S[i, i] += r
+    # S^-1 from the adjugate (S is symmetric positive definite: r > 0)
+    c00 = S[1, 1] * S[2, 2] - S[1, 2] * S[2, 1]
+    c01 = S[1, 2] * S[2, 0] - S[1, 0] * S[2, 2]
+    c02 = S[1, 0] * S[2, 1] - S[1, 1] * S[2, 0]
+    det = S[0, 0] * c00 + S[0, 1] * c01 + S[0, 2] * c02
+    S_inv = np.empty((3, 3))
+    S_inv[0, 0], S_inv[1, 0], S_inv[2, 0] = c00 / det, c01 / det, c02 / det
+    S_inv[0, 1] = (S[0, 2] * S[2, 1] - S[0, 1] * S[2, 2]) / det
+    S_inv[1, 1] = (S[0, 0] * S[2, 2] - S[0, 2] * S[2, 0]) / det
+    S_inv[2, 1] = (S[0, 1] * S[2, 0] - S[0, 0] * S[2, 1]) / det
+    S_inv[0, 2] = (S[0, 1] * S[1, 2] - S[0, 2] * S[1, 1]) / det
+    S_inv[1, 2] = (S[0, 2] * S[1, 0] - S[0, 0] * S[1, 2]) / det
+    S_inv[2, 2] = (S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]) / det
+    K = _product(PHt, S_inv, False)
+    dx = np.zeros(6)
+    for i in range(6):
+        for k in range(3):
+            dx[i] += K[i, k] * y[k]
+    nis = 0.0
+    for i in range(3):
+        for k in range(3):
+            nis += y[i] * S_inv[i, k] * y[k]
+    IKH = np.eye(6) - _product(K, H, False)
+    P_new = _product(_product(IKH, P, False), IKH, True)
+    KKt = _product(K, K, True)
+    for i in range(6):
+        for j in range(6):
+            P_new[i, j] += r * KKt[i, j]
+    return P_new, dx, nis
 
 
 def _sigma(name, value, unit, positive=False):
@@ -85,12 +167,8 @@ class AttitudeMEKF:
 
     def propagate_covariance(self, w, h):
         """P over h with the (bias-corrected) rate w: Phi = I + F h."""
-        F = np.zeros((6, 6))
-        F[:3, :3] = -_skew(w)
-        F[:3, 3:] = -np.eye(3)
-        phi = np.eye(6) + F * h
-        Qd = np.diag([self.sigma_v ** 2] * 3 + [self.sigma_u ** 2] * 3) * h  # G = diag(-I, I): G Q G^T = Q
-        self.P = phi @ self.P @ phi.T + Qd
+        self.P = _propagated_covariance(self.P, float(w[0]), float(w[1]), float(w[2]), float(h),
+                                        self.sigma_v ** 2, self.sigma_u ** 2)
 
     def update(self, b_meas, r_ref, sigma):
         """Fuse one measured unit vector b_meas (B) of the reference direction r_ref (N). Returns
@@ -99,21 +177,14 @@ class AttitudeMEKF:
         b = np.array(triad._unit(b_meas, "measured vector"))
         r = triad._unit(r_ref, "reference vector")
         s = _sigma("measurement sigma", sigma, "rad", positive=True)
-        b_hat = np.array(rotations.attitude_matrix(self.q)) @ np.array(r)
-        H = np.zeros((3, 6))
-        H[:, :3] = _skew(b_hat)
-        R = np.eye(3) * s * s
-        S = H @ self.P @ H.T + R
-        S_inv = np.linalg.inv(S)
-        K = self.P @ H.T @ S_inv
-        y = b - b_hat
-        dx = K @ y
+        A = rotations.attitude_matrix(self.q)
+        b_hat = np.array([A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] for i in range(3)])
+        self.P, dx, nis = _vector_update(self.P, b_hat, b - b_hat, s * s)
         dq = rotations.quaternion_rate(self.q, dx[:3])  # 1/2 Xi(q) dtheta
         self.q = rotations.normalized(tuple(qi + di for qi, di in zip(self.q, dq)), "q")
         self.bias = self.bias + dx[3:]
-        IKH = np.eye(6) - K @ H
-        self.P = IKH @ self.P @ IKH.T + K @ R @ K.T
-        return float(y @ S_inv @ y), float(y @ y)
+        y = b - b_hat
+        return nis, float(y @ y)
 
     def reopen_bias(self, sigma_bias, attitude_variance=0.0):
         """Forget what the filter learned of the bias (a fault changed it): its covariance back to
@@ -140,8 +211,12 @@ class AttitudeMEKF:
         self._need()
         e = rotations.circle_cross(rotations.normalized(tuple(float(x) for x in q_true), "q_true"),
                                    rotations.conjugate(self.q))
-        d = np.array(e[:3]) * (2.0 if e[3] >= 0.0 else -2.0)
-        return float(d @ np.linalg.solve(self.P[:3, :3], d))
+        k = 2.0 if e[3] >= 0.0 else -2.0
+        d = (e[0] * k, e[1] * k, e[2] * k)
+        nees = _inverse_quadratic_form(self.P[:3, :3].tolist(), d)
+        if nees is None:  # the attitude block is not positive definite: a filter gone wrong, LU then
+            nees = float(np.array(d) @ np.linalg.solve(self.P[:3, :3], np.array(d)))
+        return nees
 
     def bias_sigma(self):
         self._need()
@@ -155,6 +230,31 @@ class AttitudeMEKF:
         self.q = None if state["q"] is None else tuple(state["q"])
         self.bias = np.array(state["bias"], dtype=float)
         self.P = None if state["P"] is None else np.array(state["P"], dtype=float)
+
+
+def _inverse_quadratic_form(A, d):
+    """d^T A^-1 d for a symmetric positive definite 3x3 A (nested lists) through its Cholesky
+    factor L (A = L L^T: the value is |L^-1 d|^2), in plain floats: at every step of the mission
+    numpy's solve costs ten times more in its call overhead than in the arithmetic. None when A
+    is not positive definite."""
+    a00, a10, a11, a20, a21, a22 = A[0][0], A[1][0], A[1][1], A[2][0], A[2][1], A[2][2]
+    if not a00 > 0.0:
+        return None
+    l00 = math.sqrt(a00)
+    l10, l20 = a10 / l00, a20 / l00
+    p11 = a11 - l10 * l10
+    if not p11 > 0.0:
+        return None
+    l11 = math.sqrt(p11)
+    l21 = (a21 - l20 * l10) / l11
+    p22 = a22 - l20 * l20 - l21 * l21
+    if not p22 > 0.0:
+        return None
+    l22 = math.sqrt(p22)
+    y0 = d[0] / l00
+    y1 = (d[1] - l10 * y0) / l11
+    y2 = (d[2] - l20 * y0 - l21 * y1) / l22
+    return y0 * y0 + y1 * y1 + y2 * y2
 
 
 def _cross(a, b):

@@ -1,6 +1,6 @@
 """numba only makes the kernels faster: with it switched off (NEIGHBOR_COSIM_NUMBA=0, the path
-a host without numba takes) the atmospheres, the Cowell orbit and the orbit-averaged model give
-the same results to 1e-12."""
+a host without numba takes) the atmospheres, the Cowell orbit, the orbit-averaged model and the
+attitude filter's matrix arithmetic give the same results to 1e-12."""
 import json
 import os
 import subprocess
@@ -16,6 +16,8 @@ import numpy as np
 from components.core import jit
 from components.environment import atmosphere, space_weather
 from components.orbit import averaged, cowell
+from components.sensing import mekf
+from components.core import rotations
 
 out = {"numba": jit.ENABLED}
 sw = space_weather.SpaceWeather.from_file()
@@ -33,6 +35,17 @@ for name in ("exponential", "harris_priester", "jacchia_roberts"):
     lifetime = averaged.OrbitAveraged(m, sma0=6378136.3 + 380e3)
     lifetime.advance_to(2 * 86400.0)
     out["averaged_" + name] = [float(x) for x in lifetime.y]
+filt = mekf.AttitudeMEKF()
+filt.initialize((0.1, 0.2, 0.3, 0.9), 0.02, bias=(1e-3, -2e-3, 3e-3), sigma_bias=1e-3)
+q_true, nis = rotations.normalized((0.12, 0.18, 0.31, 0.89)), []
+for k in range(40):
+    filt.propagate([0.01, -0.02, 0.015], 0.1)
+    A = rotations.attitude_matrix(q_true)
+    for r in ((1.0, 0.0, 0.0), (0.3, 0.9, -0.2)):
+        r = rotations.normalized(r)
+        b = [A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] + 1e-3 * math.sin(7 * k + i) for i in range(3)]
+        nis.append(filt.update(b, r, 2e-3)[0])
+out["mekf"] = list(filt.q) + filt.bias.tolist() + np.diag(filt.P).tolist() + nis + [filt.attitude_nees(q_true)]
 print(json.dumps(out))
 """
 
