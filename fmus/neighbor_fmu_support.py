@@ -28,6 +28,7 @@ from components.core.names import Names, element_names, matrix_names
 from components.mission.neighbor import SPACECRAFT
 
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
+_KINDS = {cls: kind for kind, cls in _TYPES.items()}
 Scalar = Union[float, int, bool, str]
 # The moving-target inputs of the RCS controller family (declared by `target_inputs`), named here
 # once because a controller's outputs depend on them before they are declared.
@@ -84,6 +85,7 @@ class NeighborSlave(Fmi2Slave):
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
         self._batch = None  # while a get call runs: the vectors its array outputs computed
         self._accessors = {}  # (type, "getter" or "setter") -> {value reference: function}
+        self._input_names = {}  # type -> {value reference: name} of the inputs
 
     # ---- the FMI get and set calls ----------------------------------------------------------
     # pythonfmu's own look up each variable and check its type on every call; these read tables
@@ -108,12 +110,23 @@ class NeighborSlave(Fmi2Slave):
             self._batch = None
 
     def _set(self, cls, vrs, values, fallback):
+        # an input is stored in place (no setter call per value: the mission sets millions);
+        # a parameter goes through its setter, which checks it and drops the model
         setters = self._accessor_table(cls, "setter")
+        inputs = self._input_names.get(cls, {})
+        store, kind, changed = self.values, _KINDS[cls], False
         try:
             for vr, value in zip(vrs, values):
-                setters[vr](value)
+                name = inputs.get(vr)
+                if name is None:
+                    setters[vr](value)
+                else:
+                    store[name] = kind(value)
+                    changed = True
         except KeyError:
             fallback(self, vrs, values)
+        if changed:
+            self._input_version += 1
 
     def get_real(self, vrs):
         return self._get(Real, float, vrs, Fmi2Slave.get_real)
@@ -177,12 +190,13 @@ class NeighborSlave(Fmi2Slave):
     def input(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> str:
         self.values[name] = kind(start)
 
-        def setter(value, name=name):
+        def setter(value, name=name):  # pythonfmu's own calls; ours store in place (_set)
             self.values[name] = kind(value)
             self._input_version += 1
 
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
-        self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
+        var = self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
+        self._input_names.setdefault(_TYPES[kind], {})[var.value_reference] = name
         return name
 
     def input_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
@@ -197,7 +211,7 @@ class NeighborSlave(Fmi2Slave):
         """`depends_on`: input names this output depends on directly (feedthrough)."""
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         self._register(name, kind, Fmi2Causality.output, variability, unit, description,
-                       getter=lambda: kind(getter()), initial=Fmi2Initial.calculated,
+                       getter=getter, initial=Fmi2Initial.calculated,  # _get converts to kind
                        depends_on=depends_on)
         return name
 
