@@ -10,7 +10,7 @@ import pytest
 from components.attitude import rigid_body
 from components.core import rotations
 from components.sensing import triad
-from components.sensing.mekf import AttitudeMEKF, NeesMonitor
+from components.sensing.mekf import AttitudeMEKF, NeesMonitor, _inverse_quadratic_form
 
 H = 0.1
 GYRO_SIGMA = 5.5e-4  # rad/s per 10 Hz sample (the attitude-determination system's gyro)
@@ -175,3 +175,19 @@ def test_fmu_equals_the_component_and_declares_its_dependencies(build_one, tmp_p
     finally:
         fmu.terminate()
         fmu.freeInstance()
+
+
+def test_nees_through_the_cholesky_factor_equals_the_lu_solve_and_refuses_an_indefinite_block():
+    rng = np.random.default_rng(5)
+    for _ in range(50):
+        M = rng.normal(size=(3, 3))
+        A = M @ M.T + np.diag(rng.uniform(1e-8, 1e-2, 3))
+        d = rng.normal(size=3) * 1e-3
+        assert _inverse_quadratic_form(A.tolist(), tuple(d)) == pytest.approx(d @ np.linalg.solve(A, d), rel=1e-9)
+    assert _inverse_quadratic_form([[1.0, 0.0, 0.0], [0.0, -1.0, 0.0], [0.0, 0.0, 1.0]], (1.0, 1.0, 1.0)) is None
+    # a filter whose attitude block went indefinite still answers (LU), it does not raise
+    filt = AttitudeMEKF()
+    filt.initialize((0.0, 0.0, 0.0, 1.0), 0.01)
+    filt.P[1, 1] = -1e-4
+    q = rotations.normalized((0.001, 0.002, 0.0, 1.0))
+    assert math.isfinite(filt.attitude_nees(q))
