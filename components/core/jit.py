@@ -7,9 +7,17 @@ NEIGHBOR_COSIM_NUMBA=0 before the first import runs the plain-Python path even w
 installed (the tests compare the two).
 
 `objmode` lets compiled code call back into Python (the NRLMSIS density through pymsis); in the
-plain-Python path it is a no-op context."""
+plain-Python path it is a no-op context.
+
+Inside an FMU the kernels' sources are extracted to a new temporary folder for every run, where
+numba's cache (beside the source) would be lost with the folder: each run would compile them
+again (seconds for the orbit's and the estimator's). `FmuPackageCacheLocator` keeps the compiled
+code of sources in one of our FMUs' private packages (resources/nc_<name>_<digest>/, the digest
+is of the package's code) in the user's cache folder under that package's name, so the runs of
+one FMU build compile once per machine; numba still checks each source's content hash."""
 import contextlib
 import os
+import re
 
 try:
     import numba
@@ -17,6 +25,52 @@ except ImportError:  # numba is optional: plain Python then
     numba = None
 
 ENABLED = numba is not None and os.environ.get("NEIGHBOR_COSIM_NUMBA", "1") != "0"
+
+# an FMU's private package folder: builder.build_fmu names it <prefix>_<class>_<code digest>
+_FMU_PACKAGE = re.compile(r"nc3?_[a-z0-9]+_[0-9a-f]{12}")
+
+
+def fmu_package_of(py_file):
+    """(package folder name, folder of py_file inside it) when py_file lies in one of our FMUs'
+    private packages (.../resources/nc_<name>_<digest>/...), else None."""
+    parts = os.path.abspath(py_file).split(os.sep)
+    for i in range(len(parts) - 2, 0, -1):
+        if parts[i - 1] == "resources" and _FMU_PACKAGE.fullmatch(parts[i]):
+            return parts[i], os.path.join(*parts[i + 1:-1]) if i + 1 < len(parts) - 1 else ""
+    return None
+
+
+def _install_fmu_cache_locator():
+    """Put FmuPackageCacheLocator first among numba's cache locators (once per process: every
+    FMU's copy of this module checks by name). It claims only files of our FMUs' packages; a
+    numba without the locator list keeps its own behaviour."""
+    try:
+        from numba.core import caching
+        from numba.misc.appdirs import AppDirs
+        locators = caching.CacheImpl._locator_classes
+    except (ImportError, AttributeError):  # another numba's internals: its own caching then
+        return
+    if any(c.__name__ == "FmuPackageCacheLocator" for c in locators):
+        return
+
+    class FmuPackageCacheLocator(caching.UserWideCacheLocator):
+        def __init__(self, py_func, py_file):
+            super().__init__(py_func, py_file)
+            package, inside = fmu_package_of(py_file)
+            root = AppDirs(appname="numba", appauthor=False).user_cache_dir
+            self._cache_path = os.path.join(root, "neighbor-cosim-fmus", package, inside)
+
+        @classmethod
+        def from_function(cls, py_func, py_file):
+            if fmu_package_of(py_file) is None:
+                return None
+            return super().from_function(py_func, py_file)
+
+    locators.insert(0, FmuPackageCacheLocator)
+
+
+if ENABLED:
+    _install_fmu_cache_locator()
 
 
 def njit(*args, **kwargs):
