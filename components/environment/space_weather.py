@@ -71,7 +71,7 @@ def _date_of_jd(jd):
     return (_dt.datetime(1970, 1, 1) + _dt.timedelta(days=jd - _JD_UNIX_EPOCH)).isoformat(timespec="seconds") + "Z"
 
 
-@njit(cache=False)
+@njit(cache=True)
 def day_index(jd, jd0, n):
     """Row of the daily table for Julian date jd: -1 before the first day, held at n - 1."""
     d = math.floor(jd - jd0)
@@ -82,7 +82,7 @@ def day_index(jd, jd0, n):
     return int(d)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def ap_3h_at(jd, jd0, ap3h, hours_before):
     """3-hourly ap of the interval containing jd - hours_before (clamped to the table)."""
     k = math.floor((jd - jd0) * 8.0 - hours_before / 3.0)

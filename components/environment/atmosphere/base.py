@@ -10,12 +10,14 @@ from .. import geodesy, magnetic_field, sun
 from ...core.time_utils import DAYS_PER_CENTURY, J2000_JD
 
 # ---- kernels' geometry: numba compilations of the product's own functions --------------------
-geodetic_nb = njit(cache=False)(geodesy.geodetic_from_earth_fixed)
-gmst_nb = njit(cache=False)(magnetic_field.gmst)
-sun_position_au_nb = njit(cache=False)(sun.sun_position_au)
+# Cached (cache=True) like every kernel here: inside an FMU, components.core.jit keeps the compiled
+# code across runs, and the Jacchia-Roberts kernels took about 8 s to compile in every run.
+geodetic_nb = njit(cache=True)(geodesy.geodetic_from_earth_fixed)
+gmst_nb = njit(cache=True)(magnetic_field.gmst)
+sun_position_au_nb = njit(cache=True)(sun.sun_position_au)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def earth_fixed(r, jd):
     """r_E = R3(GMST) r_N (tuple), GMST of the UTC Julian date jd."""
     th = gmst_nb((jd - J2000_JD) / DAYS_PER_CENTURY)
@@ -23,7 +25,7 @@ def earth_fixed(r, jd):
     return (c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
 
 
-@njit(cache=False)
+@njit(cache=True)
 def geodetic(r, jd):
     """(geodetic latitude rad, east longitude rad, geodetic altitude m) of the N position r."""
     return geodetic_nb(earth_fixed(r, jd))

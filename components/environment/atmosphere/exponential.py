@@ -23,7 +23,7 @@ VALLADO_TABLE = (
 )
 
 
-@njit(cache=False)
+@njit(cache=True)
 def exponential_kernel(r, jd, data):
     h0, rho0, scale = data
     h = geodetic(r, jd)[2]

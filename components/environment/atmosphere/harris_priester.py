@@ -43,7 +43,7 @@ def hp_exponent_from_inclination(inclination):
     return 2.0 + 4.0 * i / (math.pi / 2.0)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def harris_priester_kernel(r, jd, data):
     h_tab, rho_min, rho_max, n, lag = data
     h = geodetic(r, jd)[2]

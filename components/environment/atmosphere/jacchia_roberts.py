@@ -80,7 +80,7 @@ CON_DEN = np.array([
 ])
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _horner(c, n, x):
     s = c[n - 1]
     for i in range(n - 2, -1, -1):
@@ -88,7 +88,7 @@ def _horner(c, n, x):
     return s
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _real_root(c, n, x):
     """Newton's method for a real root of sum c[i] x^i (n coefficients) from x."""
     for _ in range(100):
@@ -104,7 +104,7 @@ def _real_root(c, n, x):
     return x
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _deflate(c, n, root):
     """Divide sum c[i] x^i (n coefficients) by (x - root) in place (n - 1 coefficients left)."""
     s = c[n - 1]
@@ -114,7 +114,7 @@ def _deflate(c, n, root):
         s = save + s * root
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _temperature_roots(tx):
     """Roots of Roberts' quartic below 125 km: two real (near 125 and 200 km) and x +- i y."""
     c = np.empty(5)
@@ -132,7 +132,7 @@ def _temperature_roots(tx):
     return r1, r2, x, y
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _partial_fractions(r1, r2, xr, yr, rp):
     rp2 = rp * rp
     roots_2 = xr * xr + yr * yr
@@ -145,7 +145,7 @@ def _partial_fractions(r1, r2, xr, yr, rp):
     return roots_2, x_star, v, u0, u1, w0, w1
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _rho_100(z, temperature, tx, r1, r2, xr, yr):
     """90-100 km (g/cm^3)."""
     rp = POLAR_RADIUS
@@ -172,7 +172,7 @@ def _rho_100(z, temperature, tx, r1, r2, xr, yr):
     return RHO_ZERO * TZERO * m_poly * math.exp(factor_k * (log_f1 + f2)) / (MZERO * temperature)
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _rho_125(z, temperature, tx, t_inf, r1, r2, xr, yr):
     """100-125 km (g/cm^3)."""
     rp = POLAR_RADIUS
@@ -201,7 +201,7 @@ def _rho_125(z, temperature, tx, t_inf, r1, r2, xr, yr):
     return rho_sum * rho_prime * t_100 / temperature
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _rho_high(z, temperature, tx, t_inf, sum_l, t_500, sun_dec, lat):
     """125-2500 km (g/cm^3)."""
     rp = POLAR_RADIUS
@@ -227,7 +227,7 @@ def _rho_high(z, temperature, tx, t_inf, sum_l, t_500, sun_dec, lat):
     return rho
 
 
-@njit(cache=False)
+@njit(cache=True)
 def _temperatures(z, t1, kp):
     """(T_inf, Tx, T(z), L polynomial) at altitude z for the diurnal temperature t1."""
     if z < 200.0:
@@ -246,7 +246,7 @@ def _temperatures(z, t1, kp):
     return t_inf, tx, temperature, sum_l
 
 
-@njit(cache=False)
+@njit(cache=True)
 def jr_density(z, lat, hour_angle, sun_dec, f107, f107a, kp, jd_utc):
     """Jacchia-Roberts density in kg/m^3 at geodetic altitude z (km) and latitude lat (rad),
     Sun hour angle (rad, position's right ascension minus the Sun's) and declination (rad),
@@ -296,7 +296,7 @@ def jr_density(z, lat, hour_angle, sun_dec, f107, f107a, kp, jd_utc):
     return rho * 1.0e3  # g/cm^3 -> kg/m^3
 
 
-@njit(cache=False)
+@njit(cache=True)
 def jr_indices(jd, jd0, daily, f107_prev_col, f107a_col, kp_col):
     """(F10.7, F10.7a, Kp) for Jacchia-Roberts at UTC Julian date jd, GMAT's selection (module
     docstring). Raises before the first day of the table. `f107_prev_col` is a previous-day
@@ -325,7 +325,7 @@ def jr_indices(jd, jd0, daily, f107_prev_col, f107a_col, kp_col):
     return f107, f107a, kp
 
 
-@njit(cache=False)
+@njit(cache=True)
 def jacchia_roberts_kernel(r, jd, data):
     jd0, daily, f107_prev_col, f107a_col, kp_col = data
     f107, f107a, kp = jr_indices(jd, jd0, daily, f107_prev_col, f107a_col, kp_col)
