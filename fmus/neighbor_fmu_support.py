@@ -125,8 +125,9 @@ class NeighborSlave(Fmi2Slave):
                     changed = True
         except KeyError:
             fallback(self, vrs, values)
-        if changed:
-            self._input_version += 1
+        finally:  # also when the fallback raises after some inputs were stored
+            if changed:
+                self._input_version += 1
 
     def get_real(self, vrs):
         return self._get(Real, float, vrs, Fmi2Slave.get_real)

@@ -47,13 +47,16 @@ def _install_fmu_cache_locator():
     try:
         from numba.core import caching
         from numba.misc.appdirs import AppDirs
-        locators = caching.CacheImpl._locator_classes
+        # public names in recent numba, underscored in older ones (the pin allows 0.59)
+        impl = getattr(caching, "CacheImpl", None) or caching._CacheImpl
+        user_wide = getattr(caching, "UserWideCacheLocator", None) or caching._UserWideCacheLocator
+        locators = impl._locator_classes
     except (ImportError, AttributeError):  # another numba's internals: its own caching then
         return
     if any(c.__name__ == "FmuPackageCacheLocator" for c in locators):
         return
 
-    class FmuPackageCacheLocator(caching.UserWideCacheLocator):
+    class FmuPackageCacheLocator(user_wide):
         def __init__(self, py_func, py_file):
             super().__init__(py_func, py_file)
             package, inside = fmu_package_of(py_file)

@@ -179,12 +179,12 @@ class AttitudeMEKF:
         s = _sigma("measurement sigma", sigma, "rad", positive=True)
         A = rotations.attitude_matrix(self.q)
         b_hat = np.array([A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] for i in range(3)])
-        self.P, dx, nis = _vector_update(self.P, b_hat, b - b_hat, s * s)
+        y = b - b_hat
+        self.P, dx, nis = _vector_update(self.P, b_hat, y, s * s)
         dq = rotations.quaternion_rate(self.q, dx[:3])  # 1/2 Xi(q) dtheta
         self.q = rotations.normalized(tuple(qi + di for qi, di in zip(self.q, dq)), "q")
         self.bias = self.bias + dx[3:]
-        y = b - b_hat
-        return nis, float(y @ y)
+        return float(nis), float(y @ y)
 
     def reopen_bias(self, sigma_bias, attitude_variance=0.0):
         """Forget what the filter learned of the bias (a fault changed it): its covariance back to
