@@ -91,7 +91,12 @@ def geodetic_altitude_nb(x, y, z):
     return z / sl - n * (1.0 - e2)
 
 
-@njit(cache=True)
+# _deriv and _advance take the atmosphere's kernel as an argument, and numba types a function
+# argument by the identity of its dispatcher object: the cache never matches one in another
+# process, so cache=True only added a ~0.5 MB entry per run to the user's cache (for ever), and
+# once an index held more entries than numba keeps their dispatchers alive, saving it raised
+# ReferenceError inside fmi2DoStep. Compiled in each process instead (about 1 s).
+@njit(cache=False)
 def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
     x = y[0]
     yy = y[1]
@@ -128,7 +133,7 @@ def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
     out[5] = az
 
 
-@njit(cache=True)
+@njit(cache=False)
 def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E3, E5,
              reentry_altitude, max_steps):
     """DOP853 from t to t_end (lands exactly). Returns (t, y, h_next, reentered, steps, rejected).
