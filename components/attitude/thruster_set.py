@@ -35,8 +35,22 @@ is that of the real (misaligned, force-error) thrusters left on. The thrust lost
 thruster-seconds (`axial_off_time`): the propulsion takes it out of the burn's thrust and flow, so
 the burn lasts a little longer on the same propellant and the RCS spends none on y and z. This is
 how a spacecraft trims a thrust-axis misalignment during a burn at no propellant cost.
+
+A stuck thruster (`stuck_thruster`, one of the 12 RCS thrusters, 1-based in layout order; off by
+default): once the set has operated `stuck_time` seconds (the sum of its steps) that thruster
+never fires (stuck off) or fires at every step (`stuck_on`, a valve stuck open). Each thruster's
+feed has a latch valve (an assumption: the thesis sizes no valves): the fault management
+(components.attitude.thruster_monitor) closes the faulty thruster's with `disable`, which stops
+a stuck-on one, and from then on the flags are allocated over the thrusters left
+(`allocation_table`): the torque nearest the pair torques the flags ask for, then the smallest
+net force, then the fewest thrusters. No other thruster makes an x torque of the same sign as a
+dead x thruster's partner, so that partner fires alone (half the torque) and a y or z pair
+cancels its side torque. With every thruster enabled the pairs fire exactly as before.
 """
+import itertools
 import math
+
+import numpy as np
 
 from ..core import checks, rotations
 from ..mission.neighbor import SPACECRAFT
@@ -71,6 +85,29 @@ def thesis_layout(a=0.1, c=0.3):
     return out
 
 
+def allocation_table(torques, forces, levels, force, candidates, max_thrusters=6):
+    """{(fx, fy, fz): thruster indices} over the 27 flag triples, from the thrusters `candidates`
+    (indices into `torques`/`forces`, the nominal N.m and N of each): per triple the subset of at
+    most `max_thrusters` whose torque is nearest the pair torques (fx Lx, fy Ly, fz Lz) relative to
+    each axis' level, then with the smallest net force, then the fewest thrusters."""
+    candidates = sorted(candidates)
+    subsets = [()] + [c for k in range(1, min(max_thrusters, len(candidates)) + 1)
+                      for c in itertools.combinations(candidates, k)]
+    member = np.zeros((len(subsets), len(torques)))
+    for row, subset in enumerate(subsets):
+        member[row, list(subset)] = 1.0
+    torque = member @ np.asarray(torques, dtype=float)
+    net_force = member @ np.asarray(forces, dtype=float)
+    levels = np.asarray(levels, dtype=float)
+    # a missed torque costs most, a net force (pushing the orbit) next, a thruster opened least
+    base = 0.05 * np.sum((net_force / force) ** 2, axis=1) + 0.01 * member.sum(axis=1)
+    table = {}
+    for flags in itertools.product((-1, 0, 1), repeat=3):
+        cost = np.sum(((torque - np.asarray(flags) * levels) / levels) ** 2, axis=1) + base
+        table[flags] = subsets[int(np.argmin(cost))]
+    return table
+
+
 def _sign(x):
     return (x > 0) - (x < 0)
 
@@ -94,12 +131,13 @@ class ThrusterSet:
 
     force: nominal force of one thruster (N); force_error: per-thruster fraction (16 values, e.g.
     0.02 = 2 % strong); misalignment: per-thruster pair of small angles (rad); min_on_time (s);
-    isp, g0 for the propellant; off_pulsing: y and z torques in the burn from the axial thrusters
+    isp, g0 for the propellant; off_pulsing: y and z torques in the burn from the axial thrusters;
+    stuck_thruster (1-12, 0: none), stuck_on, stuck_time (s of operation): the stuck-thruster fault
     (module docstring). Commands are -1/0/+1 per axis (the controllers' thrust flags)."""
 
     def __init__(self, force=SPACECRAFT.rcs_thrust, a=SPACECRAFT.edge_a, c=SPACECRAFT.edge_c, isp=SPACECRAFT.isp,
                  g0=SPACECRAFT.g0, min_on_time=0.0, force_error=None,
-                 misalignment=None, off_pulsing=False):
+                 misalignment=None, off_pulsing=False, stuck_thruster=0, stuck_on=False, stuck_time=0.0):
         self.layout = thesis_layout(a, c)
         n = len(self.layout)
         self.force = checks.positive("thrust", force, "N")
@@ -117,11 +155,15 @@ class ThrusterSet:
             raise ValueError(f"misalignment must be {n} pairs of angles within 0.2 rad, got {angles!r}")
         self.forces = []  # force vector of each thruster while it fires (N, B)
         self.torques = []  # its torque l x F (N.m, B), Eq. 13
+        self.nominal_forces, self.nominal_torques = [], []  # the same without errors: what flight software knows
         for (_, position, direction, _), err, ang in zip(self.layout, errors, angles):
             d = _misaligned(direction, ang) if ang != (0.0, 0.0) else direction
             f = tuple(self.force * (1.0 + err) * x for x in d)
             self.forces.append(f)
             self.torques.append(rotations.cross(position, f))
+            nominal = tuple(self.force * x for x in direction)
+            self.nominal_forces.append(nominal)
+            self.nominal_torques.append(rotations.cross(position, nominal))
         self.force_norms = [rotations.norm(f) for f in self.forces]  # read at every step's propellant output
         self.pairs = {}  # (axis, sign) -> thruster indices
         for i, (_, _, _, role) in enumerate(self.layout):
@@ -135,6 +177,51 @@ class ThrusterSet:
         self.fire_time = [0.0] * n
         self.on_left = [0.0] * n  # minimum on-time still owed after a firing started
         self.axial_off_time = 0.0  # thruster-seconds the axial thrusters were switched off in the burn
+        self.rcs = [i for i in range(n) if i not in self.axial]
+        stuck = int(stuck_thruster)
+        if stuck != stuck_thruster or not 0 <= stuck <= len(self.rcs):
+            raise ValueError(f"stuck_thruster = {stuck_thruster!r} must be 0 (none) or an RCS thruster "
+                             f"1-{len(self.rcs)}")
+        self.stuck_thruster = self.rcs[stuck - 1] if stuck else None
+        self.stuck_on = bool(stuck_on)
+        self.stuck_time = float(stuck_time)
+        if not (math.isfinite(self.stuck_time) and self.stuck_time >= 0):
+            raise ValueError(f"stuck_time = {stuck_time!r} s must be a finite number >= 0")
+        self.operating_time = 0.0  # s, the sum of the steps: the stuck fault's clock
+        self.disabled = set()  # thrusters whose latch valve the fault management closed
+        self._allocation = None  # flags -> thrusters, once a thruster is disabled
+        self.monitor = None  # the fault detection (components.attitude.thruster_monitor), if flown
+        self.fault_time = -1.0  # when it declared a stuck thruster (-1: never)
+
+    @property
+    def stuck(self):
+        """The stuck-thruster fault has happened (its thruster index), or None."""
+        if self.stuck_thruster is not None and self.operating_time >= self.stuck_time - 1e-9:
+            return self.stuck_thruster
+        return None
+
+    def disable(self, index):
+        """Close thruster `index`'s latch valve (it never fires again, stuck open or not) and
+        allocate the flags over the thrusters left."""
+        if index not in self.rcs:
+            raise ValueError(f"thruster {index!r} is not one of the RCS thrusters {self.rcs}")
+        self.disabled.add(index)
+        self._allocation = allocation_table(self.nominal_torques, self.nominal_forces, self.levels, self.force,
+                                            [i for i in self.rcs if i not in self.disabled])
+
+    def watch(self, t, omega_meas, flags, h, axial=False):
+        """The fault detection's step [t, t + h) before the set's: the gyro's rates at t and the
+        thrusters flight software opens for `flags` (with the axial ones left on in the burn);
+        a declared fault closes its thrusters' valves before they fire in this step."""
+        opened = self.commanded(flags, axial)
+        if axial:  # the axial thrusters' nominal torques cancel only when all four fire
+            off = self.axial_off(flags, axial)
+            opened = opened + [i for i in self.axial if i not in off]
+        declared = self.monitor.step(t, omega_meas, opened, h, self.disabled)
+        if declared is not None:
+            for index, _ in declared[0]:
+                self.disable(index)
+            self.fault_time = declared[1]
 
     def flags(self, command):
         """-1/0/+1 per axis: nearest available level to the commanded torque."""
@@ -145,17 +232,33 @@ class ThrusterSet:
         return [0.5 * sum(self.fire_time[i] for key, idx in self.pairs.items() if key[0] == axis for i in idx)
                 for axis in range(3)]
 
-    def firing(self, flags, axial=False):
-        """Indices of the RCS thrusters the pair flags (-1/0/1 per axis) fire, with the ones still
-        inside their minimum on-time; in the burn with off-pulsing, the x pairs only."""
+    def commanded(self, flags, axial=False):
+        """Indices of the RCS thrusters the pair flags (-1/0/1 per axis) open, with the ones still
+        inside their minimum on-time; in the burn with off-pulsing, the x pairs only. With a
+        thruster disabled, the allocation over the others (never a disabled one)."""
         on = {i for i in range(len(self.layout)) if self.on_left[i] > 0.0}
         pulsing = axial and self.off_pulsing
         for axis, f in enumerate(flags):
             if f not in (-1, 0, 1):
                 raise ValueError(f"thrust flag {axis + 1} = {f!r} must be -1, 0 or 1")
+        if self._allocation is not None:
+            key = (int(flags[0]), 0, 0) if pulsing else tuple(int(f) for f in flags)
+            return sorted(on.union(self._allocation[key]) - self.disabled)
+        for axis, f in enumerate(flags):
             if f and not (pulsing and axis > 0):
                 on.update(self.pairs[(axis, int(f))])
         return sorted(on)
+
+    def firing(self, flags, axial=False, commanded=None):
+        """Indices of the RCS thrusters that fire: the commanded ones (`commanded`, if already
+        known), less a stuck-off thruster, with a stuck-on one whose valve is still open."""
+        on = self.commanded(flags, axial) if commanded is None else commanded
+        stuck = self.stuck
+        if stuck is None:
+            return on
+        if self.stuck_on:
+            return on if stuck in on or stuck in self.disabled else sorted(on + [stuck])
+        return [i for i in on if i != stuck]
 
     def axial_off(self, flags, axial=False):
         """Indices of the axial thrusters switched off for the y and z flags (none unless
@@ -187,13 +290,16 @@ class ThrusterSet:
 
     def step(self, flags, h, axial=False):
         """Advance h seconds with `flags` (and `axial`, the burn) held: firing times, the minimum
-        on-time and the axial thrusters' off time."""
-        for i in self.firing(flags, axial):
+        on-time, the axial thrusters' off time and the operating time."""
+        commanded = self.commanded(flags, axial)
+        for i in commanded:
             started = self.on_left[i] <= 0.0
-            self.fire_time[i] += h
             left = (self.min_on_time if started else self.on_left[i]) - h
             self.on_left[i] = max(0.0, left)
+        for i in self.firing(flags, axial, commanded):
+            self.fire_time[i] += h
         self.axial_off_time += h * len(self.axial_off(flags, axial))
+        self.operating_time += h
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
@@ -201,9 +307,18 @@ class ThrusterSet:
         return impulse / (self.isp * self.g0)
 
     def get_state(self):
-        return {"fire_time": list(self.fire_time), "on_left": list(self.on_left), "axial_off_time": self.axial_off_time}
+        return {"fire_time": list(self.fire_time), "on_left": list(self.on_left), "axial_off_time": self.axial_off_time,
+                "operating_time": self.operating_time, "disabled": sorted(self.disabled), "fault_time": self.fault_time,
+                "monitor": None if self.monitor is None else self.monitor.get_state()}
 
     def set_state(self, state):
         self.fire_time = list(state["fire_time"])
         self.on_left = list(state["on_left"])
         self.axial_off_time = float(state["axial_off_time"])
+        self.operating_time = float(state["operating_time"])
+        self.disabled, self._allocation = set(), None
+        for i in state["disabled"]:
+            self.disable(int(i))
+        self.fault_time = float(state["fault_time"])
+        if self.monitor is not None and state["monitor"] is not None:
+            self.monitor.set_state(state["monitor"])

@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from components.attitude import thruster_control as tc
-from components.attitude.thruster_set import ThrusterSet, thesis_layout
+from components.attitude.thruster_set import ThrusterSet, allocation_table, thesis_layout
 from components.attitude.thrusters import ThrusterPairs
 
 
@@ -128,3 +128,61 @@ def test_off_pulsing_cancels_a_tilted_thrust_axis_without_rcs_propellant():
             assert s.propellant_mass() == 0.0 and s.axial_off_time == pytest.approx(2 * duty * 100.0)
         else:
             assert s.propellant_mass() > 0.0 and s.axial_off_time == 0.0
+
+
+def test_the_allocation_over_every_thruster_is_the_pairs():
+    """The allocation the fault management falls back to gives, with nothing excluded, exactly the
+    thesis' pairs for every flag triple (its costs rank them first)."""
+    s = ThrusterSet()
+    table = allocation_table(s.nominal_torques, s.nominal_forces, s.levels, s.force, s.rcs)
+    for flags, thrusters in table.items():
+        assert sorted(thrusters) == s.commanded(list(flags)), flags
+
+
+@pytest.mark.parametrize("dead", range(12))
+def test_a_disabled_thruster_never_fires_and_the_others_take_its_axis(dead):
+    """Any one RCS thruster's valve closed: every single-axis command still gives a torque of the
+    commanded sign on its axis (at least half a pair's), the side torques within half a pair's."""
+    s = ThrusterSet()
+    s.disable(dead)
+    levels = s.levels
+    for axis in range(3):
+        for sign in (1, -1):
+            flags = [0, 0, 0]
+            flags[axis] = sign
+            assert dead not in s.commanded(flags) and dead not in s.firing(flags)
+            _, torque = s.force_and_torque(flags)
+            assert sign * torque[axis] >= 0.5 * levels[axis] - 1e-15, (s.layout[dead][0], flags, torque)
+            for other in set(range(3)) - {axis}:
+                assert abs(torque[other]) <= 0.5 * levels[other] + 1e-15, (s.layout[dead][0], flags, torque)
+    assert s.commanded([0, 0, 0]) == []
+    restored = ThrusterSet()
+    restored.set_state(s.get_state())
+    assert restored.disabled == {dead} and restored.commanded([1, -1, 1]) == s.commanded([1, -1, 1])
+
+
+def test_a_stuck_thruster_from_its_time_on_and_its_valve_closed():
+    names = [name for name, *_ in thesis_layout()]
+    off = ThrusterSet(stuck_thruster=1, stuck_time=0.03)  # x+1 stuck off after 30 ms of operation
+    on = ThrusterSet(stuck_thruster=5, stuck_on=True, stuck_time=0.03)  # y+far stuck open
+    x1, y_far = names.index("x+1"), names.index("y+far")
+    for s in (off, on):
+        s.step([0, 0, 0], 0.015)
+        assert s.stuck is None and s.firing([1, 0, 0]) == s.commanded([1, 0, 0])
+        s.step([1, 0, 0], 0.015)
+    assert off.stuck == x1 and off.firing([1, 0, 0]) == [i for i in off.commanded([1, 0, 0]) if i != x1]
+    assert on.stuck == y_far and on.firing([0, 0, 0]) == [y_far]
+    # the open valve's torque and force act without a command; the propellant is counted
+    force, torque = on.force_and_torque([0, 0, 0])
+    assert torque == pytest.approx(on.torques[y_far]) and force == pytest.approx(on.forces[y_far])
+    spent = on.propellant_mass()
+    on.step([0, 0, 0], 1.0)
+    assert on.propellant_mass() > spent
+    on.disable(y_far)  # the latch valve closed: it stops
+    assert on.firing([0, 0, 0]) == [] and y_far not in on.firing([0, 1, 0])
+    with pytest.raises(ValueError, match="stuck_thruster = 13 must be 0"):
+        ThrusterSet(stuck_thruster=13)
+    with pytest.raises(ValueError, match="stuck_time"):
+        ThrusterSet(stuck_thruster=1, stuck_time=-1.0)
+    with pytest.raises(ValueError, match="not one of the RCS thrusters"):
+        ThrusterSet().disable(12)  # an axial thruster
