@@ -11,10 +11,18 @@ adds the axial thrusters' torque, a disturbance when they are misaligned. With `
 last) the y and z torques in the burn come from switching axial thrusters off (the RCS y and z pairs
 stay off); `axial_off_time`, the thruster-seconds switched off, goes to the propulsion, which takes
 that thrust out of the burn.
+
+The stuck-thruster fault and its management (appended after off-pulsing): `stuck_thruster`
+(1-12, 0 none) never fires, or with `stuck_on` fires at every step, once the set has operated
+`stuck_time`; with `fault_detection` the flight software's monitor
+(components.attitude.thruster_monitor) compares the gyro's rates (`omega_meas_B`) with the
+response the thrusters it opened should give (nominal layout, the inertia of a box of `mass` and
+edges a, b, c), closes the declared thrusters' latch valves and allocates the flags over the
+others; `disabled_mask` (bit i-1 for RCS thruster i) and `fault_time` say what and when.
 """
 from neighbor_fmu_support import NeighborSlave
 
-from components.attitude import thruster_set
+from components.attitude import rigid_body, thruster_monitor, thruster_set
 from components.mission.neighbor import SPACECRAFT
 
 # declared after the outputs that depend on it (appended in a later release)
@@ -71,12 +79,45 @@ class RcsThrusterSet(NeighborSlave):
                        bool)
         self.output("axial_off_time", lambda: self.model.axial_off_time, "s",
                     "Time the axial thrusters were switched off in the burn (off-pulsing), summed over the thrusters")
+        # the stuck-thruster fault and its detection (appended in a later release)
+        self.parameter("stuck_thruster", 0, None,
+                       "Stuck-thruster fault: the RCS thruster that sticks, 0 for none (1-12 in layout order: x+1, "
+                       "x+2, x-1, x-2, y+far, y+near, y-far, y-near, z+far, z+near, z-far, z-near)", int)
+        self.parameter("stuck_on", False, None, "The stuck thruster fires at every step (a valve stuck open); false: "
+                       "it never fires", bool)
+        self.parameter("stuck_time", 0.0, "s", "Operating time (the sum of the set's steps) at which the thruster "
+                       "sticks (>= 0)")
+        self.parameter("fault_detection", False, None,
+                       "Flight software detects a stuck thruster from the gyro's rates, closes its latch valve and "
+                       "allocates the flags over the others", bool)
+        self.parameter("mass", SPACECRAFT.mass, "kg", "Spacecraft mass the detection's inertia is computed from "
+                       "(a uniform box of edges a, b, c, Eq. 4)")
+        self.parameter("edge_b", SPACECRAFT.edge_b, "m", "Box edge b along body z, for the detection's inertia")
+        self.parameter("gyro_sigma", 5.5e-4, "rad/s", "The gyro's noise of one sample at gyro_sample_time (the "
+                       "detection's noise model)")
+        self.parameter("gyro_sample_time", 0.1, "s", "The sample time gyro_sigma is given at (white rate noise: "
+                       "scaled by the square root of the ratio to the step)")
+        self.parameter("detection_window", 1.0, "s", "Window of the rate response the detection tests (two in a "
+                       "row name the fault)")
+        self.input_array("omega_meas_B", [0.0] * 3, "rad/s", "The gyro's measured body rates (the "
+                                 "detection's only view of the body)")
+        self.output("disabled_mask", lambda: sum(1 << self.model.rcs.index(i) for i in self.model.disabled), None,
+                    "RCS thrusters whose latch valve the fault detection closed: bit i-1 for thruster i (0: none)", int)
+        self.output("fault_time", lambda: self.model.fault_time, "s",
+                    "Time the fault detection declared a stuck thruster (-1: never)")
 
     def build_model(self):
         v = self.values
-        return thruster_set.ThrusterSet(
+        model = thruster_set.ThrusterSet(
             v["thrust"], v["edge_a"], v["edge_c"], v["Isp"], v["g0"], v["min_on_time"], self.vector("force_error", N),
-            list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))), v["off_pulsing"])
+            list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))), v["off_pulsing"],
+            v["stuck_thruster"], v["stuck_on"], v["stuck_time"])
+        if v["fault_detection"]:
+            inertia = rigid_body.box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"])
+            model.monitor = thruster_monitor.ThrusterMonitor(
+                dict(enumerate(model.nominal_torques)), model.rcs, inertia, v["gyro_sigma"], v["gyro_sample_time"],
+                v["detection_window"])
+        return model
 
     def _flags(self):
         return self.model.flags(self.vector("torque_cmd_B", 3))
@@ -85,6 +126,9 @@ class RcsThrusterSet(NeighborSlave):
         return self.model.force_and_torque(self.feedthrough(self._flags), self.values["axial_firing"])
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.feedthrough(self._flags), step_size, self.values["axial_firing"])
+        flags, burn = self.feedthrough(self._flags), self.values["axial_firing"]
+        if self.model.monitor is not None:
+            self.model.watch(current_time, self.vector("omega_meas_B", 3), flags, step_size, burn)
+        self.model.step(flags, step_size, burn)
         self._input_version += 1  # the minimum on-time changed: outputs computed before the step are stale
         return True

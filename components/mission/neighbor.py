@@ -121,7 +121,7 @@ MISSION_RECORD: Tuple[str, ...] = (
     "host.heartbeat", "orbit.sma", "orbit.altitude", "orbit.perigee_altitude",
     "orbit.apogee_altitude", "orbit.reentered", "ground.visible", "ground.elevation",
     "propulsion.propellant_used", "propulsion.burning", "propulsion.mass", "propulsion.on_fraction",
-    "thrusters.propellant_mass", "thrusters.axial_off_time",
+    "thrusters.propellant_mass", "thrusters.axial_off_time", "thrusters.disabled_mask", "thrusters.fault_time",
     "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
     "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked",
     *elements("dynamics.omega_BN_B", 3), *elements("dynamics.euler123", 3),

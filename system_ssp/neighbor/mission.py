@@ -32,6 +32,7 @@ from typing import Dict
 import numpy as np
 
 from components.core.constants import DAY, MU_EARTH, R_EQ, YEAR
+from components.attitude.thruster_set import thesis_layout
 from components.mission.modes import DeorbitPhase, MissionMode
 from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS, MISSION_RECORD, MISSION_SYSTEMS,
                                          SCENARIOS as DEFINED_SCENARIOS, SPACECRAFT, scenario_set)
@@ -45,6 +46,9 @@ from ..systems import PARAMETERS_DIR
 from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
                              positive_float, staged_results)
 from . import budgets, deorbit_study, propulsion_report, thesis
+
+# the RCS thrusters' names, bit by bit of the thruster set's disabled_mask
+NAMES_RCS = [name for name, *_, role in thesis_layout() if role != "axial"]
 
 SYSTEMS = MISSION_SYSTEMS
 # the parameter set each applies: the closed loop on the estimator (the system's own values), on
@@ -202,6 +206,15 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     if resets:
         faults.append(f"the estimator's innovations contradicted it {resets} time(s) (a gyro bias jump): the bias "
                       "was reopened and learned again")
+    disabled = int(d["thrusters.disabled_mask"][-1])
+    s["thrusters_disabled"] = [NAMES_RCS[i] for i in range(len(NAMES_RCS)) if disabled >> i & 1]
+    if disabled:
+        declared = float(d["thrusters.fault_time"][-1])
+        began = _first(mode == MissionMode.DEORBIT)
+        s["thruster_fault_after_deorbit_start_s"] = declared - float(t[began]) if began is not None else None
+        when = "" if began is None else f" {declared - float(t[began]):.1f} s after the de-orbit began"
+        faults.append(f"a stuck thruster declared from the rate response{when}: the valve of "
+                      f"{' and '.join(s['thrusters_disabled'])} closed, its axis taken by the others")
     if safe:
         faults.append("no valid attitude for the slew or the burn: the de-orbit was abandoned for the safe state "
                       "(monitoring: no thrust, the position beaconed in ground contacts)")

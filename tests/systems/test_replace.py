@@ -31,7 +31,9 @@ EXTRAS = {"attitude_error", "pointing_error", "sliding_vector[1]", "sliding_vect
           # torque, net force and off-pulsing
           # the tracking law's boundary layer sized for the estimate: the knowledge it reads, the e it uses
           "sigma_attitude_B[1]", "sigma_attitude_B[2]", "sigma_attitude_B[3]",
-          "boundary_layer[1]", "boundary_layer[2]", "boundary_layer[3]"}
+          "boundary_layer[1]", "boundary_layer[2]", "boundary_layer[3]",
+          # the thruster set's stuck-thruster detection: the gyro's rates it reads, what it closed
+          "omega_meas_B[1]", "omega_meas_B[2]", "omega_meas_B[3]", "disabled_mask", "fault_time"}
 
 
 def _cli(*args):

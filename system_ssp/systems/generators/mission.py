@@ -202,7 +202,7 @@ TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e
 # changes appears here.
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
               "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
-              "thrusters.off_pulsing": False, "estimator.fault_window": 0,
+              "thrusters.off_pulsing": False, "thrusters.fault_detection": False, "estimator.fault_window": 0,
               "mission.attitude_determination_timeout": 0.0, "mission.safe_without_attitude": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
@@ -215,12 +215,14 @@ GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynam
 # propulsion's initial mass together.
 SPACECRAFT_PARAMETERS = {
     "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", SPACECRAFT.mass,
-                        [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0")]),
+                        [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0"),
+                         ("thrusters", "mass")]),
     "spacecraft_edge_a": ("Box edge a along body y, m (Appendix A: 0.1 m); also the x thruster pairs' spacing",
                           SPACECRAFT.edge_a, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("estimator", "edge_a"),
                                 ("thrusters", "edge_a")]),
     "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", SPACECRAFT.edge_b,
-                          [("dynamics", "edge_b"), ("tracking", "edge_b"), ("estimator", "edge_b")]),
+                          [("dynamics", "edge_b"), ("tracking", "edge_b"), ("estimator", "edge_b"),
+                           ("thrusters", "edge_b")]),
     "spacecraft_edge_c": ("Box edge c along body x, m (Appendix A: 0.3 m); also the y and z thruster pairs' arms",
                           SPACECRAFT.edge_c, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("estimator", "edge_c"),
                                 ("thrusters", "edge_c")]),
@@ -371,6 +373,7 @@ def system(orbit_fmu):
              ("coarse_sun", "sun_B", "estimator", "coarse_sun_B", 3),
              ("coarse_sun", "valid", "estimator", "coarse_sun_valid", 0),
              ("dynamics", "omega_BN_B", "gyro", "omega_BN_B", 3),
+             ("gyro", "omega_meas_B", "thrusters", "omega_meas_B", 3),
              ("horizon", "nadir_B", "estimator", "nadir_B", 3),
              ("horizon", "valid", "estimator", "nadir_valid", 0),
              ("sun_sensor", "sun_B", "estimator", "sun_B", 3),
@@ -459,7 +462,9 @@ def generate(writer):
                 "target_from_input": True, **TRACKING_LAYER})
     writer.ssv("mission_thrusters",
                "In the burn, y and z torques by switching axial thrusters off (off-pulsing): no RCS propellant "
-               "for the thrust axis' misalignment torque", {"off_pulsing": True})
+               "for the thrust axis' misalignment torque; a stuck thruster detected from the gyro's rates, its valve "
+               "closed and its axis taken by the others",
+               {"off_pulsing": True, "fault_detection": True, "gyro_sigma": ad.GYRO_SIGMA, "gyro_sample_time": ad.STEP})
     writer.ssv("mission_detumble",
                "Detumble flight settle criterion: rate window 0.75 impulse bit per axis held for 1 s", DETUMBLE_FLIGHT)
     writer.ssv("mission_slew",
