@@ -11,7 +11,8 @@ from system_ssp import SSPError
 from system_ssp.tools.flatten import flatten_system_parameters
 from system_ssp.master.parameters import collect_parameters
 
-MASS_USERS = [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0")]
+MASS_USERS = [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0"),
+              ("thrusters", "mass")]
 
 
 def _values(system, **kw):
@@ -23,9 +24,9 @@ def test_one_mass_reaches_every_component_that_uses_it(ssp_paths, tmp_path):
     with system_ssp.System(ssp_paths["neighbor_mission_lifetime"]) as s:
         assert [(c.name, v) for c, v, _ in s.parameter_links["spacecraft_mass"]] == MASS_USERS
         default = _values(s)
-        assert [default[f"{c}.{v}"] for c, v in MASS_USERS] == [12.0] * 4
+        assert [default[f"{c}.{v}"] for c, v in MASS_USERS] == [12.0] * len(MASS_USERS)
         heavy = _values(s, parameters={"spacecraft_mass": 14.0})
-        assert [heavy[f"{c}.{v}"] for c, v in MASS_USERS] == [14.0] * 4
+        assert [heavy[f"{c}.{v}"] for c, v in MASS_USERS] == [14.0] * len(MASS_USERS)
         # a later component value still overrides its own parameter only
         mixed = _values(s, parameters={"spacecraft_mass": 14.0, "tracking.mass": 13.0})
         assert (mixed["dynamics.mass"], mixed["tracking.mass"], mixed["propulsion.mass0"]) == (14.0, 13.0, 14.0)
@@ -38,7 +39,7 @@ def test_one_mass_reaches_every_component_that_uses_it(ssp_paths, tmp_path):
                        'SystemStructureCommon" name="g"><ssc:BaseUnit kg="1" factor="0.001"/></ssc:Unit></ssv:Units>'
                        '</ssv:ParameterSet>\n')
         grams = _values(s, parameter_sets=[str(ssv)])
-        assert [grams[f"{c}.{v}"] for c, v in MASS_USERS] == [pytest.approx(13.5)] * 4
+        assert [grams[f"{c}.{v}"] for c, v in MASS_USERS] == [pytest.approx(13.5)] * len(MASS_USERS)
         with pytest.raises(SSPError, match=r"'spacecraft_mas': not a system parameter.*spacecraft_mass"):
             _values(s, parameters={"spacecraft_mas": 14.0})
         with pytest.raises(SSPError, match=r"spacecraft_mass \(system parameter\) -> dynamics.mass"):
