@@ -56,12 +56,12 @@ class ThrusterMonitor:
         J = np.array(inertia, dtype=float).reshape(3, 3)
         if not np.all(np.isfinite(J)) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise ValueError(f"inertia {J.tolist()} must be finite and positive definite (kg.m2)")
-        self.J, self.J_inv = J, np.linalg.inv(J)
+        J_inv = np.linalg.inv(J)
         self.index = sorted(int(i) for i in torques)  # column of each thruster in the open-time rows
         self.column = {i: k for k, i in enumerate(self.index)}
-        self.signatures = np.array([self.J_inv @ np.asarray(torques[i], dtype=float) for i in self.index])
+        self.signatures = np.array([J_inv @ np.asarray(torques[i], dtype=float) for i in self.index])
         self._torque_rows = [tuple(float(x) for x in torques[i]) for i in self.index]  # nominal, N.m
-        self._J, self._J_inv = tuple(map(tuple, J.tolist())), tuple(map(tuple, self.J_inv.tolist()))
+        self._J, self._J_inv = tuple(map(tuple, J.tolist())), tuple(map(tuple, J_inv.tolist()))
         self.candidates = sorted(int(i) for i in candidates)
         missing = [i for i in self.candidates if i not in self.column]
         if missing:

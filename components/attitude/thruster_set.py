@@ -213,10 +213,8 @@ class ThrusterSet:
         """The fault detection's step [t, t + h) before the set's: the gyro's rates at t and the
         thrusters flight software opens for `flags` (with the axial ones left on in the burn);
         a declared fault closes its thrusters' valves before they fire in this step."""
-        opened = self.commanded(flags, axial)
-        if axial:  # the axial thrusters' nominal torques cancel only when all four fire
-            off = self.axial_off(flags, axial)
-            opened = opened + [i for i in self.axial if i not in off]
+        # the axial thrusters' nominal torques cancel only when all four fire
+        opened = self.commanded(flags, axial) + self.axial_on(flags, axial)
         declared = self.monitor.step(t, omega_meas, opened, h, self.disabled)
         if declared is not None:
             for index, _ in declared[0]:
@@ -271,6 +269,14 @@ class ThrusterSet:
         return tuple(i for i in self.axial
                      if (not fy or self._off_signs[i][0] == fy) and (not fz or self._off_signs[i][1] == fz))
 
+    def axial_on(self, flags, axial=False):
+        """Indices of the axial thrusters firing: in the burn (`axial`) those not switched off for
+        the flags, else none."""
+        if not axial:
+            return []
+        off = self.axial_off(flags, axial)
+        return [i for i in self.axial if i not in off]
+
     def force_and_torque(self, flags, axial=False):
         """(net force of the RCS thrusters firing for `flags` (N, B), torque (N.m, B)), the torque
         with the axial thrusters' left on when `axial` (the burn: their force is the propulsion's;
@@ -280,12 +286,9 @@ class ThrusterSet:
             f, t = self.forces[i], self.torques[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
-        if axial:
-            off = self.axial_off(flags, axial)
-            for i in self.axial:
-                if i not in off:
-                    t = self.torques[i]
-                    tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
+        for i in self.axial_on(flags, axial):
+            t = self.torques[i]
+            tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
         return (fx, fy, fz), (tx, ty, tz)
 
     def step(self, flags, h, axial=False):

@@ -211,8 +211,9 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     if disabled:
         declared = float(d["thrusters.fault_time"][-1])
         began = _first(mode == MissionMode.DEORBIT)
-        s["thruster_fault_after_deorbit_start_s"] = declared - float(t[began]) if began is not None else None
-        when = "" if began is None else f" {declared - float(t[began]):.1f} s after the de-orbit began"
+        after = None if began is None else declared - float(t[began])
+        s["thruster_fault_after_deorbit_start_s"] = after
+        when = "" if after is None else f" {after:.1f} s after the de-orbit began"
         faults.append(f"a stuck thruster declared from the rate response{when}: the valve of "
                       f"{' and '.join(s['thrusters_disabled'])} closed, its axis taken by the others")
     if safe:
