@@ -18,6 +18,7 @@ are when it is read (true direct feedthrough, as FMI co-simulation masters expec
 import copy
 import math
 from collections import OrderedDict
+from operator import itemgetter
 from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
 
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
@@ -53,6 +54,14 @@ class AttitudeMeasurementSignals(NamedTuple):
     rate: Names
 
 
+def _picker(indices):
+    """f(vector) -> the elements at `indices`, as a sequence."""
+    if len(indices) == 1:
+        i = indices[0]
+        return lambda vector: (vector[i],)
+    return itemgetter(*indices)
+
+
 class ParameterError(ValueError):
     """A parameter or input value outside its allowed range (message names the variable)."""
 
@@ -83,14 +92,18 @@ class NeighborSlave(Fmi2Slave):
         self._model_generation = 0  # counts model builds: a cache key that is never reused
         self._vector_keys = {}
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
-        self._batch = None  # while a get call runs: the vectors its array outputs computed
         self._accessors = {}  # (type, "getter" or "setter") -> {value reference: function}
         self._input_names = {}  # type -> {value reference: name} of the inputs
+        self._array_elements = {}  # value reference of an array output's element -> (vector getter, index)
+        self._get_plans = {cls: {} for cls in _KINDS}  # type -> {value references: plan (_get_plan)}
+        self._set_plans = {cls: {} for cls in _KINDS}  # type -> {value references: input names or None}
 
     # ---- the FMI get and set calls ----------------------------------------------------------
-    # pythonfmu's own look up each variable and check its type on every call; these read tables
-    # built at the first call (every variable is declared in __init__) and fall back to
-    # pythonfmu's for anything the tables lack, so its errors stay the same.
+    # pythonfmu's own look up each variable and check its type on every call. Ours follow a plan
+    # made at the first call with a given list of value references (a master asks for the same
+    # list at every step; our runtime passes it as the same tuple): a get calls each array
+    # output's vector getter once and picks its elements, a set of inputs stores them in one
+    # update. Anything a plan cannot serve falls back to pythonfmu's, so its errors stay the same.
     def _accessor_table(self, cls, what):
         table = self._accessors.get((cls, what))
         if table is None:
@@ -99,19 +112,65 @@ class NeighborSlave(Fmi2Slave):
                 if isinstance(var, cls) and getattr(var, what) is not None}
         return table
 
-    def _get(self, cls, kind, vrs, fallback):
+    def _get_plan(self, cls, key):
+        """(vector getters, [(index into them, picker of the elements or None for a scalar)]) for
+        the value references `key`, or None when one of them has no getter of type cls."""
         getters = self._accessor_table(cls, "getter")
-        self._batch = {}
-        try:
-            return [kind(getters[vr]()) for vr in vrs]
-        except KeyError:
+        sources, slots, runs = [], {}, []
+        for vr in key:
+            element = self._array_elements.get(vr)
+            if element is None:
+                getter = getters.get(vr)
+                if getter is None:
+                    return None
+                slots[getter] = len(sources)
+                sources.append(getter)
+                runs.append([len(sources) - 1, None])
+                continue
+            if vr not in getters:
+                return None
+            vector_getter, i = element
+            s = slots.get(vector_getter)
+            if s is None:
+                s = slots[vector_getter] = len(sources)
+                sources.append(vector_getter)
+            if runs and runs[-1][0] == s and runs[-1][1] is not None:
+                runs[-1][1].append(i)  # the next element of the same vector
+            else:
+                runs.append([s, [i]])
+        return sources, [(s, None if idx is None else _picker(idx)) for s, idx in runs]
+
+    def _get(self, cls, kind, vrs, fallback):
+        key = vrs if type(vrs) is tuple else tuple(vrs)
+        plans = self._get_plans[cls]
+        plan = plans.get(key, False)
+        if plan is False:
+            plan = plans[key] = self._get_plan(cls, key)
+        if plan is None:
             return fallback(self, vrs)
-        finally:
-            self._batch = None
+        sources, runs = plan
+        vectors = [get() for get in sources]
+        out = []
+        for s, pick in runs:
+            if pick is None:
+                out.append(vectors[s])
+            else:
+                out.extend(pick(vectors[s]))
+        return list(map(kind, out))
 
     def _set(self, cls, vrs, values, fallback):
-        # an input is stored in place (no setter call per value: the mission sets millions);
-        # a parameter goes through its setter, which checks it and drops the model
+        # inputs are stored in place in one update (no setter call per value: the mission sets
+        # millions); a parameter goes through its setter, which checks it and drops the model
+        key = vrs if type(vrs) is tuple else tuple(vrs)
+        plans = self._set_plans[cls]
+        names = plans.get(key, False)
+        if names is False:
+            inputs = self._input_names.get(cls, {})
+            names = plans[key] = [inputs[vr] for vr in key] if all(vr in inputs for vr in key) else None
+        if names is not None and len(values) == len(names):
+            self.values.update(zip(names, map(_KINDS[cls], values)))
+            self._input_version += 1
+            return
         setters = self._accessor_table(cls, "setter")
         inputs = self._input_names.get(cls, {})
         store, kind, changed = self.values, _KINDS[cls], False
@@ -222,17 +281,10 @@ class NeighborSlave(Fmi2Slave):
         names = element_names(name, n)
 
         def element(i):
-            def get():
-                batch = self._batch  # inside one get call: the vector is computed once, not per element
-                if batch is None:
-                    return getter()[i]
-                vector = batch.get(name)
-                if vector is None:
-                    vector = batch[name] = getter()
-                return vector[i]
-            return get
+            return lambda: getter()[i]
 
         for i, element_name in enumerate(names):
+            self._array_elements[len(self.vars)] = (getter, i)  # the value reference it gets next
             self.output(element_name, element(i), unit, f"{description} (component {i + 1})", kind, depends_on)
         return names
 

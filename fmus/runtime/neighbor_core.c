@@ -398,6 +398,17 @@ static int start_runtime(const char *resources) {
 enum { ST_OK = 0, ST_WARNING = 1, ST_DISCARD = 2, ST_ERROR = 3, ST_FATAL = 4 };
 typedef int Status;
 
+/* The value references of a get or set call as the Python tuple the model's get/set receive: a
+   master asks for the same lists at every step, and the model keys its prepared plan of the
+   call by that tuple (NeighborSlave._get/_set), so the last few are kept, each with a copy of
+   its numbers to compare. */
+#define VR_CACHED 4
+typedef struct {
+    unsigned int *copy;
+    size_t n;
+    PyObject *tuple;
+} VrTuple;
+
 typedef struct {
     HostCallbacks cb;
     char *name;
@@ -406,6 +417,8 @@ typedef struct {
     PyObject *log_queue;  /* the slave's list of pending messages */
     PyObject *m_get[4], *m_set[4];  /* bound get_real ... get_string, set_real ... set_string */
     PyObject *m_do_step;
+    VrTuple vr_tuples[2][4][VR_CACHED]; /* [get, set][kind][slot] */
+    int vr_next[2][4];                  /* the slot the next new list replaces */
     char **strings;  /* String results, valid until the next call */
     size_t n_strings;
     int broken;  /* a fatal error: every later call returns Fatal */
@@ -521,6 +534,32 @@ static PyObject *vr_list(const unsigned int vr[], size_t n) {
     return list;
 }
 
+/* A new reference to the tuple of vr[0 .. n) for a get (set = 0) or set (set = 1) of `kind`. */
+static PyObject *vr_tuple(Instance *inst, int set, int kind, const unsigned int vr[], size_t n) {
+    VrTuple *slots = inst->vr_tuples[set][kind];
+    for (int i = 0; i < VR_CACHED; i++) {
+        VrTuple *c = &slots[i];
+        if (c->tuple && c->n == n && (n == 0 || memcmp(c->copy, vr, n * sizeof *vr) == 0)) {
+            py.IncRef(c->tuple);
+            return c->tuple;
+        }
+    }
+    PyObject *t = py.TupleNew((Py_ssize_t)n);
+    for (size_t i = 0; i < n; i++) py.TupleSetItem(t, (Py_ssize_t)i, py.LongFromUnsignedLong(vr[i]));
+    unsigned int *copy = (unsigned int *)malloc(n ? n * sizeof *vr : 1);
+    if (!copy) return t;  /* not kept */
+    if (n) memcpy(copy, vr, n * sizeof *vr);
+    VrTuple *c = &slots[inst->vr_next[set][kind]];
+    inst->vr_next[set][kind] = (inst->vr_next[set][kind] + 1) % VR_CACHED;
+    if (c->tuple) py.DecRef(c->tuple);
+    free(c->copy);
+    c->copy = copy;
+    c->n = n;
+    c->tuple = t;
+    py.IncRef(t);
+    return t;
+}
+
 static PyObject *none_ref(void) {
     PyObject *none = py.DictGetItemString(loader, "NONE");
     py.IncRef(none);
@@ -584,6 +623,15 @@ static void release_instance(Instance *inst) {
         if (inst->m_set[k]) py.DecRef(inst->m_set[k]);
     }
     if (inst->m_do_step) py.DecRef(inst->m_do_step);
+    for (int d = 0; d < 2; d++)
+        for (int k = 0; k < 4; k++)
+            for (int i = 0; i < VR_CACHED; i++) {
+                VrTuple *c = &inst->vr_tuples[d][k][i];
+                if (c->tuple) py.DecRef(c->tuple);
+                free(c->copy);
+                c->tuple = NULL;
+                c->copy = NULL;
+            }
     if (inst->log_queue) py.DecRef(inst->log_queue);
     if (inst->slave) py.DecRef(inst->slave);
 }
@@ -732,7 +780,7 @@ static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr,
         py.IncRef(inst->slave);
         res = call(inst, fn, tuple_of(3, inst->slave, py.LongFromLong(kind), vr_list(vr, nvr)), what, &status);
     } else {
-        res = call(inst, inst->m_get[kind], tuple_of(1, vr_list(vr, nvr)), what, &status);
+        res = call(inst, inst->m_get[kind], tuple_of(1, vr_tuple(inst, 0, kind, vr, nvr)), what, &status);
     }
     if (res) {
         if (kind == KIND_STRING) {
@@ -798,7 +846,7 @@ static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr,
         res = call(inst, fn, tuple_of(4, inst->slave, py.LongFromLong(kind), vr_list(vr, nvr), values), what,
                    &status);
     } else {
-        res = call(inst, inst->m_set[kind], tuple_of(2, vr_list(vr, nvr), values), what, &status);
+        res = call(inst, inst->m_set[kind], tuple_of(2, vr_tuple(inst, 1, kind, vr, nvr), values), what, &status);
     }
     if (res) py.DecRef(res);
     LEAVE();

@@ -198,7 +198,7 @@ class _Mode:
     def __init__(self, name, h, order, record_every, conditions, mult, refresh):
         self.name, self.h, self.order, self.record_every = name, h, order, record_every
         self.conditions, self.mult, self.refresh = conditions, mult, refresh
-        self.arrays = None  # (order, mult, refresh) for the compiled loop
+        self.arrays = None  # (order, mult, refresh, compiled.LazyRefresh) for the compiled loop
 
 
 class _Signal:
@@ -300,6 +300,7 @@ class ScheduledAlgorithm:
         self.events = [_Signal(table, ci, var, "Real") for ci, var in sch.events]
         self.cond_comps = sorted({sig.ci for sig in self.signals})
         self.prod = [sorted(producers[ci]) for ci in range(n)]
+        self.consumers, self.watched = consumers, watched  # for the compiled loop's lazy refresh
         # Times closer than this are the same instant: a few ulps of the largest time in the run
         # (1.5e-5 s at 40 years), far below any step, so that t + (t_event - t) lands on t_event.
         self.tol = 64.0 * math.ulp(max(1.0, abs(plan.start), abs(plan.stop)))
@@ -315,7 +316,8 @@ class ScheduledAlgorithm:
         self.span = SpanSize()
         for m in self.modes:
             m.arrays = (np.array(m.order, dtype=np.int64), np.array(m.mult, dtype=np.int64),
-                        np.array(m.refresh, dtype=np.int64))
+                        np.array(m.refresh, dtype=np.int64),
+                        compiled.lazy_refresh(self.n, m.order, m.refresh, self.consumers, self.watched))
         self.loop.load(mode_arrays=self.modes[0].arrays)
         return True
 
@@ -383,10 +385,10 @@ class ScheduledAlgorithm:
         T.ev_buf[:] = self.ev_values
         T.sig_values[:] = self.signal_values
         clocks = np.array(tc, dtype=np.float64)
-        order, mult, refresh = mode.arrays
+        order, mult, refresh, lazy = mode.arrays
         rows, times = loop.enter(mode.record_every)
         steps, t1, spent, flags = compiled.scheduled_span(
-            T, order, mult, refresh, float(mode.h), float(t), float(stop), float(tol), self.span.start(),
+            T, lazy, order, mult, refresh, float(mode.h), float(t), float(stop), float(tol), self.span.start(),
             float(self.mode_time[mode.name]), clocks, loop.changed, loop.status, rows, times, loop.rec)
         self.span.took()
         loop.leave()

@@ -41,6 +41,9 @@ ENABLED = os.environ.get("NEIGHBOR_COSIM_COMPILED_LOOP", "1") != "0"
 ERROR_STEP, ERROR_SET, ERROR_GET, ERROR_SIGNAL, ERROR_EVENT, ERROR_STOP, ERROR_RECORD = 1, 2, 3, 4, 5, 6, 7
 # the span's end, in its returned flags
 CONDITION_CHANGED, STOP_FIRED, FAILED = 1, 2, 4
+# a reader of a refreshed component's outputs in a mode (LazyRefresh.kind): a stepping one that
+# steps after it, one that steps before it (or is itself); a refreshed one after it, before it
+READER_AFTER, READER_BEFORE, READER_REFRESHED, READER_REFRESHED_BEFORE = 0, 1, 2, 3
 
 
 @intrinsic
@@ -288,9 +291,59 @@ def _row_due(T, rows, times, rec, t, active, status_out):
 
 
 @njit(cache=True)
-def _step_mode(T, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, status_out):
+def _refresh_one(T, ci, status_out):
+    """A refreshed component's inputs sent (where changed) and its connected outputs read."""
+    return _set_inputs(T, ci, status_out) and _get_outputs(T, ci, status_out)
+
+
+@njit(cache=True)
+def _needed(L, refresh, tc, t1, tol):
+    """L.needed[ci] for the refreshed components after a step ending at t1. A lazily refreshed
+    one (L.lazy) is refreshed now only when one of its readers would otherwise read an output
+    the Python loop's refresh at every step gives another value: a stepping reader due at the
+    next step that steps before it (or any due one when it is not due itself), a reader refreshed
+    after it in this step, or one refreshed before it at the next step while it does not step
+    (each refreshed reader is also a stepping one)."""
+    for r in range(len(refresh) - 1, -1, -1):
+        ci = refresh[r]
+        need = not L.lazy[ci]
+        if not need:
+            ci_next = tc[ci] <= t1 + tol
+            for p in range(L.ptr[ci], L.ptr[ci + 1]):
+                cj, kind = L.reader[p], L.kind[p]
+                cj_next = tc[cj] <= t1 + tol
+                if kind == READER_AFTER:
+                    need = cj_next and not ci_next
+                elif kind == READER_BEFORE:
+                    need = cj_next
+                elif kind == READER_REFRESHED:
+                    need = L.needed[cj] or (cj_next and not ci_next)
+                else:  # READER_REFRESHED_BEFORE
+                    need = cj_next or not ci_next
+                if need:
+                    break
+        L.needed[ci] = need
+
+
+@njit(cache=True)
+def _catch_up(T, L, refresh, status_out):
+    """The refreshes the steps left out (L.stale), in the refresh order: before a recorded row
+    and at a span's end (the next step may be another mode's), the outputs are then those the
+    refresh at every step would have given."""
+    for ci in refresh:
+        if L.stale[ci]:
+            if not _refresh_one(T, ci, status_out):
+                return False
+            L.stale[ci] = False
+    return True
+
+
+@njit(cache=True)
+def _step_mode(T, L, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, status_out):
     """One macro step's components (ScheduledAlgorithm._advance): each due one stepped from its
-    own time (multiples run ahead), then the refreshed feedthrough ones whose inputs changed."""
+    own time (multiples run ahead), then the refreshed feedthrough ones whose inputs changed:
+    now where a reader needs them before the next update (_needed), else marked stale (the Python
+    loop refreshes each at every such step; the values any component reads are the same)."""
     for ci in range(len(changed)):
         changed[ci] = False
     for ci in order:
@@ -305,17 +358,25 @@ def _step_mode(T, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, s
             return False
         tc[ci] = end
         changed[ci] = True
+    if len(refresh) > 0:
+        _needed(L, refresh, tc, t1, tol)
     for ci in refresh:
-        due = changed[ci]
+        due = changed[ci] or L.stale[ci]
         if not due:
             for p in range(T.prod_ptr[ci], T.prod_ptr[ci + 1]):
-                if changed[T.prod_list[p]]:
+                cp = T.prod_list[p]
+                if changed[cp] or L.stale[cp]:
                     due = True
                     break
         if due:
-            if not _set_inputs(T, ci, status_out) or not _get_outputs(T, ci, status_out):
-                return False
-            changed[ci] = True
+            if L.needed[ci]:
+                if not _refresh_one(T, ci, status_out):
+                    return False
+                changed[ci] = True
+                L.stale[ci] = False
+            else:
+                L.stale[ci] = True
+                L.left_out[0] += 1
     return True
 
 
@@ -348,13 +409,13 @@ def _read_signals(T, changed, status_out):
 
 
 @njit(cache=True)
-def scheduled_span(T, order, mult, refresh, h_mode, t, stop, tol, max_steps, spent, tc, changed, status_out, rows,
+def scheduled_span(T, L, order, mult, refresh, h_mode, t, stop, tol, max_steps, spent, tc, changed, status_out, rows,
                    times, rec):
     """Up to max_steps macro steps of one mode from t (ScheduledAlgorithm._advance, the schedule's
     signals and the stop signals read as there, the recorder's rows due on the way recorded into
-    rows/times; rec: [rows recorded, steps since the last, the mode's recordEvery]). Returns
-    (steps, t reached, `spent` plus the steps' sizes, added one by one as the Python loop does,
-    flags); `changed` is the last step's, which the observers see in Python."""
+    rows/times; rec: [rows recorded, steps since the last, the mode's recordEvery]; L: the mode's
+    LazyRefresh). Returns (steps, t reached, `spent` plus the steps' sizes, added one by one as
+    the Python loop does, flags); `changed` is the last step's, which the observers see in Python."""
     steps, flags = 0, 0
     status_out[0] = 0
     end_time = stop - tol
@@ -367,7 +428,7 @@ def scheduled_span(T, order, mult, refresh, h_mode, t, stop, tol, max_steps, spe
         if stop - t < h + tol:
             h = stop - t
         t1 = t + h if stop - (t + h) > tol else stop
-        if not _step_mode(T, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, status_out):
+        if not _step_mode(T, L, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, status_out):
             return steps, t, spent, FAILED
         t = t1
         spent += h
@@ -375,10 +436,14 @@ def scheduled_span(T, order, mult, refresh, h_mode, t, stop, tol, max_steps, spe
         flags = _read_signals(T, changed, status_out)
         if flags != 0 or t >= end_time or steps >= max_steps:
             break
+        if rec[1] + 1 >= rec[2] and not _catch_up(T, L, refresh, status_out):  # a row is due
+            return steps, t, spent, FAILED
         if not _row_due(T, rows, times, rec, t, order, status_out):
             if status_out[0] > 1:
                 return steps, t, spent, FAILED
             break
+    if flags & FAILED or not _catch_up(T, L, refresh, status_out):
+        return steps, t, spent, FAILED
     return steps, t, spent, flags
 
 
@@ -419,6 +484,43 @@ def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, c
                 return steps, FAILED
             break
     return steps, flags
+
+
+class LazyRefresh(NamedTuple):
+    """One mode's refresh, lazily (_step_mode): which refreshed components may wait (`lazy`:
+    those the schedule's and stop conditions' signals do not read), their readers in the mode
+    (`reader`/`kind` from ptr[ci] to ptr[ci + 1]), and the state the steps keep: `needed` (this
+    step's), `stale` (a refresh left out) and `left_out` (how many were)."""
+    lazy: np.ndarray     # [n] bool
+    ptr: np.ndarray      # [n + 1]
+    reader: np.ndarray
+    kind: np.ndarray     # READER_*
+    needed: np.ndarray   # [n] bool
+    stale: np.ndarray    # [n] bool
+    left_out: np.ndarray  # [1] refreshes left out so far
+
+
+def lazy_refresh(n, order, refresh, consumers, watched):
+    """The LazyRefresh of a mode stepping `order` and refreshing `refresh` (component indices),
+    from each component's consumers and the components whose outputs the schedule or a stop
+    condition reads."""
+    pos = {ci: k for k, ci in enumerate(order)}
+    refreshed = set(refresh)
+    lazy = np.zeros(n, dtype=np.bool_)
+    ptr, reader, kind = [0], [], []
+    for ci in range(n):
+        if ci in refreshed:
+            lazy[ci] = ci not in watched
+            for cj in sorted(cj for cj in consumers[ci] if cj in pos):
+                before = pos[cj] <= pos[ci]
+                reader.append(cj)
+                if cj in refreshed:
+                    kind.append(READER_REFRESHED_BEFORE if before else READER_REFRESHED)
+                else:
+                    kind.append(READER_BEFORE if before else READER_AFTER)
+        ptr.append(len(reader))
+    return LazyRefresh(lazy, _i64(ptr), _i64(reader), _i64(kind), np.zeros(n, dtype=np.bool_),
+                       np.zeros(n, dtype=np.bool_), np.zeros(1, dtype=np.int64))
 
 
 def _i64(values):
@@ -533,15 +635,16 @@ class Loop:
 
     def load(self, mode_arrays=None, fixed=None):
         """Call the span function once without a step, so that numba loads (or compiles) it now,
-        before the run's clock starts: `mode_arrays` (order, mult, refresh) of a scheduled run,
+        before the run's clock starts: `mode_arrays` (order, mult, refresh, LazyRefresh) of a scheduled run,
         or `fixed` (order, mult) of a fixed-step one."""
         rows, times = self.rows.rows, self.rows.times
         if fixed is not None:
             fixed_span(self.T, fixed[0], fixed[1], False, 0.0, 1.0, 1.0, 1, 0, 0, self.changed, self.status, rows,
                        times, self.rec)
         else:
-            scheduled_span(self.T, mode_arrays[0], mode_arrays[1], mode_arrays[2], 1.0, 0.0, 1.0, 0.0, 0, 0.0,
-                           np.zeros(len(self.changed)), self.changed, self.status, rows, times, self.rec)
+            order, mult, refresh, lazy = mode_arrays
+            scheduled_span(self.T, lazy, order, mult, refresh, 1.0, 0.0, 1.0, 0.0, 0, 0.0, np.zeros(len(self.changed)),
+                           self.changed, self.status, rows, times, self.rec)
 
     def enter(self, record_every):
         """Before a span: which inputs the Python loop has sent (its SetOp.last), the recorder's

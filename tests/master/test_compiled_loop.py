@@ -11,6 +11,7 @@ from system_ssp import Observer, SimulationError
 from system_ssp.master import algorithms, compiled
 from system_ssp.master.system import simulate
 from test_master_core import loop_system
+from test_master_schedule import scheduled_system
 
 SPAN = compiled.scheduled_span, compiled.fixed_span
 
@@ -66,6 +67,41 @@ def test_compiled_scheduled_loop_equals_the_python_loop(ssp_paths, monkeypatch):
     python, _ = _run(ssp_paths["deorbit"], False, monkeypatch, **options)
     fast, spans = _run(ssp_paths["deorbit"], True, monkeypatch, **options)
     assert 0 < spans < 200 and python.modes["burn"]["steps"] > 4000 and python.modes["coast"]["steps"] > 0
+    _same(fast, python)
+
+
+# integ steps every third 0.1 s step, before gain; gain (y = u, direct feedthrough) steps at every
+# step, so the Python loop refreshes it after each (its reader integ steps before it), while the
+# compiled loop does so only when integ steps next; rows every fourth step and at the mode change
+LAZY = """<nc:Order>integ gain timer</nc:Order><nc:Schedule>
+  <nc:Mode name="before" stepSize="0.1" every="integ:3" recordEvery="4">
+    <nc:When component="timer" connector="expired" values="0"/></nc:Mode>
+  <nc:Mode name="after" stepSize="0.05" every="gain:2"/>
+</nc:Schedule>"""
+
+
+@pytest.fixture(scope="module")
+def fmus_for_schedule(tmp_path_factory):
+    return h.build_fixture_fmus(tmp_path_factory.mktemp("master_fmus"))
+
+
+def test_compiled_loop_refreshes_only_what_the_next_step_reads(fmus_for_schedule, tmp_path, monkeypatch):
+    """The lazy refresh (compiled.LazyRefresh): refreshes left out, the recorded rows, the final
+    values and the mode change the same bit for bit as the Python loop's refresh at every step."""
+    ssd = scheduled_system(tmp_path, fmus_for_schedule, schedule=LAZY, expiry=2.05)
+    left_out = []
+    lazy_refresh = compiled.lazy_refresh
+
+    def kept(*args):
+        lazy = lazy_refresh(*args)
+        left_out.append(lazy.left_out)
+        return lazy
+
+    monkeypatch.setattr(compiled, "lazy_refresh", kept)
+    python, _ = _run(ssd, False, monkeypatch, stop_time=3.0)
+    fast, spans = _run(ssd, True, monkeypatch, stop_time=3.0)
+    assert spans > 0 and python.modes["before"]["steps"] == 21 and python.modes["after"]["steps"] == 18
+    assert sum(int(n[0]) for n in left_out) >= 10  # about two of every three steps in "before"
     _same(fast, python)
 
 
