@@ -91,6 +91,7 @@ class NeighborSlave(Fmi2Slave):
         self._input_version = 0
         self._model_generation = 0  # counts model builds: a cache key that is never reused
         self._vector_keys = {}
+        self._feedthrough_cache = {}  # compute's name -> (input version and model generation, its value)
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
         self._accessors = {}  # (type, "getter" or "setter") -> {value reference: function}
         self._input_names = {}  # type -> {value reference: name} of the inputs
@@ -375,22 +376,22 @@ class NeighborSlave(Fmi2Slave):
 
         Several outputs of a controller come from one computation on the current inputs;
         this runs it once per set of inputs rather than once per output read."""
-        self.model  # noqa: B018 - build it first, so that the key carries its generation
+        if self._model is None:
+            self.model  # noqa: B018 - build it first, so that the key carries its generation
         key = (self._input_version, self._model_generation)
-        cache = self.__dict__.setdefault("_feedthrough_cache", {})
-        hit = cache.get(compute.__name__)
+        cache = self._feedthrough_cache
+        name = compute.__name__
+        hit = cache.get(name)
         if hit is None or hit[0] != key:
-            hit = (key, compute())
-            cache[compute.__name__] = hit
+            hit = cache[name] = (key, compute())
         return hit[1]
 
     def vector(self, name: str, n: int) -> list:
         """[values of name[1] .. name[n]] (the element names are built once, not per call)."""
-        keys = self._vector_keys.get((name, n))
-        if keys is None:
-            keys = self._vector_keys[(name, n)] = list(element_names(name, n))
-        values = self.values
-        return [values[k] for k in keys]
+        pick = self._vector_keys.get((name, n))
+        if pick is None:
+            pick = self._vector_keys[(name, n)] = _picker(list(element_names(name, n)))
+        return list(pick(self.values))
 
     @property
     def model(self) -> Any:

@@ -174,7 +174,7 @@ class DeorbitTrackingController:
         updated only every few attitude steps: holding a stale target while omega_d says it moves
         would make the error jump at every update and the thrusters chase it (22.5 g instead of
         4.8 g over the 420 km burn)."""
-        target = (tuple(float(x) for x in q_target), tuple(float(x) for x in omega_target))
+        target = (tuple(map(float, q_target)), tuple(map(float, omega_target)))
         if target != self.anchor:
             self.q_d = rotations.normalized(target[0], "q_target_BN")
             self.omega_d = _finite3("omega_target_B", target[1])

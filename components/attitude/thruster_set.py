@@ -49,6 +49,7 @@ cancels its side torque. With every thruster enabled the pairs fire exactly as b
 """
 import itertools
 import math
+import operator
 
 import numpy as np
 
@@ -234,7 +235,7 @@ class ThrusterSet:
         """Indices of the RCS thrusters the pair flags (-1/0/1 per axis) open, with the ones still
         inside their minimum on-time; in the burn with off-pulsing, the x pairs only. With a
         thruster disabled, the allocation over the others (never a disabled one)."""
-        on = {i for i in range(len(self.layout)) if self.on_left[i] > 0.0}
+        on = {i for i, left in enumerate(self.on_left) if left > 0.0}
         pulsing = axial and self.off_pulsing
         for axis, f in enumerate(flags):
             if f not in (-1, 0, 1):
@@ -306,7 +307,7 @@ class ThrusterSet:
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
-        impulse = sum(n * t for n, t in zip(self.force_norms, self.fire_time))
+        impulse = sum(map(operator.mul, self.force_norms, self.fire_time))  # in order, as a generator would
         return impulse / (self.isp * self.g0)
 
     def get_state(self):

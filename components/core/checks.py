@@ -21,12 +21,13 @@ def finite_parameters(defaults, params=None):
 
 def finite_vector(v, n, what, note=None):
     """v as a tuple of n finite floats; ValueError naming `what` (and `note`, e.g. its unit)."""
-    suffix = f" ({note})" if note else ""
     try:
-        t = tuple(float(x) for x in v)
+        t = tuple(map(float, v))
     except (TypeError, ValueError):
+        suffix = f" ({note})" if note else ""
         raise ValueError(f"{what} must be {n} numbers{suffix}, got {v!r}") from None
-    if len(t) != n or not all(math.isfinite(x) for x in t):
+    if len(t) != n or not all(map(math.isfinite, t)):
+        suffix = f" ({note})" if note else ""
         raise ValueError(f"{what} {list(t)} must be {n} finite numbers{suffix}")
     return t
 

@@ -33,14 +33,14 @@ def norm(v):
 
 
 def circle_cross(p, q):
-    """Quaternion product p (x) q of Eq. 42."""
-    p4, q4 = p[3], q[3]
-    pv, qv = p[:3], q[:3]
-    c = cross(pv, qv)
-    return (p4 * qv[0] + q4 * pv[0] - c[0],
-            p4 * qv[1] + q4 * pv[1] - c[1],
-            p4 * qv[2] + q4 * pv[2] - c[2],
-            p4 * q4 - dot(pv, qv))
+    """Quaternion product p (x) q of Eq. 42 (p4 q_v + q4 p_v - p_v x q_v; p4 q4 - p_v . q_v),
+    written out: the same operations in the same order as through cross() and dot()."""
+    p1, p2, p3, p4 = p
+    q1, q2, q3, q4 = q
+    return (p4 * q1 + q4 * p1 - (p2 * q3 - p3 * q2),
+            p4 * q2 + q4 * p2 - (p3 * q1 - p1 * q3),
+            p4 * q3 + q4 * p3 - (p1 * q2 - p2 * q1),
+            p4 * q4 - (p1 * q1 + p2 * q2 + p3 * q3))
 
 
 def conjugate(q):
@@ -84,6 +84,10 @@ def normalized(q, what="quaternion"):
     n = norm(q)
     if not math.isfinite(n) or n < 1e-12:
         raise ValueError(f"{what} {list(q)} has zero or non-finite norm; give a non-zero quaternion")
+    if len(q) == 4:  # written out (millions of calls)
+        return (q[0] / n, q[1] / n, q[2] / n, q[3] / n)
+    if len(q) == 3:
+        return (q[0] / n, q[1] / n, q[2] / n)
     return tuple(x / n for x in q)
 
 

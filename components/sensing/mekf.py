@@ -130,10 +130,29 @@ class AttitudeMEKF:
         self.q = None
         self.bias = np.zeros(3)
         self.P = None
+        self._block, self._block_of = None, None  # P's attitude block as lists, and the P it is of
 
     @property
     def initialized(self):
         return self.q is not None
+
+    @property
+    def bias(self):
+        """The gyro bias estimate (rad/s), an array."""
+        return self._bias
+
+    @bias.setter
+    def bias(self, value):
+        self._bias = value
+        self._bias_floats = (float(value[0]), float(value[1]), float(value[2])) if len(value) == 3 else None
+
+    def _attitude_block(self):
+        """P's attitude block as nested lists, kept while P is the same array (the NEES and the
+        sigmas read it at every step; P changes at covariance propagations and updates)."""
+        P = self.P
+        if self._block_of is not P:
+            self._block, self._block_of = P[:3, :3].tolist(), P
+        return self._block
 
     def initialize(self, q, sigma_attitude, bias=(0.0, 0.0, 0.0), sigma_bias=1e-3):
         """Start from q (e.g. a TRIAD fix) with 1-sigma errors sigma_attitude (rad) per axis and
@@ -152,14 +171,15 @@ class AttitudeMEKF:
 
     def rate(self, omega_meas):
         """The rate estimate omega_meas - b (rad/s)."""
-        return tuple(float(w) - float(b) for w, b in zip(omega_meas, self.bias))
+        b = self._bias_floats
+        return (float(omega_meas[0]) - b[0], float(omega_meas[1]) - b[1], float(omega_meas[2]) - b[2])
 
     def propagate(self, omega_meas, h, covariance=True):
         """Attitude over h with the bias-corrected rate held; the covariance too unless the
         caller gathers several steps into one propagate_covariance (first order either way)."""
         self._need()
         w = self.rate(omega_meas)
-        if not all(math.isfinite(x) for x in w):
+        if not (math.isfinite(w[0]) and math.isfinite(w[1]) and math.isfinite(w[2])):
             raise ValueError(f"omega_meas_B {list(omega_meas)} must be finite")
         self.q = triad.propagate(self.q, w, h)
         if covariance:
@@ -196,11 +216,13 @@ class AttitudeMEKF:
         self.P[:, 3:] = 0.0
         self.P[3:, 3:] = np.eye(3) * sb * sb
         self.P[:3, :3] += np.eye(3) * _sigma("attitude_variance", attitude_variance, "rad^2")
+        self._block_of = None  # changed in place
 
     def attitude_sigma(self):
         """1-sigma attitude errors (rad) about the body axes: sqrt of the diagonal of P."""
         self._need()
-        return tuple(float(math.sqrt(max(0.0, self.P[i, i]))) for i in range(3))
+        A = self._attitude_block()
+        return (math.sqrt(max(0.0, A[0][0])), math.sqrt(max(0.0, A[1][1])), math.sqrt(max(0.0, A[2][2])))
 
     def attitude_nees(self, q_true):
         """Normalized estimation error squared of the attitude against the true q:
@@ -209,11 +231,11 @@ class AttitudeMEKF:
         degrees of freedom when the covariance is consistent: mean 3, above NEES_BOUND_95 one
         time in twenty."""
         self._need()
-        e = rotations.circle_cross(rotations.normalized(tuple(float(x) for x in q_true), "q_true"),
-                                   rotations.conjugate(self.q))
+        e = rotations.circle_cross(rotations.normalized((float(q_true[0]), float(q_true[1]), float(q_true[2]),
+                                                         float(q_true[3])), "q_true"), rotations.conjugate(self.q))
         k = 2.0 if e[3] >= 0.0 else -2.0
         d = (e[0] * k, e[1] * k, e[2] * k)
-        nees = _inverse_quadratic_form(self.P[:3, :3].tolist(), d)
+        nees = _inverse_quadratic_form(self._attitude_block(), d)
         if nees is None:  # the attitude block is not positive definite: a filter gone wrong, LU then
             nees = float(np.array(d) @ np.linalg.solve(self.P[:3, :3], np.array(d)))
         return nees
@@ -262,7 +284,9 @@ def _cross(a, b):
 
 
 def _times(M, v):
-    return tuple(M[i][0] * v[0] + M[i][1] * v[1] + M[i][2] * v[2] for i in range(3))
+    m0, m1, m2 = M
+    return (m0[0] * v[0] + m0[1] * v[1] + m0[2] * v[2], m1[0] * v[0] + m1[1] * v[1] + m1[2] * v[2],
+            m2[0] * v[0] + m2[1] * v[1] + m2[2] * v[2])
 
 
 class RateFilter:
@@ -466,7 +490,7 @@ class AttitudeEstimator:
     def rate(self):
         """The rate estimate (rad/s, body axes); None before the first gyro sample."""
         w = self.rates.omega
-        return None if w is None else tuple(float(x) for x in w)
+        return None if w is None else (float(w[0]), float(w[1]), float(w[2]))
 
     @property
     def acceleration(self):
@@ -521,7 +545,7 @@ class AttitudeEstimator:
                 if self.innovations.add(*f.update(b, r, sigma), armed):
                     f.reopen_bias(self.sigma_bias0, self.innovations.error_variance())
                     self.innovations.restart()
-        self.held_rate = tuple(float(x) for x in omega_meas)
+        self.held_rate = (float(omega_meas[0]), float(omega_meas[1]), float(omega_meas[2]))
         self.rates.update(f.rate(self.held_rate), h)
 
     def _propagate_covariance(self):

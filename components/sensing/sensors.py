@@ -216,7 +216,7 @@ class Gyro(_Seeded):
         super().__init__(seed)
 
     def _draw(self):
-        return tuple(float(x) for x in self.rng.standard_normal(3))
+        return tuple(self.rng.standard_normal(3).tolist())
 
     def step(self, h=None):
         """The next sample, h seconds of operation after the last."""
@@ -255,7 +255,7 @@ class GpsReceiver(_Seeded):
         super().__init__(seed)
 
     def _draw(self):
-        return tuple(float(x) for x in self.rng.standard_normal(3))
+        return tuple(self.rng.standard_normal(3).tolist())
 
     def step(self, h, new_time=None):
         self.time = float(new_time) if new_time is not None else self.time + h
