@@ -168,7 +168,7 @@ class NeighborSlave(Fmi2Slave):
         if names is False:
             inputs = self._input_names.get(cls, {})
             names = plans[key] = [inputs[vr] for vr in key] if all(vr in inputs for vr in key) else None
-        if names is not None and len(values) == len(names):
+        if names and len(values) == len(names):
             self.values.update(zip(names, map(_KINDS[cls], values)))
             self._input_version += 1
             return

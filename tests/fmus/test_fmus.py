@@ -185,6 +185,36 @@ def test_feedthrough_cache_follows_parameters_and_restored_state():
     assert d.get_real([out])[0] < 0
 
 
+def test_get_and_set_plans_give_what_each_value_reference_asks():
+    """The wrappers' get and set plans (neighbor_fmu_support): array elements in any order and
+    repeated, a parameter among them, a list asked for again (the plan is kept), a Boolean asked
+    for as Real (pythonfmu's error), inputs with a parameter in one set (the checking path), and an
+    empty set that changes nothing."""
+    import sys
+
+    from build_fmus import FMU_SOURCES
+
+    sys.path.insert(0, str(FMU_SOURCES))
+    from neighbor_rigid_body import RigidBody
+
+    body = RigidBody(instance_name="b")
+    vr = {v.name: v.value_reference for v in body.vars.values()}
+    body.set_real([vr["q0[1]"], vr["q0[4]"]], [0.6, 0.8])
+    body.set_real([vr["omega0[3]"]], [0.25])
+    ask = [vr["q_BN[4]"], vr["omega_BN_B[3]"], vr["q_BN[1]"], vr["q_BN[4]"], vr["max_substep"], vr["q_BN[2]"]]
+    for _ in range(2):
+        assert body.get_real(ask) == [0.8, 0.25, 0.6, 0.8, 0.005, 0.0]
+        assert body.get_real(tuple(ask)) == [0.8, 0.25, 0.6, 0.8, 0.005, 0.0]
+    assert all(type(x) is float for x in body.get_real(ask))
+    body.set_real([vr["torque_B[2]"], vr["max_substep"], vr["torque_B[1]"]], [0.5, 0.001, -0.5])
+    assert body.values["max_substep"] == 0.001 and body.get_real([vr["torque_B[1]"], vr["torque_B[2]"]]) == [-0.5, 0.5]
+    with pytest.raises(TypeError, match="is not of type Real"):  # a Boolean asked for as Real: pythonfmu says so
+        body.get_real([vr["euler0_from_q0"]])
+    version = body._input_version
+    body.set_real([], [])
+    assert body._input_version == version
+
+
 def _retyped_element_names(script):
     """Lines where a wrapper spells FMI element names itself (f"x[{i}]" or "x[1]") instead of
     taking them from the declaration that made them (input_array etc. return their names)."""
