@@ -285,8 +285,10 @@ class NeighborSlave(Fmi2Slave):
             return lambda: getter()[i]
 
         for i, element_name in enumerate(names):
-            self._array_elements[len(self.vars)] = (getter, i)  # the value reference it gets next
             self.output(element_name, element(i), unit, f"{description} (component {i + 1})", kind, depends_on)
+            var = self.vars[len(self.vars) - 1]  # the one just registered (pythonfmu numbers them in order)
+            assert var.name == element_name, (var.name, element_name)
+            self._array_elements[var.value_reference] = (getter, i)
         return names
 
     def thruster_controller_interface(self, command: Callable[[], Any], done: Callable[[], bool],
