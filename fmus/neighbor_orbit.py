@@ -14,7 +14,7 @@ falls below reentry_altitude; the model then holds its state (the system's stop 
 import math
 
 from neighbor_fmu_support import NeighborSlave
-from neighbor_orbit_support import atmosphere_model, orbit_interface
+from neighbor_orbit_support import atmosphere_model, impulse_input, orbit_interface
 
 from components.core import jit
 from components.orbit import cowell, elements
@@ -51,6 +51,7 @@ class Orbit(NeighborSlave):
         self.output("reentered", out("reentered"), None,
                     "Latched true once the geodetic altitude is below reentry_altitude; the model then holds "
                     "its state", bool)
+        impulse_input(self)
 
     def build_model(self):
         v = self.values
@@ -66,6 +67,6 @@ class Orbit(NeighborSlave):
     def do_step(self, current_time, step_size):
         m = self.model
         m.set_inputs(self.vector("F_thrust_B", 3), self.vector("q_BN", 4), self.values["retrograde"],
-                     self.values["mass"])
+                     self.values["mass"], self.vector("impulse_B", 3), step_size)
         m.advance_to(current_time + step_size)
         return True

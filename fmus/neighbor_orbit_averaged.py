@@ -18,7 +18,7 @@ over a step. The initial Keplerian elements are taken as mean elements.
 import math
 
 from neighbor_fmu_support import NeighborSlave
-from neighbor_orbit_support import atmosphere_model, orbit_interface
+from neighbor_orbit_support import atmosphere_model, impulse_input, orbit_interface
 
 from components.core import jit
 from components.orbit import averaged, elements
@@ -65,6 +65,7 @@ class OrbitAveraged(NeighborSlave):
         self.output("reentered", lambda: m().reentered, None,
                     "Latched true once the mean perigee altitude is below reentry_altitude; the model then "
                     "holds its state", bool)
+        impulse_input(self)
 
     def build_model(self):
         v = self.values
@@ -82,5 +83,5 @@ class OrbitAveraged(NeighborSlave):
     def do_step(self, current_time, step_size):
         v = self.values
         self.model.advance_to(current_time + step_size, self.vector("F_thrust_B", 3), self.vector("q_BN", 4),
-                              v["retrograde"], v["mass"])
+                              v["retrograde"], v["mass"], self.vector("impulse_B", 3))
         return True

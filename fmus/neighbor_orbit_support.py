@@ -49,6 +49,15 @@ def orbit_interface(slave, default_sma, mu, epoch, mean):
     slave.input("mass", SPACECRAFT.mass, "kg", "Spacecraft total mass (> 0), from the propulsion FMU")
 
 
+def impulse_input(slave):
+    """The attitude thrusters' running total of impulse (declared after every other variable of the
+    orbit FMUs, so that the earlier value references stay as they were)."""
+    slave.input_array("impulse_B", [0.0, 0.0, 0.0], "N.s",
+                      "Running total of the attitude thrusters' impulse in B beyond F_thrust_B (the RCS net force, "
+                      "the axial thrusters' errors); its mean over the previous step is added to F_thrust_B over "
+                      "this one (not with retrograde)")
+
+
 # ---- atmosphere parameters shared by the Atmosphere, Orbit and OrbitAveraged FMUs ------------
 def atmosphere_parameters(slave):
     """Declare the shared atmosphere parameters on a NeighborSlave (same names, units and

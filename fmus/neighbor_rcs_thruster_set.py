@@ -19,14 +19,22 @@ The stuck-thruster fault and its management (appended after off-pulsing): `stuck
 response the thrusters it opened should give (nominal layout, the inertia of a box of `mass` and
 edges a, b, c), closes the declared thrusters' latch valves and allocates the flags over the
 others; `disabled_mask` (bit i-1 for RCS thruster i) and `fault_time` say what and when.
+
+Mass properties and the orbit (appended last): with `propellant_mass_properties` the torques are about
+the centre of mass as propellant leaves the tank at the module's centre (the burn's
+`propellant_used` from the propulsion and the set's own `propellant_mass`; `mass` the mass at
+takeover). `impulse_B` is the running total of the force that the propulsion's nominal thrust does
+not carry (the RCS net force, the axial thrusters' force error and misalignment in the burn): the
+orbit takes its mean over each of its steps.
 """
 from neighbor_fmu_support import NeighborSlave
 
-from components.attitude import rigid_body, thruster_monitor, thruster_set
+from components.attitude import mass_properties, rigid_body, thruster_monitor, thruster_set
 from components.mission.neighbor import SPACECRAFT
 
-# declared after the outputs that depend on it (appended in a later release)
+# declared after the outputs that depend on them (appended in later releases)
 AXIAL_FIRING = "axial_firing"
+PROPELLANT_USED = "propellant_used"
 N = 16
 
 
@@ -46,8 +54,8 @@ class RcsThrusterSet(NeighborSlave):
         self.parameter("g0", SPACECRAFT.g0, "m/s2", "Standard gravity used with Isp (thesis value 9.81)")
         command = self.input_array("torque_cmd_B", [0.0] * 3, "N.m", "Commanded body torque from the active controller")
         self.output_array("torque_B", 3, lambda: self.feedthrough(self._force_torque)[1], "N.m",
-                          "Torque of the firing thrusters, sum of l x F (Eq. 13)",
-                          depends_on=command + (AXIAL_FIRING,))
+                          "Torque of the firing thrusters, sum of l x F (Eq. 13), about the centre of mass",
+                          depends_on=command + (AXIAL_FIRING, PROPELLANT_USED))
         self.output_array("thrust_flag", 3, lambda: self.feedthrough(self._flags), None,
                           "Firing pair per axis: 1 positive torque, -1 negative, 0 off", int, depends_on=command)
         self.output_array("torque_level", 3, lambda: self.model.levels, "N.m",
@@ -105,6 +113,15 @@ class RcsThrusterSet(NeighborSlave):
                     "RCS thrusters whose latch valve the fault detection closed: bit i-1 for thruster i (0: none)", int)
         self.output("fault_time", lambda: self.model.fault_time, "s",
                     "Time the fault detection declared a stuck thruster (-1: never)")
+        # mass properties and the force on the orbit (appended in a later release)
+        self.parameter("propellant_mass_properties", False, None,
+                       "Torques about the centre of mass as the propellant leaves the tank at the module's centre "
+                       "(-c/2 + a/2, 0, 0); false: about the host's centre (thesis)", bool)
+        self.input(PROPELLANT_USED, 0.0, "kg", "Propellant the de-orbit burn drew from the tank (>= 0), from the "
+                   "propulsion; moves the centre of mass with propellant_mass_properties")
+        self.output_array("impulse_B", 3, lambda: self.model.impulse, "N.s",
+                          "Running total of the force beyond the propulsion's nominal thrust, in B: the RCS net force "
+                          "and the axial thrusters' force error and misalignment in the burn (for the orbit)")
 
     def build_model(self):
         v = self.values
@@ -117,16 +134,20 @@ class RcsThrusterSet(NeighborSlave):
             model.monitor = thruster_monitor.ThrusterMonitor(
                 dict(enumerate(model.nominal_torques)), model.rcs, inertia, v["gyro_sigma"], v["gyro_sample_time"],
                 v["detection_window"])
+        if v["propellant_mass_properties"]:
+            model.follow_propellant(v["mass"], mass_properties.tank_position(v["edge_a"], v["edge_c"]))
         return model
 
     def _flags(self):
         return self.model.flags(self.vector("torque_cmd_B", 3))
 
     def _force_torque(self):
+        self.model.set_main_propellant(self.values[PROPELLANT_USED])
         return self.model.force_and_torque(self.feedthrough(self._flags), self.values["axial_firing"])
 
     def do_step(self, current_time, step_size):
         flags, burn = self.feedthrough(self._flags), self.values["axial_firing"]
+        self.model.set_main_propellant(self.values[PROPELLANT_USED])
         if self.model.monitor is not None:
             self.model.watch(current_time, self.vector("omega_meas_B", 3), flags, step_size, burn)
         self.model.step(flags, step_size, burn)

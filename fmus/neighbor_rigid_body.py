@@ -11,11 +11,18 @@ Euler's equation into the gyrostat equation J omega_dot = L - wheel_torque_B - o
 (J omega + h_w). They are declared after every other variable so that the value references of
 the original variables are unchanged; left at zero the model is bit-identical to the wheel-less
 one. H_B stays the body's own J omega (the total is H_B + wheel_momentum_B).
+
+Mass properties that follow the tank (appended last, off by default): with
+`propellant_mass_properties` the inertia is the one about the centre of mass once
+propellant_used + rcs_propellant kg left the tank at the NEIGHBOR module's centre
+(components.attitude.mass_properties), recomputed between steps when they change;
+`center_of_mass_B` says where it moved. Off, or with both inputs at zero, the model is the
+fixed-inertia one bit for bit.
 """
 
 from neighbor_fmu_support import NeighborSlave
 
-from components.attitude import rigid_body
+from components.attitude import mass_properties, rigid_body
 
 
 class RigidBody(NeighborSlave):
@@ -24,7 +31,8 @@ class RigidBody(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self.inertia_parameters("Spacecraft mass for the box inertia (Eq. 4)")
+        self.inertia_parameters("Spacecraft mass at takeover: the box inertia's (Eq. 4) and the one the propellant "
+                                "is drawn from")
         self.parameter_array("q0", [0.0, 0.0, 0.0, 1.0], "1",
                              "Initial attitude quaternion q_BN, scalar last (rk4 normalizes it, euler keeps it "
                              "as given like the thesis scripts; zero norm is an error)")
@@ -64,14 +72,28 @@ class RigidBody(NeighborSlave):
         self.parameter_array("euler0", [0.0, 0.0, 0.0], "rad",
                              "Start of euler_integrated when euler0_from_q0 is false (to continue a previous "
                              "maneuver's angles, as the thesis' slews continue its detumbles)")
+        # Mass properties that follow the propellant drawn (appended last, issue 28)
+        self.parameter("propellant_mass_properties", False, None,
+                       "The inertia follows the propellant drawn from the tank at the module's centre (-c/2 + a/2, "
+                       "0, 0), about the moving centre of mass; false: the fixed inertia (thesis)", bool)
+        self.input("propellant_used", 0.0, "kg", "Propellant the de-orbit burn drew from the tank (>= 0), from "
+                   "the propulsion; with propellant_mass_properties")
+        self.input("rcs_propellant", 0.0, "kg", "Propellant the RCS thrusters drew from the same tank (>= 0); "
+                   "with propellant_mass_properties")
+        self.output_array("center_of_mass_B", 3, lambda: m().center_of_mass, "m",
+                          "Centre of mass in B relative to the one at takeover (moves to +x as the tank empties)")
 
     def build_model(self):
         J = self.inertia(rigid_body.box_inertia)
         euler0 = None if self.values["euler0_from_q0"] else self.vector("euler0", 3)
+        self._tank = mass_properties.tank_position(self.values["edge_a"], self.values["edge_c"])
         return rigid_body.RigidBody(J, self.vector("q0", 4), self.vector("omega0", 3),
                                     self.values["integrator"], self.values["max_substep"], euler0)
 
     def do_step(self, current_time, step_size):
+        v = self.values
+        if v["propellant_mass_properties"]:
+            self.model.follow_propellant(v["propellant_used"] + v["rcs_propellant"], v["mass"], self._tank)
         self.model.step(self.vector("torque_B", 3), step_size, self.vector("wheel_torque_B", 3),
                         self.vector("wheel_momentum_B", 3))
         return True

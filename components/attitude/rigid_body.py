@@ -40,6 +40,7 @@ import numpy as np
 
 from ..core import rotations
 from ..core.jit import njit
+from . import mass_properties
 
 INTEGRATORS = ("euler", "rk4")
 ZERO3 = (0.0, 0.0, 0.0)
@@ -88,6 +89,9 @@ class RigidBody:
         self.Jinv = tuple(tuple(row) for row in np.linalg.inv(J).tolist())
         self._J9 = tuple(x for row in self.J for x in row)  # the RK4 kernel's flat, typed copies
         self._Ji9 = tuple(x for row in self.Jinv for x in row)
+        self.J0 = self.J  # the inertia at takeover, before any propellant is drawn
+        self.drawn = 0.0  # kg of propellant the inertia has followed (follow_propellant)
+        self.center_of_mass = (0.0, 0.0, 0.0)  # m in B, from the takeover centre of mass
         q0 = tuple(float(x) for x in q0)
         unit_q0 = rotations.normalized(q0, "q0")  # also rejects a zero or non-finite q0
         # The thesis scripts carry q from one maneuver to the next without normalizing it
@@ -102,6 +106,23 @@ class RigidBody:
         if len(euler0) != 3 or not all(math.isfinite(x) for x in euler0):
             raise ValueError(f"euler0 {list(euler0)} must be three finite angles in rad")
         self.euler_integrated = euler0
+
+    def set_inertia(self, J, Jinv):
+        """Hold the inertia J (and its inverse) from now on: the mass properties as the tank empties
+        (components.attitude.mass_properties), applied between steps."""
+        self.J, self.Jinv = J, Jinv
+        self._J9 = tuple(x for row in J for x in row)
+        self._Ji9 = tuple(x for row in Jinv for x in row)
+
+    def follow_propellant(self, drawn, mass0, tank):
+        """The inertia about the centre of mass once `drawn` kg left the tank at `tank` (m, B) of a
+        body of `mass0` kg (components.attitude.mass_properties); recomputed once it changed by
+        mass_properties.RESOLUTION."""
+        if abs(drawn - self.drawn) < mass_properties.RESOLUTION:
+            return
+        J, c = mass_properties.drawn(self.J0, mass0, drawn, tank)
+        self.set_inertia(J, mass_properties.inverse(J))
+        self.drawn, self.center_of_mass = drawn, c
 
     # ---- dynamics --------------------------------------------------------------------
     def angular_acceleration(self, omega, torque, wheel_torque=ZERO3, h_w=ZERO3):
@@ -172,13 +193,17 @@ class RigidBody:
     # ---- full state for FMU get/set state ------------------------------------------------
     def get_state(self):
         return {"q": list(self.q), "omega": list(self.omega), "omega_dot": list(self.omega_dot),
-                "euler_integrated": list(self.euler_integrated)}
+                "euler_integrated": list(self.euler_integrated), "J": [list(r) for r in self.J],
+                "Jinv": [list(r) for r in self.Jinv], "drawn": self.drawn, "center_of_mass": list(self.center_of_mass)}
 
     def set_state(self, state):
         self.q = tuple(state["q"])
         self.omega = tuple(state["omega"])
         self.omega_dot = tuple(state["omega_dot"])
         self.euler_integrated = tuple(state["euler_integrated"])
+        if "J" in state:  # states saved before the inertia could change carry none
+            self.set_inertia(tuple(map(tuple, state["J"])), tuple(map(tuple, state["Jinv"])))
+            self.drawn, self.center_of_mass = float(state["drawn"]), tuple(state["center_of_mass"])
 
 
 # ---- the RK4 kernel (numba where installed; the same arithmetic, operation for operation, as

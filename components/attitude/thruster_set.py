@@ -46,6 +46,15 @@ a stuck-on one, and from then on the flags are allocated over the thrusters left
 net force, then the fewest thrusters. No other thruster makes an x torque of the same sign as a
 dead x thruster's partner, so that partner fires alone (half the torque) and a y or z pair
 cancels its side torque. With every thruster enabled the pairs fire exactly as before.
+
+Mass properties (`follow_propellant`, off by default): the torques are about the centre of mass,
+which moves to +x as propellant leaves the tank at the module's centre
+(components.attitude.mass_properties): L = sum_i (l_i - r_cm) x F_i = sum_i l_i x F_i - r_cm x
+sum_i F_i, so a pair (a couple) gives the same torque and only the net force of the thrusters firing,
+the axial ones' in the burn included, adds r_cm x F. What reaches the orbit besides the
+propulsion's nominal thrust n F x is kept as a running total, `impulse` (N.s, B): the net force of
+the RCS thrusters firing and, in the burn, the axial thrusters' deviation from their nominal force
+(force error and misalignment); the orbit applies its mean over each of its steps.
 """
 import itertools
 import math
@@ -55,6 +64,7 @@ import numpy as np
 
 from ..core import checks, rotations
 from ..mission.neighbor import SPACECRAFT
+from . import mass_properties
 from . import thruster_control as tc
 
 AXES = ("x", "y", "z")
@@ -166,6 +176,14 @@ class ThrusterSet:
             self.nominal_forces.append(nominal)
             self.nominal_torques.append(rotations.cross(position, nominal))
         self.force_norms = [rotations.norm(f) for f in self.forces]  # read at every step's propellant output
+        # what an axial thruster's real force adds to the propulsion's nominal one (zero when ideal)
+        self.deviations = [tuple(f - g for f, g in zip(fr, nom)) for fr, nom in zip(self.forces, self.nominal_forces)]
+        self.impulse = (0.0, 0.0, 0.0)  # N.s in B: running total of the force beyond the propulsion's thrust
+        self.tank = None  # the tank's centre (m, B) when the centre of mass follows the propellant
+        self.mass0 = 0.0
+        self.main_drawn = 0.0  # kg the de-orbit burn drew from the tank
+        self.center_of_mass = (0.0, 0.0, 0.0)
+        self._com_drawn = 0.0  # the propellant drawn at the centre of mass' last move
         self.pairs = {}  # (axis, sign) -> thruster indices
         for i, (_, _, _, role) in enumerate(self.layout):
             if role != "axial":
@@ -193,6 +211,31 @@ class ThrusterSet:
         self._allocation = None  # flags -> thrusters, once a thruster is disabled
         self.monitor = None  # the fault detection (components.attitude.thruster_monitor), if flown
         self.fault_time = -1.0  # when it declared a stuck thruster (-1: never)
+
+    def follow_propellant(self, mass0, tank):
+        """From now on the torques are about the centre of mass of a body of `mass0` kg from whose
+        tank (m, B) the propellant is drawn (module docstring)."""
+        self.mass0 = checks.positive("mass", mass0, "kg")
+        self.tank = tuple(float(x) for x in tank)
+        self._move_center_of_mass()
+
+    def set_main_propellant(self, used):
+        """The propellant the de-orbit burn has drawn from the same tank (kg)."""
+        if used != self.main_drawn:
+            self.main_drawn = float(used)
+            self._move_center_of_mass()
+
+    def _move_center_of_mass(self):
+        if self.tank is None:
+            return
+        drawn = self.main_drawn + self.propellant_mass()
+        if not (math.isfinite(drawn) and 0.0 <= drawn < self.mass0):
+            raise ValueError(f"propellant drawn = {drawn!r} kg must be in [0, {self.mass0!r}) (the mass at takeover)")
+        if abs(drawn - self._com_drawn) < mass_properties.RESOLUTION:
+            return
+        m = self.mass0 - drawn
+        self.center_of_mass = tuple(-drawn * x / m for x in self.tank)
+        self._com_drawn = drawn
 
     @property
     def stuck(self):
@@ -287,9 +330,15 @@ class ThrusterSet:
             f, t = self.forces[i], self.torques[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
+        ax = ay = az = 0.0
         for i in self.axial_on(flags, axial):
-            t = self.torques[i]
+            t, f = self.torques[i], self.forces[i]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
+            ax, ay, az = ax + f[0], ay + f[1], az + f[2]
+        if self.tank is not None:  # about the centre of mass: less r_cm x (the net force of all firing)
+            c = self.center_of_mass
+            nx, ny, nz = fx + ax, fy + ay, fz + az
+            tx, ty, tz = tx - (c[1] * nz - c[2] * ny), ty - (c[2] * nx - c[0] * nz), tz - (c[0] * ny - c[1] * nx)
         return (fx, fy, fz), (tx, ty, tz)
 
     def step(self, flags, h, axial=False):
@@ -300,10 +349,21 @@ class ThrusterSet:
             started = self.on_left[i] <= 0.0
             left = (self.min_on_time if started else self.on_left[i]) - h
             self.on_left[i] = max(0.0, left)
-        for i in self.firing(flags, axial, commanded):
+        fx = fy = fz = 0.0
+        firing = self.firing(flags, axial, commanded)
+        for i in firing:
             self.fire_time[i] += h
+            f = self.forces[i]
+            fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
+        for i in self.axial_on(flags, axial):
+            f = self.deviations[i]
+            fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
+        p = self.impulse
+        self.impulse = (p[0] + fx * h, p[1] + fy * h, p[2] + fz * h)
         self.axial_off_time += h * len(self.axial_off(flags, axial))
         self.operating_time += h
+        if firing:
+            self._move_center_of_mass()
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
@@ -313,7 +373,9 @@ class ThrusterSet:
     def get_state(self):
         return {"fire_time": list(self.fire_time), "on_left": list(self.on_left), "axial_off_time": self.axial_off_time,
                 "operating_time": self.operating_time, "disabled": sorted(self.disabled), "fault_time": self.fault_time,
-                "monitor": None if self.monitor is None else self.monitor.get_state()}
+                "monitor": None if self.monitor is None else self.monitor.get_state(), "impulse": list(self.impulse),
+                "main_drawn": self.main_drawn, "com_drawn": self._com_drawn,
+                "center_of_mass": list(self.center_of_mass)}
 
     def set_state(self, state):
         self.fire_time = list(state["fire_time"])
@@ -326,3 +388,7 @@ class ThrusterSet:
         self.fault_time = float(state["fault_time"])
         if self.monitor is not None and state["monitor"] is not None:
             self.monitor.set_state(state["monitor"])
+        self.impulse = tuple(state.get("impulse", (0.0, 0.0, 0.0)))  # states saved before it carry none
+        self.main_drawn = float(state.get("main_drawn", 0.0))
+        self._com_drawn = float(state.get("com_drawn", 0.0))
+        self.center_of_mass = tuple(state.get("center_of_mass", (0.0, 0.0, 0.0)))

@@ -47,7 +47,9 @@ orbit_elements has no M rate). argp's drift rotates (ex, ey); lam gets dargp/dt 
 
 Thrust: the Gauss equations with the instantaneous thrust acceleration at the current position
 (not averaged: burns are short), F_N / m, either F_N = A(q)^T F_B or, with `retrograde`, |F_B|
-along -v. Inputs (thrust, attitude, mass) are held over a call of advance_to.
+along -v. Inputs (thrust, attitude, mass) are held over a call of advance_to; the attitude
+thrusters' running total of impulse (`impulse_B`) adds their mean force over the previous call
+(propulsion.ImpulseWindow), except with retrograde.
 
 Integration: classical RK4 on the six elements. Step size: at most `max_step` (default one
 day), steps end on UTC midnights (the space-weather indices change there), at most
@@ -67,6 +69,7 @@ from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
 from ..environment import geodesy
 from ..mission.neighbor import SPACECRAFT
 from . import elements
+from .propulsion import ImpulseWindow
 from ..core import time_utils
 
 J2 = elements.J2_EGM96
@@ -338,6 +341,7 @@ class OrbitAveraged:
         self.reentered = False
         self.reentry_time = None
         self.evaluations = 0  # drag-average evaluations (for the bench)
+        self.impulse = ImpulseWindow()  # the attitude thrusters' force (advance_to's impulse_B)
         self._out_cache = None
 
     # ---- elements --------------------------------------------------------------------------
@@ -435,10 +439,16 @@ class OrbitAveraged:
         return quaternion_to_dcm(q_BN).T @ F / mass, 0.0
 
     def advance_to(self, t_end, F_thrust_B=(0.0, 0.0, 0.0), q_BN=(0.0, 0.0, 0.0, 1.0), retrograde=False,
-                   mass=SPACECRAFT.mass):
+                   mass=SPACECRAFT.mass, impulse_B=None):
         """Integrate to t_end (s since the epoch) with the inputs held; stops integrating at
-        re-entry (the clock still moves to t_end)."""
+        re-entry (the clock still moves to t_end). impulse_B: the attitude thrusters' running total
+        of impulse (N.s, B), whose mean force over the previous step is added to F_thrust_B
+        (propulsion.ImpulseWindow; not with retrograde)."""
         t_end = time_utils.check_time(t_end, "time")
+        if impulse_B is not None:
+            extra = self.impulse.force(impulse_B, t_end - self.t)
+            if extra != (0.0, 0.0, 0.0) and not retrograde:
+                F_thrust_B = tuple(float(f) + e for f, e in zip(F_thrust_B, extra))
         mass = float(mass)
         if not (math.isfinite(mass) and mass > 0.0):
             raise ValueError(f"mass = {mass!r} kg must be finite and > 0")
@@ -518,7 +528,8 @@ class OrbitAveraged:
 
     def get_state(self):
         return {"t": self.t, "y": [float(x) for x in self.y], "reentered": self.reentered,
-                "reentry_time": self.reentry_time, "evaluations": self.evaluations}
+                "reentry_time": self.reentry_time, "evaluations": self.evaluations,
+                "impulse": self.impulse.get_state()}
 
     def set_state(self, state):
         self.t = float(state["t"])
@@ -526,4 +537,6 @@ class OrbitAveraged:
         self.reentered = bool(state["reentered"])
         self.reentry_time = state["reentry_time"]
         self.evaluations = int(state["evaluations"])
+        if "impulse" in state:  # states saved before the thrusters' force reached the orbit carry none
+            self.impulse.set_state(state["impulse"])
         self._out_cache = None

@@ -13,8 +13,11 @@ Equations of motion (N frame, m and s):
                                              every stage, so the burn follows the velocity)
 
 F_B, q_BN, `retrograde` and the mass are inputs held constant across a communication step
-(zero-order hold). The density rho comes from a model of components/environment/atmosphere/
-(`make_density_model`) and is evaluated at every integrator stage (no caching across stages).
+(zero-order hold). F_B is the propulsion's thrust plus, when given (`impulse_B`), the attitude
+thrusters' mean force over the previous step (propulsion.ImpulseWindow: the RCS net force, the axial
+thrusters' force error and misalignment); `retrograde` takes the propulsion's magnitude only.
+The density rho comes from a model of components/environment/atmosphere/ (`make_density_model`)
+and is evaluated at every integrator stage (no caching across stages).
 
 Integrator: Dormand-Prince 8(5,3) (DOP853, Hairer's coefficients in components/orbit/dop853.py,
 his error estimator and step control), written as one function that integrates a whole
@@ -46,6 +49,7 @@ from ..environment.gravity import accel_zonal, zonal_coefficients
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
 from ..mission.neighbor import SPACECRAFT
 from . import dop853
+from .propulsion import ImpulseWindow
 from .elements import kepler_to_cartesian, osculating_ecc, osculating_sma
 
 RTOL = 1e-11
@@ -277,14 +281,20 @@ class CowellOrbit:
         self.reentry_time = float("nan")
         self.steps = 0  # internal integrator steps so far (diagnostics)
         self.F_B = (0.0, 0.0, 0.0)
+        self.F_extra_B = (0.0, 0.0, 0.0)  # the attitude thrusters' mean force over the previous step
+        self.impulse = ImpulseWindow()
         self.q_BN = (0.0, 0.0, 0.0, 1.0)
         self.retrograde = False
         self.mass = positive("mass", mass, "kg")
         self._outputs = None
 
     # ---- inputs --------------------------------------------------------------------------
-    def set_inputs(self, F_thrust_B=None, q_BN=None, retrograde=None, mass=None):
-        """Inputs held until the next step (zero-order hold)."""
+    def set_inputs(self, F_thrust_B=None, q_BN=None, retrograde=None, mass=None, impulse_B=None, step=0.0):
+        """Inputs held until the next step (zero-order hold). impulse_B: the attitude thrusters' running
+        total of impulse (N.s, B) before a step of `step` seconds, whose mean force over the previous
+        step is added to F_thrust_B (propulsion.ImpulseWindow; not with retrograde)."""
+        if impulse_B is not None:
+            self.F_extra_B = self.impulse.force(impulse_B, step)
         if F_thrust_B is not None:
             F = tuple(float(x) for x in F_thrust_B)
             if len(F) != 3 or not all(math.isfinite(x) for x in F):
@@ -305,7 +315,9 @@ class CowellOrbit:
         """A(q)^T F_B / m (m/s^2) for the held inputs (not used when retrograde)."""
         q = rotations.normalized(self.q_BN, "q_BN")
         Am = rotations.attitude_matrix(q)
-        F = self.F_B
+        F, e = self.F_B, self.F_extra_B
+        if e != (0.0, 0.0, 0.0):
+            F = (F[0] + e[0], F[1] + e[1], F[2] + e[2])
         return tuple((Am[0][k] * F[0] + Am[1][k] * F[1] + Am[2][k] * F[2]) / self.mass for k in range(3))
 
     def _force_parameters(self):
@@ -380,7 +392,8 @@ class CowellOrbit:
     def get_state(self):
         return {"t": self.t, "t_state": self.t_state, "y": [float(x) for x in self.y], "h": self.h,
                 "reentered": self.reentered, "reentry_time": self.reentry_time, "steps": self.steps,
-                "F_B": self.F_B, "q_BN": self.q_BN, "retrograde": self.retrograde, "mass": self.mass}
+                "F_B": self.F_B, "q_BN": self.q_BN, "retrograde": self.retrograde, "mass": self.mass,
+                "F_extra_B": self.F_extra_B, "impulse": self.impulse.get_state()}
 
     def set_state(self, state):
         self.t = float(state["t"])
@@ -394,6 +407,9 @@ class CowellOrbit:
         self.q_BN = tuple(state["q_BN"])
         self.retrograde = bool(state["retrograde"])
         self.mass = float(state["mass"])
+        if "impulse" in state:  # states saved before the thrusters' force reached the orbit carry none
+            self.F_extra_B = tuple(state["F_extra_B"])
+            self.impulse.set_state(state["impulse"])
         self._outputs = None
 
 

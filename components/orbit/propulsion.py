@@ -325,3 +325,33 @@ class MainThrusters:
         self.on_fraction = float(state["on_fraction"])
         self.off_seen = float(state["off_seen"])
         self.last_h = float(state["last_h"])
+
+
+class ImpulseWindow:
+    """The mean force over a model's previous step from a running total of impulse (N.s, B): what
+    the attitude thrusters push the orbit with besides the propulsion's nominal thrust
+    (components.attitude.thruster_set, `impulse`). A model stepped more slowly than the thrusters
+    (the orbit every 0.495 s in the maneuvers) applies the thrusters' mean force of its previous
+    step over the current one, as MainThrusters takes the off-pulsing: one of its steps late, no
+    impulse lost. The force is in B as the thrusters accumulate it; the orbit turns it to N with
+    the attitude at its step's start (in the burn the body turns 0.03 deg in a step)."""
+
+    def __init__(self):
+        self.seen = None  # the running total at the previous step (None: no step yet)
+        self.last_h = 0.0
+
+    def force(self, total, h):
+        """The mean force (N, B) to hold over the coming step of h seconds, given the running total now."""
+        total = checks.finite_vector(total, 3, "impulse_B", "running total of impulse in B, N.s")
+        force = (0.0, 0.0, 0.0)
+        if self.seen is not None and self.last_h > 0.0:
+            force = tuple((a - b) / self.last_h for a, b in zip(total, self.seen))
+        self.seen, self.last_h = total, float(h)
+        return force
+
+    def get_state(self):
+        return {"seen": None if self.seen is None else list(self.seen), "last_h": self.last_h}
+
+    def set_state(self, state):
+        self.seen = None if state["seen"] is None else tuple(state["seen"])
+        self.last_h = float(state["last_h"])

@@ -33,7 +33,9 @@ EXTRAS = {"attitude_error", "pointing_error", "sliding_vector[1]", "sliding_vect
           "sigma_attitude_B[1]", "sigma_attitude_B[2]", "sigma_attitude_B[3]",
           "boundary_layer[1]", "boundary_layer[2]", "boundary_layer[3]",
           # the thruster set's stuck-thruster detection: the gyro's rates it reads, what it closed
-          "omega_meas_B[1]", "omega_meas_B[2]", "omega_meas_B[3]", "disabled_mask", "fault_time"}
+          "omega_meas_B[1]", "omega_meas_B[2]", "omega_meas_B[3]", "disabled_mask", "fault_time",
+          # the thruster set's centre of mass following the tank, its force beyond the propulsion's for the orbit
+          "propellant_used", "impulse_B[1]", "impulse_B[2]", "impulse_B[3]"}
 
 
 def _cli(*args):

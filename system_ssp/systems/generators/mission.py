@@ -10,7 +10,10 @@ re-entry. Components (instance: FMU):
   detumble / slew / tracking: the three RCS attitude controllers (only the enabled one commands)
   guidance: BurnGuidance (burn attitude and rate from the orbit) -> slew and tracking targets
   selector: TorqueSelector -> thrusters: RcsThrusterSet (the 16 thrusters one by one) -> dynamics;
-  the RCS propellant comes out of the propulsion's tank (propulsion.rcs_propellant lowers the mass)
+  the RCS propellant comes out of the propulsion's tank (propulsion.rcs_propellant lowers the mass);
+  the rigid body's inertia and the thrusters' centre of mass follow the propellant drawn, and the
+  thrusters' force beyond the propulsion's nominal thrust (RCS net force, axial misalignment and
+  force error) reaches the orbit as a running total of impulse (closed loop; off in the thesis set)
   power: Power (LG HG2 cell, Table 5 loads)   data: DataStorage (256 kB flash, 9600 baud)
   attitude knowledge (section 3.3.1): sun: SunEphemeris, shadow: EarthShadow, gps: GpsReceiver,
   horizon: HorizonSensor, sun_sensor: SunSensor (the fine one, +x, 60 deg), coarse_sun: SunSensor
@@ -203,6 +206,7 @@ TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
               "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
               "thrusters.off_pulsing": False, "thrusters.fault_detection": False, "estimator.fault_window": 0,
+              "dynamics.propellant_mass_properties": False, "thrusters.propellant_mass_properties": False,
               "mission.attitude_determination_timeout": 0.0, "mission.safe_without_attitude": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
@@ -353,6 +357,11 @@ def system(orbit_fmu):
              ("propulsion", "burning", "thrusters", "axial_firing", 0),
              ("thrusters", "axial_off_time", "propulsion", "axial_off_time", 0),
              ("thrusters", "torque_B", "dynamics", "torque_B", 3),
+             # mass properties that follow the tank, the thrusters' force on the orbit (issue 28)
+             ("propulsion", "propellant_used", "dynamics", "propellant_used", 0),
+             ("thrusters", "propellant_mass", "dynamics", "rcs_propellant", 0),
+             ("propulsion", "propellant_used", "thrusters", "propellant_used", 0),
+             ("thrusters", "impulse_B", "orbit", "impulse_B", 3),
              ("mission", "data_recording", "data", "data_recording", 0),
              ("mission", "downlink_enable", "data", "downlink_enable", 0),
              ("ground", "visible", "data", "ground_contact", 0),
@@ -453,8 +462,10 @@ def generate(writer):
                f"{base.target_perigee_km:g} km budget (Eq. 2-3: {base.thesis['propellant']:g} kg)",
                {"mass0": SPACECRAFT.mass, "propellant_budget": budget[base.name]})
     writer.ssv("mission_takeover",
-               "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), RK4 attitude integration",
-               {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "rk4"})
+               "Host tumble when NEIGHBOR takes over (Eq. 6-7: 10 deg/s per axis), RK4 attitude integration, the "
+               "inertia following the propellant drawn from the tank",
+               {**vec("q0", [0.0, 0.0, 0.0, 1.0]), **vec("omega0", W0_TAKEOVER), "integrator": "rk4",
+                "propellant_mass_properties": True})
     writer.ssv("mission_tracking",
                "De-orbit tracking (Appendix F): k 1, G 0.1 I, e 0.001 widened to 3 sigmas of the estimate's noise and "
                "one impulse bit, desired attitude and rate from the burn guidance",
@@ -463,8 +474,9 @@ def generate(writer):
     writer.ssv("mission_thrusters",
                "In the burn, y and z torques by switching axial thrusters off (off-pulsing): no RCS propellant "
                "for the thrust axis' misalignment torque; a stuck thruster detected from the gyro's rates, its valve "
-               "closed and its axis taken by the others",
-               {"off_pulsing": True, "fault_detection": True, "gyro_sigma": ad.GYRO_SIGMA, "gyro_sample_time": ad.STEP})
+               "closed and its axis taken by the others; torques about the centre of mass as the tank empties",
+               {"off_pulsing": True, "fault_detection": True, "gyro_sigma": ad.GYRO_SIGMA, "gyro_sample_time": ad.STEP,
+                "propellant_mass_properties": True})
     writer.ssv("mission_detumble",
                "Detumble flight settle criterion: rate window 0.75 impulse bit per axis held for 1 s", DETUMBLE_FLIGHT)
     writer.ssv("mission_slew",
