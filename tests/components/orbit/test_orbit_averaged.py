@@ -269,7 +269,7 @@ def test_bad_parameters_are_named():
 
 # ---- FMU ---------------------------------------------------------------------------------------
 CONTRACT_INPUTS = {"F_thrust_B[1]", "F_thrust_B[2]", "F_thrust_B[3]", "q_BN[1]", "q_BN[2]", "q_BN[3]", "q_BN[4]",
-                   "retrograde", "mass"}
+                   "retrograde", "mass", "impulse_B[1]", "impulse_B[2]", "impulse_B[3]"}
 CONTRACT_OUTPUTS = {"r_BN_N[1]", "r_BN_N[2]", "r_BN_N[3]", "v_BN_N[1]", "v_BN_N[2]", "v_BN_N[3]", "altitude",
                     "altitude_spherical", "latitude", "longitude", "sma", "ecc", "perigee_altitude",
                     "apogee_altitude", "density", "reentered"}
