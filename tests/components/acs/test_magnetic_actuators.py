@@ -337,9 +337,14 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
             # then the thesis' Eq. 31 angles, appended after the wheel inputs
             later = ([f"euler_integrated[{i}]" for i in (1, 2, 3)] + ["euler0_from_q0"]
                      + [f"euler0[{i}]" for i in (1, 2, 3)])
-            assert names[-13:-7] == new and names[-14] == "H_B[3]" and names[-7:] == later
-            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-13])
+            # then the mass properties that follow the tank (issue 28)
+            last = (["propellant_mass_properties", "propellant_used", "rcs_propellant"]
+                    + [f"center_of_mass_B[{i}]" for i in (1, 2, 3)])
+            assert names[-19:-13] == new and names[-20] == "H_B[3]" and names[-13:-6] == later
+            assert names[-6:] == last
+            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-19])
             assert min(vr[n] for n in later) > max(vr[n] for n in new)
+            assert min(vr[n] for n in last) > max(vr[n] for n in later)
             assert names.index("torque_B[1]") < names.index("q_BN[1]")
 
 
