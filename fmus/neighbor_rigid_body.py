@@ -15,8 +15,8 @@ one. H_B stays the body's own J omega (the total is H_B + wheel_momentum_B).
 Mass properties that follow the tank (appended last, off by default): with
 `propellant_mass_properties` the inertia is the one about the centre of mass once
 propellant_used + rcs_propellant kg left the tank at the NEIGHBOR module's centre
-(components.attitude.mass_properties), recomputed between steps when they change;
-`center_of_mass_B` says where it moved. Off, or with both inputs at zero, the model is the
+(components.attitude.mass_properties), recomputed before a step once 0.1 g more has been drawn;
+`center_of_mass_B` says where it moved. Off, or with less than 0.1 g drawn, the model is the
 fixed-inertia one bit for bit.
 """
 

@@ -26,13 +26,22 @@ FAULTS = {"420km": ["none"] * 4 + ["thruster_dead", "none"], "475km": ["all_sun_
           "525km": ["none", "none"]}
 
 
-@pytest.mark.parametrize("scenario", RUNS)
-def test_dispersed_missions_deorbit_within_their_budgets(ssp_paths, tmp_path, scenario):
+def test_dispersed_missions_deorbit_within_their_budgets(ssp_paths, tmp_path):
+    """One test, the scenarios one after another: each campaign takes both cores with its two Dask
+    workers, and with pytest-xdist the suite's other tests run on the other pytest worker beside
+    it (xdist_group cannot keep three tests on one worker with pytest 9.2: pytest-xdist #1386)."""
+    for scenario in RUNS:
+        spec = load_spec(CAMPAIGNS / f"mission_dispersion_{scenario}.toml")
+        spec = dataclasses.replace(spec, runs=RUNS[scenario], system=ssp_paths["neighbor_mission_lifetime"])
+        summary = run_campaign(spec, tmp_path / scenario, workers=2)
+        try:
+            _check(scenario, summary, sorted(_read_rows(tmp_path / scenario), key=lambda r: r["run"]))
+        except AssertionError as exc:
+            raise AssertionError(f"{scenario}: {exc}") from exc
+
+
+def _check(scenario, summary, rows):
     runs = RUNS[scenario]
-    spec = load_spec(CAMPAIGNS / f"mission_dispersion_{scenario}.toml")
-    spec = dataclasses.replace(spec, runs=runs, system=ssp_paths["neighbor_mission_lifetime"])
-    summary = run_campaign(spec, tmp_path / "dispersion", workers=2)
-    rows = sorted(_read_rows(tmp_path / "dispersion"), key=lambda r: r["run"])
     assert [r["run"] for r in rows] == list(range(runs))
     assert [r["error"] for r in rows if r["status"] != "ok"] == []
     assert [r["fault"] for r in rows] == FAULTS[scenario]
