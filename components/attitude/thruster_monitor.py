@@ -22,12 +22,16 @@ A window names a candidate when its best hypothesis lowers the sum of squares by
 `gate` (25: chi-square with one degree of freedom, about 6e-7 by chance); every hypothesis within
 `gate` of the best belongs to it. Two can: when the controller never rests (a dead y+ thruster
 reverses the y+ torque, the y+ command never stops) "y+ far stuck off" and "y- far stuck on" are
-the same torque at the same times; no window tells them apart, and both are declared (more than
-two: nothing). `confirmations` (2) windows in a row naming the same thrusters and modes declare the
-fault, so a single disturbed window (a gyro bias jump) never does. Windows run only while every
-rate is below `max_rate` (10 deg/s: in a faster tumble the gyroscopic term's inertia error hides
-a thruster; the model error covers that term's share too) and no step is longer than a tenth of
-the window (the attitude loop's steps; a long step starts the window over). One fault is
+the same torque at the same times; no window tells them apart, and both are declared. Two of one
+mode (x+1 or x+2 stuck off, whose torques differ only in the side torque a fast tumble's
+gyroscopic term can hide), or more than two, name nothing: they are alternatives, and closing
+both thrusters of a pair would leave its torque direction with none (a 475 km dispersed run with
+x+1 dead and a 13.7 deg/s tumble closed x+1 and x+2 and never finished its detumble).
+`confirmations` (2) windows in a row naming the same thrusters and modes declare the fault, so a
+single disturbed window (a gyro bias jump) never does. Windows run only while every rate is below
+`max_rate` (10 deg/s: in a faster tumble the gyroscopic term's inertia error hides a thruster; the
+model error covers that term's share too) and no step is longer than a tenth of the window (the
+attitude loop's steps; a long step starts the window over). One fault is
 declared per run.
 
 Operations choice (docs/models/mission.md, "Faults"): each declared thruster's latch valve is closed
@@ -41,6 +45,14 @@ import numpy as np
 from ..core import checks
 
 STUCK_OFF, STUCK_ON = 1, 2  # the modes a detection names
+
+
+def declarable(group):
+    """Whether a window's hypotheses within the gate of its best name a fault: one, or two as one
+    thruster stuck off and another stuck on (the same torque at the same times). Two of one mode
+    are alternatives the window cannot tell apart, and closing both could leave a torque direction
+    with no thruster; more than two, nothing."""
+    return len(group) == 1 or (len(group) == 2 and len({mode for _, mode in group}) == 2)
 
 
 class ThrusterMonitor:
@@ -162,7 +174,7 @@ class ThrusterMonitor:
             fits = misfit(E[None, :, :] - curves[:, :, None] * signatures[:, None, :])
             best = float(np.min(fits))
             group = frozenset(hypotheses[k] for k in np.flatnonzero(fits < best + self.gate))
-            if null - best > self.gate and len(group) <= 2:
+            if null - best > self.gate and declarable(group):
                 hypothesis = group
         if hypothesis is not None and hypothesis == self._candidate:
             self._count += 1

@@ -8,7 +8,7 @@ import numpy as np
 import pytest
 
 from components.attitude.rigid_body import RigidBody, box_inertia
-from components.attitude.thruster_monitor import STUCK_OFF, STUCK_ON, ThrusterMonitor
+from components.attitude.thruster_monitor import STUCK_OFF, STUCK_ON, ThrusterMonitor, declarable
 from components.attitude.thruster_set import ThrusterSet, thesis_layout
 from components.sensing.sensors import Gyro
 
@@ -93,3 +93,17 @@ def test_the_monitor_state_round_trips_and_bad_values_are_named():
             ThrusterMonitor(**args)
     with pytest.raises(ValueError, match="positive definite"):
         ThrusterMonitor(torques, range(12), -np.eye(3), GYRO_SIGMA, GYRO_SAMPLE_TIME)
+
+
+def test_two_hypotheses_of_one_mode_name_nothing():
+    """A window whose best hypotheses are x+1 and x+2 both stuck off (their torques differ only in
+    the side torque, which a fast tumble's gyroscopic term can hide) names nothing: closing both
+    would leave +x with no thruster. A 475 km dispersed run (x+1 dead, 13.7 deg/s) did close both and
+    then timed its detumble out twice; with this rule it closed x+1 and x-1 (off and on, the same
+    torque at the same times) and detumbled in 14 s."""
+    x1, x2, xm1 = NAMES.index("x+1"), NAMES.index("x+2"), NAMES.index("x-1")
+    assert declarable(frozenset({(x1, STUCK_OFF)}))
+    assert declarable(frozenset({(x1, STUCK_OFF), (xm1, STUCK_ON)}))
+    assert not declarable(frozenset({(x1, STUCK_OFF), (x2, STUCK_OFF)}))
+    assert not declarable(frozenset({(x1, STUCK_ON), (x2, STUCK_ON)}))
+    assert not declarable(frozenset({(x1, STUCK_OFF), (xm1, STUCK_ON), (x2, STUCK_OFF)}))
