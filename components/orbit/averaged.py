@@ -445,15 +445,15 @@ class OrbitAveraged:
         of impulse (N.s, B), whose mean force over the previous step is added to F_thrust_B
         (propulsion.ImpulseWindow; not with retrograde)."""
         t_end = time_utils.check_time(t_end, "time")
-        if impulse_B is not None:
-            extra = self.impulse.force(impulse_B, t_end - self.t)
-            if extra != (0.0, 0.0, 0.0) and not retrograde:
-                F_thrust_B = tuple(float(f) + e for f, e in zip(F_thrust_B, extra))
         mass = float(mass)
         if not (math.isfinite(mass) and mass > 0.0):
             raise ValueError(f"mass = {mass!r} kg must be finite and > 0")
         if t_end < self.t:
             raise ValueError(f"time {t_end!r} s is before the model time {self.t!r} s (no backward steps)")
+        if impulse_B is not None:  # after the checks: a refused call leaves the window as it was
+            extra = self.impulse.force(impulse_B, t_end - self.t)
+            if extra != (0.0, 0.0, 0.0) and not retrograde:
+                F_thrust_B = tuple(float(f) + e for f, e in zip(F_thrust_B, extra))
         thrust = self.thrust_acceleration(F_thrust_B, q_BN, retrograde, mass)
         self._out_cache = None
         t, y = self.t, self.y

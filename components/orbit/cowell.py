@@ -293,8 +293,6 @@ class CowellOrbit:
         """Inputs held until the next step (zero-order hold). impulse_B: the attitude thrusters' running
         total of impulse (N.s, B) before a step of `step` seconds, whose mean force over the previous
         step is added to F_thrust_B (propulsion.ImpulseWindow; not with retrograde)."""
-        if impulse_B is not None:
-            self.F_extra_B = self.impulse.force(impulse_B, step)
         if F_thrust_B is not None:
             F = tuple(float(x) for x in F_thrust_B)
             if len(F) != 3 or not all(math.isfinite(x) for x in F):
@@ -310,6 +308,8 @@ class CowellOrbit:
             self.retrograde = bool(retrograde)
         if mass is not None:
             self.mass = positive("mass", mass, "kg")
+        if impulse_B is not None:  # last: a refused input leaves the window as it was
+            self.F_extra_B = self.impulse.force(impulse_B, step)
 
     def thrust_acceleration_N(self):
         """A(q)^T F_B / m (m/s^2) for the held inputs (not used when retrograde)."""
