@@ -95,6 +95,6 @@ def _check(scenario, summary, rows):
         drawn = r["burn_propellant_kg"] + r["rcs_propellant_kg"]
         assert r["com_shift_m"] == pytest.approx(drawn * 0.1 / (r["spacecraft_mass"] - drawn), abs=2e-6), r
         assert (r["end_s"] - r["burn_start_s"]) / YEAR < 5.0, r
-    flying = [r for r in rows if r["fault"] != "all_sun_sensors_dead"]
+    assert any(r["fault"] != "all_sun_sensors_dead" for r in rows)  # each scenario flies a de-orbit
     assert summary["probabilities"]["reentered"]["p"] == 1.0
-    assert summary["probabilities"]["rcs_within_allowance"]["p"] == 1.0 and flying
+    assert summary["probabilities"]["rcs_within_allowance"]["p"] == 1.0
