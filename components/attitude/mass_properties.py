@@ -54,8 +54,8 @@ def drawn(inertia0, mass0, propellant, tank):
 
 
 def inverse(J):
-    """The inverse of a 3x3 matrix by its adjugate (kept in plain floats: the rigid body's inertia
-    changes at every step that draws propellant, where numpy's call costs more than the arithmetic)."""
+    """The inverse of a 3x3 matrix by its adjugate, in plain floats (the rigid body keeps its
+    inertia as tuples of floats; numpy's inverse would cost more than the arithmetic)."""
     (a, b, c), (d, e, f), (g, h, i) = J
     A, B, C = e * i - f * h, f * g - d * i, d * h - e * g
     det = a * A + b * B + c * C
