@@ -26,8 +26,10 @@ import numpy as np
 
 from ..core import rotations
 from ..core import jit
+from ..core.constants import R_EQ
 from ..core.jit import njit
 from . import triad
+from .nadir_history import NadirHistory
 
 
 # ---- the filter's matrix arithmetic (numba where installed: components.core.jit) ------------
@@ -383,6 +385,10 @@ class NeesMonitor:
 COVARIANCE_STEP = 0.1
 
 
+# The horizon sensor's history before a fix is let go once it spans this many nadir_history_time
+# (an eclipse of up to 36 minutes and the minutes of sunlight that tell the Sun sensors failed fit)
+HISTORY_KEPT = 3.0
+
 BIAS_LEARNED = 0.2  # of sigma_bias0: the fault monitor watches once every axis' bias sigma is below it
 
 
@@ -465,7 +471,7 @@ class AttitudeEstimator:
     def __init__(self, nadir_sigma=math.radians(0.25), sun_sigma=math.radians(0.5) / 3.0,
                  sigma_v=5.5e-4 * math.sqrt(0.1), sigma_u=1e-6, sigma_bias0=1e-3, min_separation=math.radians(5.0),
                  inertia=None, accel_sigma=5e-4, update_interval=0.0, coarse_sun_sigma=None, fault_window=0,
-                 fault_limit=3.64):
+                 fault_limit=3.64, nadir_history_time=0.0, sun_missing_time=300.0):
         self.triad = triad.AttitudeDetermination(nadir_sigma, sun_sigma, min_separation=min_separation)
         self.coarse_triad = None if coarse_sun_sigma is None else \
             triad.AttitudeDetermination(nadir_sigma, coarse_sun_sigma, min_separation=min_separation)
@@ -485,6 +491,13 @@ class AttitudeEstimator:
         self.innovations = InnovationMonitor(fault_window, fault_limit)
         self.updated = {"nadir": -math.inf, "sun": -math.inf, "coarse": -math.inf}  # sensor -> time of its last update
         self.seen = {}  # sensor -> the sample it gave at the last step
+        # without a Sun vector: the fix from the horizon sensor's history (nadir_history.py)
+        self.nadir_history_time = _sigma("nadir_history_time", nadir_history_time, "s")
+        self.sun_missing_time = _sigma("sun_missing_time", sun_missing_time, "s")
+        self.history = NadirHistory(self.triad.nadir_sigma, self.sigma_bias0) \
+            if self.nadir_history_time > 0.0 else None
+        self.sunlit_without_sun = 0.0  # s in sunlight with no Sun vector, before the first fix
+        self.without_sun = False  # the filter started from the history and has had no Sun vector since
 
     @property
     def rate(self):
@@ -526,6 +539,8 @@ class AttitudeEstimator:
         self.rates.predict(torque, h)
         if not f.initialized:
             self._initialize(measurements, coarse)
+            if not f.initialized and self.history is not None:
+                self._from_history(measurements, coarse, omega_meas, h)
         else:
             sun_N = [s - r for s, r in zip(r_SN_N, r_BN_N)]
             updates = []  # (sensor, measured vector, reference direction, sigma) of the new samples
@@ -542,6 +557,8 @@ class AttitudeEstimator:
             armed = bool(updates and self.innovations.window) and max(f.bias_sigma()) < BIAS_LEARNED * self.sigma_bias0
             for name, b, r, sigma in updates:
                 self._mark(name, b)
+                if name != "nadir":
+                    self.without_sun = False
                 if self.innovations.add(*f.update(b, r, sigma), armed):
                     f.reopen_bias(self.sigma_bias0, self.innovations.error_variance())
                     self.innovations.restart()
@@ -571,6 +588,30 @@ class AttitudeEstimator:
         self._mark("nadir", nadir_B)
         self._mark(*sun_used)
 
+    def _from_history(self, measurements, coarse, omega_meas, h):
+        """Before a TRIAD fix: keep the gyro and the horizon sensor's samples, and once the history
+        spans nadir_history_time and the spacecraft has been sunlit (a cylindrical shadow from the
+        GPS position and the Sun's) for sun_missing_time with no Sun vector from any sensor (they
+        have failed: the coarse sensors see the Sun whenever it shines), start the filter from the
+        history's fix. Until then nothing here changes what the estimator does."""
+        nadir_B, nadir_valid, _, sun_valid, r_BN_N, r_SN_N = measurements
+        if self.history.elapsed > HISTORY_KEPT * self.nadir_history_time:
+            self.history.clear()  # bounded: a Sun seen but no TRIAD possible for long would grow it
+        new = nadir_valid and self._new("nadir", nadir_B)
+        self.history.add(omega_meas, h if self.history.rates else None, nadir_B if new else None,
+                         [-x for x in r_BN_N] if new else None)
+        if new:
+            self._mark("nadir", nadir_B)
+        if not (sun_valid or coarse is not None) and _sunlit(r_BN_N, r_SN_N):
+            self.sunlit_without_sun += h
+        if not (new and self.history.span >= self.nadir_history_time - 1e-9
+                and self.sunlit_without_sun >= self.sun_missing_time - 1e-9):
+            return
+        if self.history.solve(self.filter) is None:
+            return
+        self.without_sun = True
+        self.history.clear()
+
     def check(self, q_true):
         """Record the attitude NEES against the true attitude (a simulation's diagnostic of the
         filter's consistency; nothing the filter uses). Returns it; 0 before the first fix."""
@@ -585,7 +626,9 @@ class AttitudeEstimator:
                 "filter": self.filter.get_state(), "rates": self.rates.get_state(), "time": self.time,
                 "cov_pending": self.cov_pending, "cov_rate": list(self.cov_rate),
                 "held_rate": self.held_rate, "updated": dict(self.updated),
-                "seen": {k: list(v) for k, v in self.seen.items()}}
+                "seen": {k: list(v) for k, v in self.seen.items()},
+                "history": None if self.history is None else self.history.get_state(),
+                "sunlit_without_sun": self.sunlit_without_sun, "without_sun": self.without_sun}
 
     def set_state(self, state):
         self.consistency.set_state(state["consistency"])
@@ -597,3 +640,18 @@ class AttitudeEstimator:
         self.held_rate = None if state["held_rate"] is None else tuple(state["held_rate"])
         self.updated = {k: float(t) for k, t in state["updated"].items()}
         self.seen = {k: tuple(v) for k, v in state["seen"].items()}
+        if self.history is not None:
+            self.history.set_state(state["history"])
+        self.sunlit_without_sun, self.without_sun = float(state["sunlit_without_sun"]), bool(state["without_sun"])
+
+
+def _sunlit(r_BN_N, r_SN_N):
+    """In sunlight by a cylindrical Earth shadow (the Sun's direction from the Earth's centre)."""
+    s = r_SN_N
+    sn = rotations.norm(s)
+    if sn == 0.0:
+        return True
+    along = rotations.dot(r_BN_N, s) / sn
+    if along >= 0.0:
+        return True
+    return rotations.dot(r_BN_N, r_BN_N) - along * along > R_EQ * R_EQ

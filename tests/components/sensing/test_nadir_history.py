@@ -1,0 +1,143 @@
+"""Attitude without the Sun from the horizon sensor's history, the gyro and the GPS
+(components/sensing/nadir_history.py): the rigid body, the BMG160 gyro and the horizon sensor of
+the mission, on a 420 km orbit, with a gyro bias the fix must learn."""
+import math
+
+import numpy as np
+import pytest
+
+from components.attitude.rigid_body import RigidBody, box_inertia
+from components.core import rotations
+from components.core.constants import MU_EARTH, R_EQ
+from components.mission.neighbor import SPACECRAFT
+from components.sensing import triad
+from components.sensing.mekf import AttitudeEstimator, AttitudeMEKF
+from components.sensing.nadir_history import NadirHistory
+from components.sensing.sensors import Gyro, HorizonSensor
+
+NADIR_SIGMA = math.radians(0.25)
+GYRO_SIGMA, GYRO_SAMPLE_TIME = 5.5e-4, 0.1
+SIGMA_BIAS0 = 1e-3
+STEP = 0.1
+CHI2_3_999 = 16.266  # chi-square, 3 degrees of freedom, 99.9 %
+
+
+def _position(t, radius=R_EQ + 420e3, inclination=math.radians(51.6), phase=0.3):
+    u = math.sqrt(MU_EARTH / radius ** 3) * t + phase
+    return (radius * math.cos(u), radius * math.sin(u) * math.cos(inclination),
+            radius * math.sin(u) * math.sin(inclination))
+
+
+def _fly(seed, rate_deg, duration=1200.0):
+    """The true final attitude and the history's fix after `duration` s: a body tumbling at
+    rate_deg about a random axis (0: turning only at minus the gyro's bias, as after a detumble
+    on the uncorrected gyro)."""
+    rng = np.random.default_rng(seed)
+    bias = rng.normal(0.0, SIGMA_BIAS0, 3)
+    axis = rng.normal(size=3)
+    omega0 = -bias + math.radians(rate_deg) * axis / np.linalg.norm(axis)
+    q0 = rotations.normalized(tuple(rng.normal(size=4)))
+    body = RigidBody(box_inertia(SPACECRAFT.mass, SPACECRAFT.edge_a, SPACECRAFT.edge_b, SPACECRAFT.edge_c),
+                     q0, omega0)
+    gyro = Gyro(bias, GYRO_SIGMA, seed + 1, GYRO_SAMPLE_TIME)
+    horizon = HorizonSensor(NADIR_SIGMA, seed + 2)
+    history = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
+    history.add(gyro.measure(body.omega))
+    t = 0.0
+    for _ in range(int(round(duration / STEP))):
+        body.step((0.0, 0.0, 0.0), STEP)
+        t += STEP
+        gyro.step(STEP)
+        horizon.step(STEP)
+        r = _position(t)
+        nadir_B, _ = horizon.measure(r, body.q)
+        history.add(gyro.measure(body.omega), STEP, nadir_B, [-x for x in r])
+    return body.q, bias, history
+
+
+@pytest.mark.parametrize("seed, rate_deg", [(1, 10.0), (2, 15.0), (3, 0.0)])
+def test_the_history_fixes_the_attitude_and_the_bias_within_its_covariance(seed, rate_deg):
+    q_true, bias, history = _fly(seed, rate_deg)
+    assert history.span == pytest.approx(1200.0)
+    f = history.solve(AttitudeMEKF(GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), 1e-6))
+    error = triad.error_angle(f.q, q_true)
+    nees = f.attitude_nees(q_true)
+    print(f"seed {seed}, {rate_deg} deg/s: error {math.degrees(error):.3f} deg, sigma "
+          f"{[round(math.degrees(s), 3) for s in f.attitude_sigma()]} deg, NEES {nees:.2f}, bias error "
+          f"{math.degrees(np.linalg.norm(f.bias - bias)):.4f} deg/s")
+    assert error < math.radians(2.0)  # the 30 deg ambiguity about the nadir resolved
+    assert nees < CHI2_3_999
+    assert np.linalg.norm(f.bias - bias) < 0.1 * np.linalg.norm(bias)
+
+
+def test_too_few_samples_give_no_fix():
+    history = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
+    history.add((0.0, 0.0, 0.0))
+    for _ in range(5):
+        history.add((0.0, 0.0, 0.0), STEP, (0.0, 0.0, 1.0), (0.0, 0.0, 1.0))
+    f = AttitudeMEKF()
+    assert history.solve(f) is None
+    assert not f.initialized
+
+
+SUN_N = (1.496e11, 0.0, 0.0)
+
+
+def _estimate(history_time, sun_seen, duration=1500.0, seed=5):
+    """The estimator of the mission (coarse Sun sensors standing in for the fine one) on a body
+    tumbling at 10 deg/s; the Sun vectors come only with sun_seen (else every Sun sensor has
+    failed). Returns (estimator, true q, the estimates at every step)."""
+    rng = np.random.default_rng(seed)
+    bias = rng.normal(0.0, SIGMA_BIAS0, 3)
+    axis = rng.normal(size=3)
+    body = RigidBody(box_inertia(SPACECRAFT.mass, SPACECRAFT.edge_a, SPACECRAFT.edge_b, SPACECRAFT.edge_c),
+                     rotations.normalized(tuple(rng.normal(size=4))), math.radians(10.0) * axis / np.linalg.norm(axis))
+    gyro = Gyro(bias, GYRO_SIGMA, seed + 1, GYRO_SAMPLE_TIME)
+    horizon = HorizonSensor(NADIR_SIGMA, seed + 2)
+    estimator = AttitudeEstimator(sigma_v=GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), sigma_bias0=SIGMA_BIAS0,
+                                  coarse_sun_sigma=math.radians(2.0), nadir_history_time=history_time)
+    estimates, t = [], 0.0
+    for _ in range(int(round(duration / STEP))):
+        body.step((0.0, 0.0, 0.0), STEP)
+        t += STEP
+        gyro.step(STEP)
+        horizon.step(STEP)
+        r = _position(t)
+        nadir_B, valid = horizon.measure(r, body.q)
+        s = np.array(SUN_N) - np.array(r)
+        sun_B = tuple(np.array(rotations.attitude_matrix(body.q)) @ (s / np.linalg.norm(s)))
+        estimator.step((nadir_B, valid, (0.0, 0.0, 0.0), False, r, SUN_N), gyro.measure(body.omega), STEP,
+                       coarse_sun=(sun_B, sun_seen))
+        estimates.append(estimator.filter.q)
+    return estimator, body.q, estimates
+
+
+def test_the_estimator_fixes_from_the_history_when_no_sun_sensor_sees_the_sun():
+    estimator, q_true, _ = _estimate(1200.0, sun_seen=False)
+    assert estimator.filter.initialized and estimator.without_sun
+    assert estimator.sunlit_without_sun >= estimator.sun_missing_time
+    assert triad.error_angle(estimator.filter.q, q_true) < math.radians(2.0)
+    assert estimator.filter.attitude_nees(q_true) < CHI2_3_999
+    assert not estimator.history.rates  # the samples are let go once used
+    # off (the thesis set): no fix without the Sun
+    off, _, _ = _estimate(0.0, sun_seen=False, duration=300.0)
+    assert not off.filter.initialized and off.history is None
+
+
+def test_the_history_changes_nothing_while_a_sun_sensor_sees_the_sun():
+    with_history, _, a = _estimate(1200.0, sun_seen=True, duration=200.0)
+    without, _, b = _estimate(0.0, sun_seen=True, duration=200.0)
+    assert a == b  # bit for bit, at every step
+    assert not with_history.without_sun and not with_history.history.rates
+
+
+def test_the_history_is_part_of_the_state():
+    """FMU state: the estimator's history before the fix is saved and restored with it."""
+    _, _, history = _fly(6, 10.0, duration=30.0)
+    copy = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
+    copy.set_state(history.get_state())
+    assert copy.get_state() == history.get_state() and copy.span == pytest.approx(30.0)
+    a, b = AttitudeMEKF(), AttitudeMEKF()
+    history.solve(a)
+    copy.solve(b)
+    assert a.get_state() == b.get_state()
