@@ -17,6 +17,12 @@ does not run), so controllers wired to the estimator fly on the true state.
 Fault detection (appended last): with `fault_window` > 0 the mean normalized innovation squared
 over that many vector updates is watched once the bias is learned; above `fault_limit` the gyro
 bias is reopened and learned again (mekf.InnovationMonitor), and `bias_resets` counts it.
+
+The fix without the Sun (appended last): with `nadir_history_time` > 0 the estimator keeps the
+horizon sensor's and the gyro's samples until a fix; once they span that long and the spacecraft
+has been sunlit for `sun_missing_time` with no Sun vector (every Sun sensor failed), the attitude
+and the gyro bias come from the history (components/sensing/nadir_history.py) and
+`attitude_valid` uses `valid_sigma_without_sun` until a Sun vector is seen again.
 """
 import math
 
@@ -108,19 +114,33 @@ class AttitudeEstimator(NeighborSlave):
                     "Times the innovations contradicted the filter and the gyro bias was reopened (a bias jump)", int)
         self.output("innovation_largest", lambda: self.model.innovations.largest, "1",
                     "Largest window mean of the normalized innovation squared seen while watched (2 when consistent)")
+        # the fix without the Sun (appended in a later release)
+        self.parameter("nadir_history_time", 0.0, "s",
+                       "Without a Sun vector: the span of the horizon sensor's and the gyro's history the first fix "
+                       "is taken from once every Sun sensor has failed (>= 0; 0: off, the filter waits for the Sun)")
+        self.parameter("sun_missing_time", 300.0, "s",
+                       "Time in sunlight (a cylindrical shadow from r_BN_N and r_SN_N) with no Sun vector from any "
+                       "sensor after which the Sun sensors are taken as failed (>= 0)")
+        self.parameter("valid_sigma_without_sun", math.radians(1.0), "rad",
+                       "valid_sigma while the filter has had no Sun vector since a fix from the history, > 0")
+        self.output("fixed_without_sun", lambda: self.model.without_sun, None,
+                    "The filter started from the horizon sensor's history and has had no Sun vector since", bool)
 
     def build_model(self):
         v = self.values
         if not (v["gyro_sample_time"] > 0.0):
             raise ValueError(f"gyro_sample_time = {v['gyro_sample_time']!r} s must be > 0")
-        if not (v["valid_sigma"] > 0.0):
-            raise ValueError(f"valid_sigma = {v['valid_sigma']!r} rad must be > 0")
+        for name in ("valid_sigma", "valid_sigma_without_sun"):
+            if not (v[name] > 0.0):
+                raise ValueError(f"{name} = {v[name]!r} rad must be > 0")
         sigma_v = v["gyro_sigma"] * math.sqrt(v["gyro_sample_time"])  # rad/s^0.5
         return mekf.AttitudeEstimator(v["nadir_sigma"], v["sun_sigma"], sigma_v, v["bias_walk"], v["sigma_bias0"],
                                       v["min_separation"], inertia=self.inertia(rigid_body.box_inertia),
                                       accel_sigma=v["accel_sigma"], update_interval=v["update_interval"],
                                       coarse_sun_sigma=v["coarse_sun_sigma"] if v["use_coarse_sun"] else None,
-                                      fault_window=v["fault_window"], fault_limit=v["fault_limit"])
+                                      fault_window=v["fault_window"], fault_limit=v["fault_limit"],
+                                      nadir_history_time=v["nadir_history_time"],
+                                      sun_missing_time=v["sun_missing_time"])
 
     def _q(self):
         return self._outputs()["q"]
@@ -131,7 +151,8 @@ class AttitudeEstimator(NeighborSlave):
 
     def _valid(self):
         v = self.values
-        return v["truth_feedback"] or (self.model.filter.initialized and max(self._sigma()) <= v["valid_sigma"])
+        limit = v["valid_sigma_without_sun"] if self.model.without_sun else v["valid_sigma"]
+        return v["truth_feedback"] or (self.model.filter.initialized and max(self._sigma()) <= limit)
 
     def _sigma(self):
         f = self.model.filter

@@ -125,7 +125,8 @@ MISSION_RECORD: Tuple[str, ...] = (
     "tracking.attitude_error", "tracking.pointing_error", "power.state_of_charge", "power.energy",
     "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked",
     *elements("dynamics.omega_BN_B", 3), *elements("dynamics.euler123", 3),
-    *elements("dynamics.euler_integrated", 3), *elements("dynamics.q_BN", 4), *elements("guidance.q_target_BN", 4))
+    *elements("dynamics.euler_integrated", 3), *elements("dynamics.q_BN", 4), *elements("guidance.q_target_BN", 4),
+    "estimator.fixed_without_sun")
 # What the de-orbit study records for its table and figures.
 DEORBIT_RECORD: Tuple[str, ...] = (
     "orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",

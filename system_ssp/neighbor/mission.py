@@ -201,6 +201,12 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     if int(d["mission.determination_timeouts"][-1]):
         faults.insert(0, "the attitude determination timed out without a valid attitude: the detumble started "
                          "anyway (it needs rates only)")
+    s["fixed_without_sun"] = bool(d["estimator.fixed_without_sun"][-1])
+    if s["fixed_without_sun"]:
+        began, fixed = _first(mode == MissionMode.DEORBIT), _first(d["estimator.initialized"] > 0)
+        when = "" if began is None or fixed is None else f" {float(t[fixed] - t[began]):.0f} s after the de-orbit began"
+        faults.insert(0, "no Sun vector from any Sun sensor: the first attitude fix from the horizon sensor's and "
+                         f"the gyro's history{when}, flown on without the Sun (valid at a wider sigma)")
     resets = int(d["estimator.bias_resets"][-1])
     s["bias_resets"] = resets
     if resets:

@@ -241,8 +241,10 @@ def test_off_nominal_mission_finishes_through_phase_timeouts(ssp_paths, tmp_path
     assert "| OVER |" in mission.table(s)
 
 
-def test_without_sun_sensors_the_mission_ends_in_the_safe_state(ssp_paths):
-    """Both Sun sensors dead (fault parameters of the sensors): the estimator never gets an
+def test_without_sun_sensors_or_a_fix_from_the_horizon_history_the_mission_ends_in_the_safe_state(ssp_paths):
+    """Both Sun sensors dead (fault parameters of the sensors) and no fix from the horizon sensor's
+    history (`estimator.nadir_history_time` 0; in the mission it gives the fix after 20 minutes, as
+    the suite's dispersed 475 km run 0 checks): the estimator never gets an
     attitude, the determination times out (here after 700 s instead of the mission's 6000 s, and
     the detumble after 60 s instead of 600, to keep the test short), the detumble runs on the
     gyro's rates and then waits for an attitude until it times out (twice: one retry), and no slew
@@ -251,6 +253,7 @@ def test_without_sun_sensors_the_mission_ends_in_the_safe_state(ssp_paths):
     was empty."""
     s, r = mission.run_mission("420km", ssp_dir=ssp_paths["neighbor_mission"].parent,
                                parameters={"sun_sensor.failed": True, "coarse_sun.failed": True,
+                                           "estimator.nadir_history_time": 0.0,
                                            "mission.attitude_determination_timeout": 700.0,
                                            "mission.detumble_timeout": 60.0})
     assert r.final["mission.safe_reason"] == 1 and r.final["mission.determination_timeouts"] == 1

@@ -196,6 +196,11 @@ COARSE_SUN_SIGMA = math.radians(2.0)
 # The detumble waits (after the 10 minutes of determination) until the estimator's largest
 # 1-sigma attitude error is below this: a TRIAD fix right at the end would start it at 1-2 deg.
 VALID_SIGMA = math.radians(0.25)
+# Without any Sun sensor: the first fix from the horizon sensor's and the gyro's history once it
+# spans 20 minutes (a fifth of an orbit: the nadir has turned 78 deg) and the spacecraft has been
+# sunlit 5 minutes with no Sun vector; valid at 1 deg 1-sigma, since no Sun vector narrows the
+# rotation about the nadir further (a 3 deg thrust axis error costs 0.14 % of the burn's delta-V).
+NADIR_HISTORY = {"nadir_history_time": 1200.0, "sun_missing_time": 300.0, "valid_sigma_without_sun": math.radians(1.0)}
 ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / INERTIA[0, 0]
 # The tracking law's boundary layer sized for estimates (deorbit_tracking.boundary_layer): its
 # deadband in s at least 3 sigmas of the estimate's noise and one impulse bit; the rate estimate's
@@ -206,6 +211,7 @@ TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
               "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
               "thrusters.off_pulsing": False, "thrusters.fault_detection": False, "estimator.fault_window": 0,
+              "estimator.nadir_history_time": 0.0,
               "dynamics.propellant_mass_properties": False, "thrusters.propellant_mass_properties": False,
               "mission.attitude_determination_timeout": 0.0, "mission.safe_without_attitude": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
@@ -438,8 +444,8 @@ def generate(writer):
     writer.ssv("mission_manager",
                "Operating modes (Section 3.4): 30-day grace period, 5 s daily wake, 10 min attitude determination; "
                "in monitoring one GPS beacon contact a day (operators choose the frequency, Section 3.6); without a "
-               "valid attitude after one orbit (no Sun sensor left) the detumble on rates, then the safe state "
-               "instead of a slew or burn",
+               "valid attitude after one orbit (no Sun sensor left and no fix from the horizon sensor's history) the "
+               "detumble on rates, then the safe state instead of a slew or burn",
                {"grace_period": GRACE_DAYS * DAY, "wake_period": DAY, "wake_duration": 5.0,
                "attitude_determination_duration": 600.0, "beacon_interval": DAY,
                 "attitude_determination_timeout": DETERMINATION_TIMEOUT, "safe_without_attitude": True})
@@ -506,12 +512,14 @@ def generate(writer):
     writer.ssv("mission_estimator", "Attitude estimator: the sensors' accuracies, each vector sample used once "
                "(vector sensors at about 10 Hz), rate filter trusting the torque model to 2 % of one pair's "
                "acceleration, coarse Sun vectors when the fine sensor has none, attitude valid at 0.25 deg 1-sigma, "
-               "a gyro bias jump detected from the innovations over 100 updates (9 s) and the bias learned again",
+               "a gyro bias jump detected from the innovations over 100 updates (9 s) and the bias learned again; "
+               "with every Sun sensor failed the first fix from 20 minutes of the horizon sensor and the gyro, valid "
+               "at 1 deg",
                {"nadir_sigma": ad.HORIZON_SIGMA, "sun_sigma": ad.SUN_SIGMA, "gyro_sigma": ad.GYRO_SIGMA,
                 "gyro_sample_time": ad.STEP, "sigma_bias0": 1e-3, "update_interval": UPDATE_INTERVAL,
                 "accel_sigma": ACCEL_SIGMA,
                 "use_coarse_sun": True, "coarse_sun_sigma": COARSE_SUN_SIGMA, "valid_sigma": VALID_SIGMA,
-                "fault_window": FAULT_WINDOW})
+                "fault_window": FAULT_WINDOW, **NADIR_HISTORY})
     writer.ssv(GNC_SETS["closed-loop-truth"],
                "Closed-loop guidance and control on the true state (a fidelity choice): the estimator passes the "
                "rigid body's attitude, rate and acceleration through; the sensors are not stepped",
