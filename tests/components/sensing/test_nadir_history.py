@@ -28,21 +28,21 @@ def _position(t, radius=R_EQ + 420e3, inclination=math.radians(51.6), phase=0.3)
             radius * math.sin(u) * math.sin(inclination))
 
 
-def _fly(seed, rate_deg, duration=1200.0):
-    """The true final attitude and the history's fix after `duration` s: a body tumbling at
-    rate_deg about a random axis (0: turning only at minus the gyro's bias, as after a detumble
-    on the uncorrected gyro)."""
+def _flight(seed, rate_deg, duration):
+    """The gyro's bias, then per 0.1 s step (the body, the gyro's sample, the horizon sensor's
+    nadir, the position): a body tumbling at rate_deg about a random axis (0: turning only at
+    minus the gyro's bias, as after a detumble on the uncorrected gyro). The first item after the
+    bias is the start, with no nadir."""
     rng = np.random.default_rng(seed)
     bias = rng.normal(0.0, SIGMA_BIAS0, 3)
     axis = rng.normal(size=3)
     omega0 = -bias + math.radians(rate_deg) * axis / np.linalg.norm(axis)
-    q0 = rotations.normalized(tuple(rng.normal(size=4)))
     body = RigidBody(box_inertia(SPACECRAFT.mass, SPACECRAFT.edge_a, SPACECRAFT.edge_b, SPACECRAFT.edge_c),
-                     q0, omega0)
+                     rotations.normalized(tuple(rng.normal(size=4))), omega0)
     gyro = Gyro(bias, GYRO_SIGMA, seed + 1, GYRO_SAMPLE_TIME)
     horizon = HorizonSensor(NADIR_SIGMA, seed + 2)
-    history = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
-    history.add(gyro.measure(body.omega))
+    yield bias
+    yield body, gyro.measure(body.omega), None, None
     t = 0.0
     for _ in range(int(round(duration / STEP))):
         body.step((0.0, 0.0, 0.0), STEP)
@@ -50,8 +50,21 @@ def _fly(seed, rate_deg, duration=1200.0):
         gyro.step(STEP)
         horizon.step(STEP)
         r = _position(t)
-        nadir_B, _ = horizon.measure(r, body.q)
-        history.add(gyro.measure(body.omega), STEP, nadir_B, [-x for x in r])
+        yield body, gyro.measure(body.omega), horizon.measure(r, body.q)[0], r
+
+
+def _fly(seed, rate_deg, duration=1200.0):
+    """The true final attitude, the gyro's bias and the history after `duration` s of _flight."""
+    flight = _flight(seed, rate_deg, duration)
+    bias = next(flight)
+    history = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
+    body = None
+    for sample in flight:
+        body, omega, nadir_B, r = sample
+        if r is None:
+            history.add(omega)
+        else:
+            history.add(omega, STEP, nadir_B, [-x for x in r])
     return body.q, bias, history
 
 
@@ -87,27 +100,16 @@ def _estimate(history_time, sun_seen, duration=1500.0, seed=5):
     """The estimator of the mission (coarse Sun sensors standing in for the fine one) on a body
     tumbling at 10 deg/s; the Sun vectors come only with sun_seen (else every Sun sensor has
     failed). Returns (estimator, true q, the estimates at every step)."""
-    rng = np.random.default_rng(seed)
-    bias = rng.normal(0.0, SIGMA_BIAS0, 3)
-    axis = rng.normal(size=3)
-    body = RigidBody(box_inertia(SPACECRAFT.mass, SPACECRAFT.edge_a, SPACECRAFT.edge_b, SPACECRAFT.edge_c),
-                     rotations.normalized(tuple(rng.normal(size=4))), math.radians(10.0) * axis / np.linalg.norm(axis))
-    gyro = Gyro(bias, GYRO_SIGMA, seed + 1, GYRO_SAMPLE_TIME)
-    horizon = HorizonSensor(NADIR_SIGMA, seed + 2)
     estimator = AttitudeEstimator(sigma_v=GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), sigma_bias0=SIGMA_BIAS0,
                                   coarse_sun_sigma=math.radians(2.0), nadir_history_time=history_time)
-    estimates, t = [], 0.0
-    for _ in range(int(round(duration / STEP))):
-        body.step((0.0, 0.0, 0.0), STEP)
-        t += STEP
-        gyro.step(STEP)
-        horizon.step(STEP)
-        r = _position(t)
-        nadir_B, valid = horizon.measure(r, body.q)
+    estimates = []
+    flight = _flight(seed, 10.0, duration)
+    next(flight)  # the bias
+    next(flight)  # the start: the estimator's first step is the end of the first 0.1 s
+    for body, omega, nadir_B, r in flight:
         s = np.array(SUN_N) - np.array(r)
         sun_B = tuple(np.array(rotations.attitude_matrix(body.q)) @ (s / np.linalg.norm(s)))
-        estimator.step((nadir_B, valid, (0.0, 0.0, 0.0), False, r, SUN_N), gyro.measure(body.omega), STEP,
-                       coarse_sun=(sun_B, sun_seen))
+        estimator.step((nadir_B, True, (0.0, 0.0, 0.0), False, r, SUN_N), omega, STEP, coarse_sun=(sun_B, sun_seen))
         estimates.append(estimator.filter.q)
     return estimator, body.q, estimates
 
