@@ -21,8 +21,9 @@ Crassidis 2014, section 6.2.4), solved here in two passes over the stored sample
    own covariance would not: it treats the integrated gyro as exact).
 
 Measured (tests/components/sensing/test_nadir_history.py; 420 km, BMG160 gyro, 0.25 deg horizon
-sensor, a bias of 1 mrad/s per axis, 1200 s): a body tumbling at 5-15 deg/s or turning at the
-bias rate alone ends within a few tenths to about 1 deg, consistent with the filter's covariance.
+sensor, a bias of 1 mrad/s per axis, 1200 s): a body tumbling at 10-15 deg/s or turning at the
+bias rate alone ends within 0.1-0.6 deg, consistent with the filter's covariance. In the 475 km
+dispersed missions the fixes were less accurate (one 4.4 deg off with a 0.6 deg sigma; docs/models/mission.md).
 """
 import math
 
@@ -152,11 +153,13 @@ class NadirHistory:
             self.nadir.append((len(self.rates) - 1, b / np.linalg.norm(b), r / np.linalg.norm(r)))
             self.span = self.elapsed
 
-    def _fit(self, A0, bias, rates, h, index, n_B, n_N, iterations):
-        """Gauss-Newton from (A0, bias); returns (A0, bias, the fit's sum of squares)."""
+    def _fit(self, A0, bias, rates, h, index, n_B, n_N, iterations, integrated=None):
+        """Gauss-Newton from (A0, bias); returns (A0, bias, the fit's sum of squares).
+        `integrated`: _integrate(rates, h, bias) when the caller has it already."""
         cost = math.inf
         for _ in range(iterations):
-            D, G = _integrate(rates, h, bias)
+            D, G = _integrate(rates, h, bias) if integrated is None else integrated
+            integrated = None
             Dk, Gk = D[index], G[index]
             pred = np.einsum("kij,jl,kl->ki", Dk, A0, n_N)
             y = n_B - pred
@@ -183,13 +186,13 @@ class NadirHistory:
         n_B = np.array([b for _, b, _ in self.nadir])
         n_N = np.array([r for _, _, r in self.nadir])
         # the first nadir in the start's frame, with no bias: A0 n_N[0] = D_0^T n_B[0]
-        D, _ = _integrate(rates, h, np.zeros(3))
-        u = D[index[0]].T @ n_B[0]
+        unbiased = _integrate(rates, h, np.zeros(3))  # every start's first iteration
+        u = unbiased[0][index[0]].T @ n_B[0]
         base = _turning(n_N[0], u)
         best = None
         for i in range(YAW_GUESSES):
             start = _rotation(u * (2.0 * math.pi * i / YAW_GUESSES)) @ base
-            fit = self._fit(start, np.zeros(3), rates, h, index, n_B, n_N, SCREEN_ITERATIONS)
+            fit = self._fit(start, np.zeros(3), rates, h, index, n_B, n_N, SCREEN_ITERATIONS, unbiased)
             if best is None or fit[2] < best[2]:
                 best = fit
         A0, bias, _ = self._fit(best[0], best[1], rates, h, index, n_B, n_N, MAX_ITERATIONS)
