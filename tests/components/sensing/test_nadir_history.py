@@ -12,6 +12,7 @@ from components.core.constants import MU_EARTH, R_EQ
 from components.mission.neighbor import SPACECRAFT
 from components.sensing import triad
 from components.sensing.mekf import AttitudeEstimator, AttitudeMEKF
+from components.sensing import nadir_history
 from components.sensing.nadir_history import NadirHistory
 from components.sensing.sensors import Gyro, HorizonSensor
 
@@ -143,3 +144,17 @@ def test_the_history_is_part_of_the_state():
     history.solve(a)
     copy.solve(b)
     assert a.get_state() == b.get_state()
+
+
+def test_the_gyro_integration_is_the_same_with_and_without_numba():
+    """The compiled element loops and numpy's products (the path without numba) agree to rounding,
+    a still step and a zero-length one included."""
+    rng = np.random.default_rng(8)
+    rates = rng.normal(0.0, 0.2, (2001, 3))
+    rates[10:12] = 0.0
+    h = np.full(2000, STEP)
+    h[5] = 0.0
+    for bias in (np.zeros(3), rng.normal(0.0, SIGMA_BIAS0, 3)):
+        looped = nadir_history._looped_integrate(rates, h, bias)
+        for a, b in zip(looped, nadir_history._integrate_numpy(rates, h, bias)):
+            np.testing.assert_allclose(a, b, rtol=0.0, atol=1e-12 * max(1.0, np.abs(a).max()))
