@@ -5,8 +5,8 @@ the Sun vector gives TRIAD. Over time the nadir turns in inertial space (at the 
 about the orbit normal) and the body turns under the gyro: with the gyro carrying the body from
 one sample to the next, nadir vectors taken at different times are different directions in one
 frame, and together they fix the whole attitude and the gyro's bias. This is the single-vector
-attitude problem with a gyro (observable when the reference direction moves; Markley and
-Crassidis 2014, section 6.2.4), solved here in two passes over the stored samples:
+attitude problem with a gyro, observable when the reference direction moves, solved here in two
+passes over the stored samples:
 
 1. Batch least squares (Gauss-Newton) for the attitude A0 at the history's start and the gyro
    bias b: the body's rotation from the start to sample k, D_k, is integrated from the gyro less
