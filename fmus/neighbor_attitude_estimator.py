@@ -21,7 +21,8 @@ bias is reopened and learned again (mekf.InnovationMonitor), and `bias_resets` c
 The fix without the Sun (appended last): with `nadir_history_time` > 0 the estimator keeps the
 horizon sensor's and the gyro's samples until a fix; once they span that long and the spacecraft
 has been sunlit for `sun_missing_time` with no Sun vector (every Sun sensor failed), the attitude
-and the gyro bias come from the history (components/sensing/nadir_history.py) and
+and the gyro bias come from the history (components/sensing/nadir_history.py; while two
+attitudes fit it alike, as for a body at rest, no fix: tried again after 120 s more) and
 `attitude_valid` uses `valid_sigma_without_sun` until a Sun vector is seen again.
 """
 import math

@@ -26,8 +26,8 @@ import numpy as np
 
 from ..core import rotations
 from ..core import jit
-from ..core.constants import R_EQ
 from ..core.jit import njit
+from ..environment.eclipse import sunlit_fraction
 from . import triad
 from .nadir_history import NadirHistory
 
@@ -590,7 +590,7 @@ class AttitudeEstimator:
 
     def _from_history(self, measurements, coarse, omega_meas, h):
         """Before a TRIAD fix: keep the gyro and the horizon sensor's samples, and once the history
-        spans nadir_history_time and the spacecraft has been sunlit (a cylindrical shadow from the
+        spans nadir_history_time and the spacecraft has been sunlit (the conical shadow from the
         GPS position and the Sun's) for sun_missing_time with no Sun vector from any sensor (they
         have failed: the coarse sensors see the Sun whenever it shines), start the filter from the
         history's fix. Until then nothing here changes what the estimator does."""
@@ -604,7 +604,7 @@ class AttitudeEstimator:
             self._mark("nadir", nadir_B)
         if not (sun_valid or coarse is not None) and _sunlit(r_BN_N, r_SN_N):
             self.sunlit_without_sun += h
-        if not (new and self.history.span >= self.nadir_history_time - 1e-9
+        if not (new and self.history.span >= max(self.nadir_history_time, self.history.next_try) - 1e-9
                 and self.sunlit_without_sun >= self.sun_missing_time - 1e-9):
             return
         if self.history.solve(self.filter) is None:
@@ -646,12 +646,9 @@ class AttitudeEstimator:
 
 
 def _sunlit(r_BN_N, r_SN_N):
-    """In sunlight by a cylindrical Earth shadow (the Sun's direction from the Earth's centre)."""
-    s = r_SN_N
-    sn = rotations.norm(s)
-    if sn == 0.0:
-        return True
-    along = rotations.dot(r_BN_N, s) / sn
-    if along >= 0.0:
-        return True
-    return rotations.dot(r_BN_N, r_BN_N) - along * along > R_EQ * R_EQ
+    """Some of the Sun's disk seen past the Earth (the conical shadow of
+    components.environment.eclipse). Positions not set yet (zero: no shadow to compute) are not."""
+    try:
+        return sunlit_fraction(r_BN_N, r_SN_N) > 0.0
+    except ValueError:
+        return False
