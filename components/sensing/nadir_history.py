@@ -15,16 +15,18 @@ passes over the stored samples:
    position. Linearized about (A0, b): y_k = [n_k x](D_k dtheta0 - G_k db), G_{k+1} = M_k G_k + h I
    (M_k the step's rotation), the MEKF's error dynamics. The rotation about the first nadir is
    unknown, so the iterations start from 12 guesses 30 deg apart about it (bias 0), each run to
-   its minimum; the best is kept unless another attitude fits about as well (ambiguous: no fix).
-   This pass finds the basin; its estimate is not the answer, since over 20 minutes the gyro's
-   noise turns the integrated body by about half a degree (a random walk), which the exact-gyro
-   fit absorbs into a wrong start and bias (2 deg and 3 deg in one 475 km mission).
+   its minimum, and from the best one's mirror image (_mirrors); the distinct minima that fit
+   nearly as well as the best go on to step 2. This pass finds the basin; its estimate is not
+   the answer, since over 20 minutes the gyro's noise turns the integrated body by about half a
+   degree (a random walk), which the exact-gyro fit absorbs into a wrong start and bias (2 deg
+   and 3 deg in one 475 km mission).
 2. Smoothing with the gyro's noise: the attitude at knots KNOT_SPACING apart and the bias, each
    nadir sample tied to its knot by the gyro as above, consecutive knots tied by the gyro with
    the noise the filter assumes (sigma_v^2 per second per axis), the bias by the filter's prior;
    Gauss-Newton from the first pass. The normal equations are block tridiagonal in the knots
    with the bias coupled to all (solved by block elimination and the bias' Schur complement), so
-   the cost grows with the history's length. The last knot is the last sample: the filter
+   the cost grows linearly with the history's length. The best smoothed fit wins unless another distinct
+   one fits about as well (ambiguous: no fix yet). The last knot is the last sample: the filter
    starts there with the estimate and the joint covariance of its attitude and the bias.
 
 An earlier version ran the MEKF over the samples from the first pass' start in place of step 2:
@@ -32,9 +34,11 @@ started several degrees off with a 5 deg sigma, its linearization settled on a w
 with a narrow covariance (the 475 km mission's run 7: 4.4 deg off claiming 0.4 deg per axis, NEES
 52; from the same data the smoothing is 1.6 deg off with 0.55-0.69 deg per axis, NEES 3.0).
 
-Measured (tests/components/sensing/test_nadir_history.py; 420 km, BMG160 gyro, 0.25 deg horizon
-sensor, a bias of 1 mrad/s per axis, 1200 s): a body tumbling at 10-15 deg/s or turning at the
-bias rate alone ends within about 1 deg, consistent with the covariance; the solve takes 1-3 s.
+Measured (bench/bench_nadir_history.py on the flight of tests/components/sensing/
+test_nadir_history.py: 420 km, BMG160 gyro, 0.25 deg horizon sensor, a bias of 1 mrad/s per axis,
+1200 s): a body tumbling at 5-13.5 deg/s ends 0.03-0.55 deg off, turning at the bias rate alone
+within 4 deg (2 of 12 without a fix), consistent with the covariance (mean NEES 2.4); the solve
+takes 1-3 s.
 """
 import math
 
@@ -287,7 +291,7 @@ class NadirHistory:
         bias = np.array(bias, dtype=float)
         var_v = sigma_v ** 2
         # the measurement's noise per axis, and the gyro's between the sample and its knot
-        w = 1.0 / ((self.nadir_sigma / math.sqrt(2.0)) ** 2 + var_v * (t[index] - t[knots[seg]]))
+        w = 1.0 / ((max(self.nadir_sigma, 1e-6) / math.sqrt(2.0)) ** 2 + var_v * (t[index] - t[knots[seg]]))
         q_link = 1.0 / (var_v * np.diff(t[knots]))
         for _ in range(MAX_ITERATIONS):
             D, G = _integrate(rates, h, bias)
