@@ -341,12 +341,14 @@ def _mirrors(A0, bias, t, index, n_N):
     the body A_k R_k with R_k = R_o(2 a_k) R_pi(n_m) sees every nadir as A_k does. For a body
     at rest in inertial space that is a body turning at 2 w about o, which a bias error of that
     size gives the gyro: the same fit exactly. Either sign of the bias error is returned."""
-    first, last = n_N[0], n_N[-1]
-    normal = np.cross(first, last)
+    # o and the angle swept from sample to sample: right for an arc of any length
+    steps = np.cross(n_N[:-1], n_N[1:])
+    normal = steps.sum(axis=0)
     if np.linalg.norm(normal) < 1e-9:
         return []
     o = normal / np.linalg.norm(normal)
-    w = _angle(_turning(first, last)) / (t[index[-1]] - t[index[0]])
+    swept = np.arctan2(steps @ o, np.einsum("ki,ki->k", n_N[:-1], n_N[1:])).sum()
+    w = swept / (t[index[-1]] - t[index[0]])
     mid = n_N[len(n_N) // 2]
     a0 = -w * t[index[len(n_N) // 2]]  # the nadir's angle at the history's start (t = 0) from n_m
     mirror = _rotation(o * 2.0 * a0).T @ (2.0 * np.outer(mid, mid) - np.eye(3))  # active R_o(2 a0) R_pi(n_m)
