@@ -22,7 +22,8 @@ The fix without the Sun (appended last): with `nadir_history_time` > 0 the estim
 horizon sensor's and the gyro's samples until a fix; once they span that long and the spacecraft
 has been sunlit for `sun_missing_time` with no Sun vector (every Sun sensor failed), the attitude
 and the gyro bias come from the history (components/sensing/nadir_history.py; while two
-attitudes fit it alike, as for a body at rest, no fix: tried again after 120 s more) and
+attitudes fit it alike, as for a body at rest, or while its largest 1-sigma exceeds
+`history_fix_sigma`, no fix: tried again after 120 s more) and
 `attitude_valid` uses `valid_sigma_without_sun` until a Sun vector is seen again.
 """
 import math
@@ -120,12 +121,15 @@ class AttitudeEstimator(NeighborSlave):
                        "Without a Sun vector: the span of the horizon sensor's and the gyro's history the first fix "
                        "is taken from once every Sun sensor has failed (>= 0; 0: off, the filter waits for the Sun)")
         self.parameter("sun_missing_time", 300.0, "s",
-                       "Time in sunlight (a cylindrical shadow from r_BN_N and r_SN_N) with no Sun vector from any "
+                       "Time in sunlight (the conical Earth shadow from r_BN_N and r_SN_N) with no Sun vector from any "
                        "sensor after which the Sun sensors are taken as failed (>= 0)")
         self.parameter("valid_sigma_without_sun", math.radians(1.0), "rad",
                        "valid_sigma while the filter has had no Sun vector since a fix from the history, > 0")
         self.output("fixed_without_sun", lambda: self.model.without_sun, None,
                     "The filter started from the horizon sensor's history and has had no Sun vector since", bool)
+        self.parameter("history_fix_sigma", 0.0, "rad",
+                       "The history's fix is taken only once its largest 1-sigma attitude error per axis is this or "
+                       "less, else tried again after 120 s more history (>= 0; 0: any)")
 
     def build_model(self):
         v = self.values
@@ -141,7 +145,8 @@ class AttitudeEstimator(NeighborSlave):
                                       coarse_sun_sigma=v["coarse_sun_sigma"] if v["use_coarse_sun"] else None,
                                       fault_window=v["fault_window"], fault_limit=v["fault_limit"],
                                       nadir_history_time=v["nadir_history_time"],
-                                      sun_missing_time=v["sun_missing_time"])
+                                      sun_missing_time=v["sun_missing_time"],
+                                      history_fix_sigma=v["history_fix_sigma"])
 
     def _q(self):
         return self._outputs()["q"]

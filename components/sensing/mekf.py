@@ -471,7 +471,7 @@ class AttitudeEstimator:
     def __init__(self, nadir_sigma=math.radians(0.25), sun_sigma=math.radians(0.5) / 3.0,
                  sigma_v=5.5e-4 * math.sqrt(0.1), sigma_u=1e-6, sigma_bias0=1e-3, min_separation=math.radians(5.0),
                  inertia=None, accel_sigma=5e-4, update_interval=0.0, coarse_sun_sigma=None, fault_window=0,
-                 fault_limit=3.64, nadir_history_time=0.0, sun_missing_time=300.0):
+                 fault_limit=3.64, nadir_history_time=0.0, sun_missing_time=300.0, history_fix_sigma=0.0):
         self.triad = triad.AttitudeDetermination(nadir_sigma, sun_sigma, min_separation=min_separation)
         self.coarse_triad = None if coarse_sun_sigma is None else \
             triad.AttitudeDetermination(nadir_sigma, coarse_sun_sigma, min_separation=min_separation)
@@ -494,6 +494,9 @@ class AttitudeEstimator:
         # without a Sun vector: the fix from the horizon sensor's history (nadir_history.py)
         self.nadir_history_time = _sigma("nadir_history_time", nadir_history_time, "s")
         self.sun_missing_time = _sigma("sun_missing_time", sun_missing_time, "s")
+        # the history's fix is taken once its largest 1-sigma is this or less (0: any): in a weak
+        # geometry a longer arc narrows it (nadir_history.py)
+        self.history_fix_sigma = _sigma("history_fix_sigma", history_fix_sigma, "rad")
         self.history = NadirHistory(self.triad.nadir_sigma, self.sigma_bias0) \
             if self.nadir_history_time > 0.0 else None
         self.sunlit_without_sun = 0.0  # s in sunlight with no Sun vector, before the first fix
@@ -607,7 +610,7 @@ class AttitudeEstimator:
         if not (new and self.history.span >= max(self.nadir_history_time, self.history.next_try) - 1e-9
                 and self.sunlit_without_sun >= self.sun_missing_time - 1e-9):
             return
-        if self.history.solve(self.filter) is None:
+        if self.history.solve(self.filter, self.history_fix_sigma or math.inf) is None:
             return
         self.without_sun = True
         self.history.clear()

@@ -226,11 +226,12 @@ class NadirHistory:
                 break
         return A0, bias, cost
 
-    def solve(self, f):
+    def solve(self, f, max_sigma=math.inf):
         """Start the filter `f` (a mekf.AttitudeMEKF, whose gyro noise sigma_v the smoothing
         takes) at the last nadir sample with the history's estimate and covariance. Returns f, or
-        None (f untouched) with fewer than 10 nadir samples or when two distinct attitudes fit
-        the history alike (then `next_try` is RETRY_TIME further along the history)."""
+        None (f untouched) with fewer than 10 nadir samples, when two distinct attitudes fit the
+        history alike, or when the estimate's largest 1-sigma per axis exceeds max_sigma (rad;
+        then `next_try` is RETRY_TIME further along the history, which narrows it)."""
         if len(self.nadir) < 10:
             return None
         last = self.nadir[-1][0]
@@ -264,6 +265,9 @@ class NadirHistory:
         A, bias, cov, cost = smoothed[0]
         if any(_angle(other @ A.T) > DISTINCT_ANGLE and other_cost - cost < AMBIGUOUS_CHI2
                for other, _, _, other_cost in smoothed[1:]):
+            self.next_try = self.span + RETRY_TIME
+            return None
+        if math.sqrt(max(cov[0, 0], cov[1, 1], cov[2, 2])) > max_sigma:
             self.next_try = self.span + RETRY_TIME
             return None
         f.initialize(rotations.dcm_to_quaternion(A.tolist()), math.sqrt(max(cov[0, 0], cov[1, 1], cov[2, 2])),

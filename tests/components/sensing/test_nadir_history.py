@@ -98,6 +98,15 @@ def test_a_body_at_rest_gives_no_fix_and_a_later_try():
     assert copy.next_try == history.next_try
 
 
+def test_a_fix_wider_than_asked_waits_for_more_history():
+    q_true, _, history = _fly(1, 10.0, duration=600.0)
+    f = AttitudeMEKF(GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), 1e-6)
+    assert history.solve(f, max_sigma=math.radians(0.01)) is None and not f.initialized
+    assert history.next_try == pytest.approx(history.span + nadir_history.RETRY_TIME)
+    assert history.solve(f, max_sigma=math.radians(1.0)) is f
+    assert max(f.attitude_sigma()) <= math.radians(1.0) and f.attitude_nees(q_true) < CHI2_3_999
+
+
 def test_too_few_samples_give_no_fix():
     history = NadirHistory(NADIR_SIGMA, SIGMA_BIAS0)
     history.add((0.0, 0.0, 0.0))
@@ -145,9 +154,9 @@ def test_an_ambiguous_history_is_tried_again_later_not_at_every_sample(monkeypat
     tries = []
     solve = NadirHistory.solve
 
-    def counted(history, f):
+    def counted(history, f, max_sigma):
         tries.append(history.span)
-        return solve(history, f)
+        return solve(history, f, max_sigma)
 
     monkeypatch.setattr(NadirHistory, "solve", counted)
     estimator, _, _ = _estimate(600.0, sun_seen=False, duration=1000.0, at_rest=True)
