@@ -72,12 +72,7 @@ def _skew(v):
 def _integrate_numpy(rates, h, bias):
     """_integrate without numba: the steps' rotations built at once, the products in numpy (the
     element loops in plain Python would take a minute for 20 minutes of 0.1 s samples)."""
-    w = 0.5 * (rates[:-1] + rates[1:]) - bias
-    wn = np.linalg.norm(w, axis=1)
-    angle = wn * h
-    e = np.divide(w, wn[:, None], out=np.zeros_like(w), where=wn[:, None] > 0.0)
-    c, s = np.cos(angle)[:, None, None], np.sin(angle)[:, None, None]
-    M = c * np.eye(3) + (1.0 - c) * np.einsum("ki,kj->kij", e, e) - s * _skew(e)
+    M = _rotations((0.5 * (rates[:-1] + rates[1:]) - bias) * h[:, None])
     n = h.shape[0]
     D = np.empty((n + 1, 3, 3))
     G = np.empty((n + 1, 3, 3))
