@@ -1,7 +1,8 @@
 """The mission off the thesis' nominal point: examples/campaigns/mission_dispersion_<scenario>.toml
 (closed-loop guidance and control on the attitude estimator; tumble up to 15 deg/s per axis in
-either sense, mass 10-14 kg, thrusters misaligned and off in force, gyro bias and sensor noise; the 475 and 525 km
-campaigns extend the 420 km one) through the campaign runner on Dask.
+either sense, mass 10-14 kg, inertia within 10 % of the box the flight software assumes, thrusters
+misaligned and off in force, gyro bias and sensor noise; the 475 and 525 km campaigns extend the
+420 km one) through the campaign runner on Dask.
 
     python bench/bench_dispersion.py                        # 100 runs at 420 km (about 80 min on 2 cores)
     python bench/bench_dispersion.py --scenario 525km --runs 20 --workers 16

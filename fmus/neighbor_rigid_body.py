@@ -18,6 +18,11 @@ propellant_used + rcs_propellant kg left the tank at the NEIGHBOR module's centr
 (components.attitude.mass_properties), recomputed before a step once 0.1 g more has been drawn;
 `center_of_mass_B` says where it moved. Off, or with less than 0.1 g drawn, the model is the
 fixed-inertia one bit for bit.
+
+The body's own inertia (appended last): `inertia_error` scales its second moments of mass along
+x, y and z against the nominal inertia (box or inertia_B), which the flight software keeps
+(components.attitude.mass_properties.with_moment_errors: a real mass distribution for any error
+in range); the dispersion campaigns draw it. Zero, the model is the nominal one bit for bit.
 """
 
 from neighbor_fmu_support import NeighborSlave
@@ -82,9 +87,14 @@ class RigidBody(NeighborSlave):
                    "with propellant_mass_properties")
         self.output_array("center_of_mass_B", 3, lambda: m().center_of_mass, "m",
                           "Centre of mass in B relative to the one at takeover (moves to +x as the tank empties)")
+        # The body's own inertia off the nominal one (appended last, issue 28's dispersions)
+        self.parameter_array("inertia_error", [0.0, 0.0, 0.0], "1",
+                             "Fractional error of the body's second moment of mass along body x, y, z (the integral "
+                             "of x_i^2 dm) against the nominal inertia (the box, or inertia_B) the flight software "
+                             "assumes, in [-0.5, 0.5]; 0: the nominal inertia")
 
     def build_model(self):
-        J = self.inertia(rigid_body.box_inertia)
+        J = mass_properties.with_moment_errors(self.inertia(rigid_body.box_inertia), self.vector("inertia_error", 3))
         euler0 = None if self.values["euler0_from_q0"] else self.vector("euler0", 3)
         self._tank = mass_properties.tank_position(self.values["edge_a"], self.values["edge_c"])
         return rigid_body.RigidBody(J, self.vector("q0", 4), self.vector("omega0", 3),

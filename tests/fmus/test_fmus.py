@@ -6,10 +6,12 @@ import re
 import zipfile
 
 import fmpy
+import numpy as np
 import pytest
 
 import build_fmus
 from build_fmus import wrapper_scripts
+from components.attitude import mass_properties, rigid_body
 from fmu_helpers import check_declarations, instantiate
 
 EXPECTED = {"RigidBody", "DetumbleController", "SlewController", "RcsThrusters"}
@@ -83,6 +85,24 @@ def test_each_fmu_simulates_alone(fmu_paths):
     assert list(r["thrust_flag[2]"][:3]) == [-1, -1, -1] and not r["done"][-1]
     r = fmpy.simulate_fmu(str(fmu_paths["SlewController"]), stop_time=0.1, output_interval=0.01)
     assert r["done"][-1] and r["attitude_error"][-1] == 0.0
+
+
+def test_rigid_body_with_its_inertia_off_the_nominal_one(fmu_paths, capsys):
+    """inertia_error (issue 28's dispersions): the body's momentum at the start is J' omega0 with
+    J' the box's second moments scaled; none given, the box's; out of range, refused and said."""
+    from fmpy.fmi1 import FMICallException
+
+    box = rigid_body.box_inertia(12.0, 0.1, 0.2, 0.3)
+    spin = {"omega0[1]": 0.1, "omega0[2]": -0.2, "omega0[3]": 0.3}
+    errors = {"inertia_error[1]": 0.1, "inertia_error[2]": -0.1, "inertia_error[3]": 0.05}
+    for start, J in (({}, box), (errors, mass_properties.with_moment_errors(box, (0.1, -0.1, 0.05)))):
+        r = fmpy.simulate_fmu(str(fmu_paths["RigidBody"]), stop_time=0.03, output_interval=0.015,
+                              start_values={**spin, **start})
+        H = np.array(J) @ np.array([0.1, -0.2, 0.3])
+        assert [r[f"H_B[{i}]"][0] for i in (1, 2, 3)] == pytest.approx(H, rel=1e-12)
+    with pytest.raises(FMICallException):
+        fmpy.simulate_fmu(str(fmu_paths["RigidBody"]), stop_time=0.03, start_values={"inertia_error[2]": 0.7})
+    assert "inertia errors [0.0, 0.7, 0.0] must be three fractions in [-0.5, 0.5]" in capsys.readouterr().out
 
 
 def _instance(path, tmp_path, name):

@@ -1,9 +1,10 @@
 """The mission off the thesis' nominal point in its three scenarios: the first runs of
 examples/campaigns/mission_dispersion_<scenario>.toml (closed-loop guidance and control on the
-attitude estimator, tumble up to 15 deg/s per axis in either sense, mass 10-14 kg, thrusters
-misaligned up to 1 deg and off by up to 5 % in force, gyro bias and sensor noise with seeds of
-their own, one fault in a fifth of the runs) through the campaign runner on Dask: six at 420 km,
-two at 475 km and two at 525 km (whose burns are 1.7 and 3 times longer). Every run that has an
+attitude estimator, tumble up to 15 deg/s per axis in either sense, mass 10-14 kg, inertia within
+10 % of the box the flight software assumes, thrusters misaligned up to 1 deg and off by up to 5 %
+in force, gyro bias and sensor noise with seeds of their own, one fault in a fifth of the runs)
+through the campaign runner on Dask: six at 420 km, two at 475 km and two at 525 km (whose burns
+are 1.7 and 3 times longer). Every run that has an
 attitude finds it, detumbles, slews without a timeout, burns its whole budget within the
 scenario's propellant allowances and re-enters within 5 years of the burn; a run with every Sun
 sensor dead takes its first fix from the horizon sensor's history and flies the same de-orbit.
@@ -56,6 +57,9 @@ def _check(scenario, summary, rows):
         assert min(masses) < 12.0 and max(masses) > 13.0  # lighter and heavier than the nominal 12 kg
         errors = [r[f"thrusters.force_error[{i}]"] for r in rows for i in range(1, 17)]
         assert min(errors) < -0.04 and max(errors) > 0.04 and max(map(abs, errors)) <= 0.05
+        # the body's own inertia off the box the flight software assumes, both ways
+        inertia = [r[f"dynamics.inertia_error[{i}]"] for r in rows for i in (1, 2, 3)]
+        assert min(inertia) < -0.08 and max(inertia) > 0.08 and max(map(abs, inertia)) <= 0.1
         # run 4's x+1 thruster is dead from the start; the rate response names it with x-1 (bits 0
         # and 2): in its fast detumble the x+ command stays on, and "x+1 stuck off" and "x-1 stuck on"
         # then act at the same times, so both valves are closed (components/attitude/thruster_monitor.py)

@@ -338,13 +338,16 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
             later = ([f"euler_integrated[{i}]" for i in (1, 2, 3)] + ["euler0_from_q0"]
                      + [f"euler0[{i}]" for i in (1, 2, 3)])
             # then the mass properties that follow the tank (issue 28)
-            last = (["propellant_mass_properties", "propellant_used", "rcs_propellant"]
+            tank = (["propellant_mass_properties", "propellant_used", "rcs_propellant"]
                     + [f"center_of_mass_B[{i}]" for i in (1, 2, 3)])
-            assert names[-19:-13] == new and names[-20] == "H_B[3]" and names[-13:-6] == later
-            assert names[-6:] == last
-            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-19])
+            # then the body's own inertia off the nominal one (issue 28's dispersions)
+            last = [f"inertia_error[{i}]" for i in (1, 2, 3)]
+            assert names[-22:-16] == new and names[-23] == "H_B[3]" and names[-16:-9] == later
+            assert names[-9:-3] == tank and names[-3:] == last
+            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-22])
             assert min(vr[n] for n in later) > max(vr[n] for n in new)
-            assert min(vr[n] for n in last) > max(vr[n] for n in later)
+            assert min(vr[n] for n in tank) > max(vr[n] for n in later)
+            assert min(vr[n] for n in last) > max(vr[n] for n in tank)
             assert names.index("torque_B[1]") < names.index("q_BN[1]")
 
 

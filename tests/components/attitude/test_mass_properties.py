@@ -61,6 +61,43 @@ def test_drawn_propellant_outside_the_body_is_refused(dm):
         mass_properties.drawn(rigid_body.box_inertia(12.0, A, B, C).tolist(), 12.0, dm, TANK)
 
 
+def test_moment_errors_scale_the_body_along_its_axes():
+    """with_moment_errors against bodies of point masses whose coordinates are stretched by
+    sqrt(1 + e_i) along each axis (which scales their second moments by 1 + e_i): a box (the
+    analytic box of stretched edges) and a lopsided cloud with products of inertia."""
+    e = (0.1, -0.1, 0.07)
+    stretch = np.sqrt(1.0 + np.array(e))
+    J = mass_properties.with_moment_errors(rigid_body.box_inertia(12.0, A, B, C), e)
+    # edge c along x, a along y, b along z
+    box = rigid_body.box_inertia(12.0, A * stretch[1], B * stretch[2], C * stretch[0])
+    assert np.allclose(J, box, rtol=1e-13, atol=0.0)
+    rng = np.random.default_rng(4)
+    points = rng.normal(size=(60, 3)) * (0.15, 0.05, 0.1) + (0.02, -0.01, 0.03)
+    masses = rng.uniform(0.1, 0.3, 60)
+    J0, _ = _inertia_about_centre(points, masses)
+    assert abs(J0[0, 1]) > 1e-4  # products of inertia present
+    J1, _ = _inertia_about_centre(points * stretch, masses)
+    assert np.allclose(mass_properties.with_moment_errors(J0.tolist(), e), J1, rtol=1e-12, atol=1e-15)
+
+
+def test_moment_errors_keep_a_real_body_where_moment_errors_would_not():
+    """Errors of 10 % on the box's moments themselves could break the triangle inequality (0.13 <=
+    0.05 + 0.10 is 0.02 from its edge): the second moments' errors never do, and move each moment by
+    at most 10 %; zero errors give the nominal inertia itself, bit for bit."""
+    J0 = rigid_body.box_inertia(12.0, A, B, C)
+    d = np.diag(J0)
+    assert d[1] * 1.1 > d[0] * 0.9 + d[2] * 0.9  # the moments themselves, off by 10 %: no body
+    for e in itertools.product((-0.1, 0.0, 0.1), repeat=3):
+        J = np.array(mass_properties.with_moment_errors(J0, e))
+        rigid_body.check_inertia(J)  # a real body
+        assert np.all(np.abs(np.diag(J) / d - 1.0) <= 0.1 + 1e-12)
+    nominal = mass_properties.with_moment_errors(J0, (0.0, 0.0, 0.0))
+    assert nominal == tuple(tuple(float(x) for x in row) for row in J0)
+    for bad in ((0.6, 0.0, 0.0), (0.0, math.nan, 0.0), (0.1, 0.1)):
+        with pytest.raises(ValueError, match="inertia errors"):
+            mass_properties.with_moment_errors(J0, bad)
+
+
 def test_inverse_of_a_full_inertia():
     J = ((0.05, 0.001, -0.002), (0.001, 0.13, 0.003), (-0.002, 0.003, 0.1))
     assert np.allclose(np.array(mass_properties.inverse(J)) @ np.array(J), np.eye(3), rtol=0, atol=1e-13)
