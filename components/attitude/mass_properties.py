@@ -69,9 +69,9 @@ def with_moment_errors(inertia, errors):
     """The inertia (3x3 tuples, kg m2) of a body whose second moments of mass along its axes are
     (1 + errors[i]) times those of a body of inertia `inertia` (module docstring); `inertia`
     itself, unchanged, when every error is 0."""
-    e = tuple(float(x) for x in errors)
-    if len(e) != 3 or not all(math.isfinite(x) and -0.5 <= x <= 0.5 for x in e):
-        raise ValueError(f"inertia errors {list(errors)} must be three fractions in [-0.5, 0.5]")
+    e = checks.finite_vector(errors, 3, "inertia errors", "fractions in [-0.5, 0.5]")
+    if not all(-0.5 <= x <= 0.5 for x in e):
+        raise ValueError(f"inertia errors {list(e)} must be 3 fractions in [-0.5, 0.5]")
     J = tuple(tuple(float(x) for x in row) for row in inertia)
     if not any(e):
         return J

@@ -102,7 +102,7 @@ def test_rigid_body_with_its_inertia_off_the_nominal_one(fmu_paths, capsys):
         assert [r[f"H_B[{i}]"][0] for i in (1, 2, 3)] == pytest.approx(H, rel=1e-12)
     with pytest.raises(FMICallException):
         fmpy.simulate_fmu(str(fmu_paths["RigidBody"]), stop_time=0.03, start_values={"inertia_error[2]": 0.7})
-    assert "inertia errors [0.0, 0.7, 0.0] must be three fractions in [-0.5, 0.5]" in capsys.readouterr().out
+    assert "inertia errors [0.0, 0.7, 0.0] must be 3 fractions in [-0.5, 0.5]" in capsys.readouterr().out
 
 
 def _instance(path, tmp_path, name):
