@@ -80,7 +80,8 @@ def _check(scenario, summary, rows):
         # nadir, whose error grows with the gyro bias' error over the burn, and the filter says so
         # (475 km run 0: 3.0 deg at most in its 69 min burn, the sigma about the nadir, body z,
         # 2.1 deg at its end, the error's RMS 0.7 sigma about that axis and 0.9-1.0 about the
-        # others; the same run before the inertia was drawn reached 4.8 deg, 2.4 sigma)
+        # others; the same run before the inertia was drawn reached 4.8 deg, 2.4 sigma). Not yet in
+        # every long burn: 525 km run 28, outside the suite, drifted to 11 deg with NEES 7.6 (open)
         without_sun = r["fault"] == "all_sun_sensors_dead"
         assert 0.0 < r["knowledge_error_max_rad"] < math.radians(8.0 if without_sun else 5.0), r
         assert 2.0 < r["nees_mean"] < 4.0 and r["nees_over_fraction"] < (0.10 if without_sun else 0.08), r
