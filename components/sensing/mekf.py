@@ -75,9 +75,11 @@ def _propagated_covariance(P, w0, w1, w2, h, qv, qu):
 
 
 @njit(cache=True)
-def _vector_update(P, b_hat, y, r):
+def _vector_update(P, b_hat, y, r, update_bias):
     """One vector measurement: H = [[b_hat x], 0], S = H P H^T + r I, K = P H^T S^-1, dx = K y,
-    P <- (I - K H) P (I - K H)^T + r K K^T (Joseph form). Returns (P, dx, y^T S^-1 y)."""
+    P <- (I - K H) P (I - K H)^T + r K K^T (Joseph form). Without update_bias the bias rows of K
+    are zero: the bias is held, a consider state as in Schmidt's filter (the Joseph form holds for
+    any gain, so P stays the covariance of the errors). Returns (P, dx, y^T S^-1 y)."""
     H = np.zeros((3, 6))
     H[0, 1], H[0, 2], H[1, 0] = -b_hat[2], b_hat[1], b_hat[2]
     H[1, 2], H[2, 0], H[2, 1] = -b_hat[0], -b_hat[1], b_hat[0]
@@ -99,6 +101,10 @@ def _vector_update(P, b_hat, y, r):
     S_inv[1, 2] = (S[0, 2] * S[1, 0] - S[0, 0] * S[1, 2]) / det
     S_inv[2, 2] = (S[0, 0] * S[1, 1] - S[0, 1] * S[1, 0]) / det
     K = _product(PHt, S_inv, False)
+    if not update_bias:
+        for i in range(3, 6):
+            for k in range(3):
+                K[i, k] = 0.0
     dx = np.zeros(6)
     for i in range(6):
         for k in range(3):
@@ -192,9 +198,11 @@ class AttitudeMEKF:
         self.P = _propagated_covariance(self.P, float(w[0]), float(w[1]), float(w[2]), float(h),
                                         self.sigma_v ** 2, self.sigma_u ** 2)
 
-    def update(self, b_meas, r_ref, sigma):
+    def update(self, b_meas, r_ref, sigma, update_bias=True):
         """Fuse one measured unit vector b_meas (B) of the reference direction r_ref (N). Returns
-        (normalized innovation squared y^T S^-1 y, |y|^2) of the update, y = b_meas - b_hat."""
+        (normalized innovation squared y^T S^-1 y, |y|^2) of the update, y = b_meas - b_hat.
+        Without update_bias the bias estimate is held (a consider state) and only the attitude
+        is corrected; the covariance stays that of the errors, the bias' growing by its random walk."""
         self._need()
         b = np.array(triad._unit(b_meas, "measured vector"))
         r = triad._unit(r_ref, "reference vector")
@@ -202,7 +210,7 @@ class AttitudeMEKF:
         A = rotations.attitude_matrix(self.q)
         b_hat = np.array([A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] for i in range(3)])
         y = b - b_hat
-        self.P, dx, nis = _vector_update(self.P, b_hat, y, s * s)
+        self.P, dx, nis = _vector_update(self.P, b_hat, y, s * s, bool(update_bias))
         dq = rotations.quaternion_rate(self.q, dx[:3])  # 1/2 Xi(q) dtheta
         self.q = rotations.normalized(tuple(qi + di for qi, di in zip(self.q, dq)), "q")
         self.bias = self.bias + dx[3:]
@@ -501,6 +509,17 @@ class AttitudeEstimator:
             if self.nadir_history_time > 0.0 else None
         self.sunlit_without_sun = 0.0  # s in sunlight with no Sun vector, before the first fix
         self.without_sun = False  # the filter started from the history and has had no Sun vector since
+        # ... and its gyro bias is held since (a consider state): in the burn the body turns with
+        # the orbit, about the orbit normal at the orbital rate, and the nadir is the only vector; a
+        # bias along the track (normal to the nadir in the orbit plane) then drifts the nadir as a
+        # rotation about the nadir of bias / orbital rate does (gyrocompassing): the data cannot
+        # tell the two apart. The filter moved along that combination anyway (525 km run 28: its
+        # bias along x walked 0.011 deg/s, 11 deg about the nadir by the end of a 118 min burn, 5
+        # sigma). So the bias stays what the history's fix learned over the tumble, its covariance
+        # growing by the random walk the filter assumes, until a Sun vector comes or the bias is
+        # reopened. Holding only its part along the track did no better in the campaigns' runs
+        # without the Sun (docs/models/sensing.md).
+        self.bias_held = False
 
     @property
     def rate(self):
@@ -558,13 +577,14 @@ class AttitudeEstimator:
                 self._propagate_covariance()  # the covariance must be current before an update
             # watched once the bias is learned (while it is being learned the filter adapts anyway)
             armed = bool(updates and self.innovations.window) and max(f.bias_sigma()) < BIAS_LEARNED * self.sigma_bias0
+            if any(name != "nadir" for name, _, _, _ in updates):
+                self.without_sun = self.bias_held = False  # a Sun vector: the bias observable again
             for name, b, r, sigma in updates:
                 self._mark(name, b)
-                if name != "nadir":
-                    self.without_sun = False
-                if self.innovations.add(*f.update(b, r, sigma), armed):
+                if self.innovations.add(*f.update(b, r, sigma, update_bias=not self.bias_held), armed):
                     f.reopen_bias(self.sigma_bias0, self.innovations.error_variance())
                     self.innovations.restart()
+                    self.bias_held = False  # a bias changed by a fault is learned again from what observes it
         self.held_rate = (float(omega_meas[0]), float(omega_meas[1]), float(omega_meas[2]))
         self.rates.update(f.rate(self.held_rate), h)
 
@@ -612,7 +632,7 @@ class AttitudeEstimator:
             return
         if self.history.solve(self.filter, self.history_fix_sigma or math.inf) is None:
             return
-        self.without_sun = True
+        self.without_sun = self.bias_held = True
         self.history.clear()
 
     def check(self, q_true):
@@ -631,7 +651,8 @@ class AttitudeEstimator:
                 "held_rate": self.held_rate, "updated": dict(self.updated),
                 "seen": {k: list(v) for k, v in self.seen.items()},
                 "history": None if self.history is None else self.history.get_state(),
-                "sunlit_without_sun": self.sunlit_without_sun, "without_sun": self.without_sun}
+                "sunlit_without_sun": self.sunlit_without_sun, "without_sun": self.without_sun,
+                "bias_held": self.bias_held}
 
     def set_state(self, state):
         self.consistency.set_state(state["consistency"])
@@ -646,6 +667,7 @@ class AttitudeEstimator:
         if self.history is not None:
             self.history.set_state(state["history"])
         self.sunlit_without_sun, self.without_sun = float(state["sunlit_without_sun"]), bool(state["without_sun"])
+        self.bias_held = bool(state["bias_held"])
 
 
 def _sunlit(r_BN_N, r_SN_N):

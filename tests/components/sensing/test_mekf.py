@@ -23,7 +23,7 @@ def _noisy(v, sigma, rng):
     return v + rng.normal(0.0, sigma, 3)
 
 
-def _run(seconds, sun=True, seed=1, filt=None, q_true=None, rng=None):
+def _run(seconds, sun=True, seed=1, filt=None, q_true=None, rng=None, update_bias=True):
     """(filter, true q, per-step true errors (rad, about the body axes), per-step 1-sigma)."""
     rng = rng or np.random.default_rng(seed)
     n = 0.00113
@@ -37,7 +37,7 @@ def _run(seconds, sun=True, seed=1, filt=None, q_true=None, rng=None):
     errors, sigmas = [], []
     for _ in range(int(round(seconds / H))):
         A = np.array(rotations.attitude_matrix(q_true))
-        filt.update(_noisy(A @ nadir_N, NADIR_SIGMA, rng), nadir_N, NADIR_SIGMA)
+        filt.update(_noisy(A @ nadir_N, NADIR_SIGMA, rng), nadir_N, NADIR_SIGMA, update_bias)
         if sun:
             filt.update(_noisy(A @ sun_N, SUN_SIGMA, rng), sun_N, SUN_SIGMA)
         dq = rotations.circle_cross(q_true, rotations.conjugate(filt.q))  # true = dq (x) estimate
@@ -93,6 +93,23 @@ def test_eclipse_nadir_only_error_about_nadir_grows_and_the_filter_knows():
     assert np.array(filt.attitude_sigma()).max() > 2.0 * sigma_before.max()
     assert np.degrees(np.abs(err).max()) < 2.0  # the estimated bias keeps the drift small
     assert np.mean(np.abs(err) <= 3.0 * sig) > 0.97
+
+
+def test_a_held_bias_is_a_consider_state_whose_covariance_stays_honest():
+    """Nadir only with the bias held: the updates correct the attitude alone, the bias estimate
+    does not move, its covariance only grows by the random walk the filter assumes, and the
+    covariance still bounds the attitude error."""
+    rng = np.random.default_rng(11)
+    filt, q_true, _, _ = _run(600.0, rng=rng)
+    bias, P_bias = filt.bias.copy(), filt.P[3:, 3:].copy()
+    seconds = 3600.0
+    filt, _, err, sig = _run(seconds, sun=False, filt=filt, q_true=q_true, rng=rng, update_bias=False)
+    assert np.array_equal(filt.bias, bias)
+    # the updates leave the bias block alone; each propagation adds sigma_u^2 h
+    assert filt.P[3:, 3:] == pytest.approx(P_bias + np.eye(3) * filt.sigma_u ** 2 * seconds, rel=1e-9, abs=1e-18)
+    assert np.allclose(filt.P, filt.P.T) and np.all(np.linalg.eigvalsh(filt.P) > 0.0)
+    assert np.mean(np.abs(err) <= 3.0 * sig) > 0.97
+    assert np.degrees(np.abs(err).max()) < 2.0  # the held bias was learned with the Sun: a small drift
 
 
 def test_bad_use_is_refused():

@@ -123,10 +123,11 @@ SUN_N = (1.496e11, 0.0, 0.0)
 def _estimate(history_time, sun_seen, duration=1500.0, seed=5, at_rest=False):
     """The estimator of the mission (coarse Sun sensors standing in for the fine one) on a body
     tumbling at 10 deg/s (or at rest); the Sun vectors come only with sun_seen (else every Sun
-    sensor has failed). Returns (estimator, true q, the estimates at every step)."""
+    sensor has failed). Returns (estimator, true q, the estimates at every step, the bias
+    estimates at every step: None before the first fix)."""
     estimator = AttitudeEstimator(sigma_v=GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), sigma_bias0=SIGMA_BIAS0,
                                   coarse_sun_sigma=math.radians(2.0), nadir_history_time=history_time)
-    estimates = []
+    estimates, biases = [], []
     flight = _flight(seed, 10.0, duration, at_rest)
     next(flight)  # the bias
     next(flight)  # the start: the estimator's first step is the end of the first 0.1 s
@@ -135,18 +136,19 @@ def _estimate(history_time, sun_seen, duration=1500.0, seed=5, at_rest=False):
         sun_B = tuple(np.array(rotations.attitude_matrix(body.q)) @ (s / np.linalg.norm(s)))
         estimator.step((nadir_B, True, (0.0, 0.0, 0.0), False, r, SUN_N), omega, STEP, coarse_sun=(sun_B, sun_seen))
         estimates.append(estimator.filter.q)
-    return estimator, body.q, estimates
+        biases.append(tuple(estimator.filter.bias) if estimator.filter.initialized else None)
+    return estimator, body.q, estimates, biases
 
 
 def test_the_estimator_fixes_from_the_history_when_no_sun_sensor_sees_the_sun():
-    estimator, q_true, _ = _estimate(1200.0, sun_seen=False)
+    estimator, q_true, _, _ = _estimate(1200.0, sun_seen=False)
     assert estimator.filter.initialized and estimator.without_sun
     assert estimator.sunlit_without_sun >= estimator.sun_missing_time
     assert triad.error_angle(estimator.filter.q, q_true) < math.radians(2.0)
     assert estimator.filter.attitude_nees(q_true) < CHI2_3_999
     assert not estimator.history.rates  # the samples are let go once used
     # off (the thesis set): no fix without the Sun
-    off, _, _ = _estimate(0.0, sun_seen=False, duration=300.0)
+    off, _, _, _ = _estimate(0.0, sun_seen=False, duration=300.0)
     assert not off.filter.initialized and off.history is None
 
 
@@ -159,17 +161,50 @@ def test_an_ambiguous_history_is_tried_again_later_not_at_every_sample(monkeypat
         return solve(history, f, max_sigma)
 
     monkeypatch.setattr(NadirHistory, "solve", counted)
-    estimator, _, _ = _estimate(600.0, sun_seen=False, duration=1000.0, at_rest=True)
+    estimator, _, _, _ = _estimate(600.0, sun_seen=False, duration=1000.0, at_rest=True)
     assert not estimator.filter.initialized
     assert len(tries) == 4  # at 600 s of history, then every RETRY_TIME: 720, 840, 960 s
     assert np.diff(tries) == pytest.approx([nadir_history.RETRY_TIME] * 3, abs=0.2)
 
 
 def test_the_history_changes_nothing_while_a_sun_sensor_sees_the_sun():
-    with_history, _, a = _estimate(1200.0, sun_seen=True, duration=200.0)
-    without, _, b = _estimate(0.0, sun_seen=True, duration=200.0)
+    with_history, _, a, _ = _estimate(1200.0, sun_seen=True, duration=200.0)
+    without, _, b, _ = _estimate(0.0, sun_seen=True, duration=200.0)
     assert a == b  # bit for bit, at every step
-    assert not with_history.without_sun and not with_history.history.rates
+    assert not with_history.without_sun and not with_history.bias_held and not with_history.history.rates
+
+
+def test_after_the_fix_without_the_sun_the_bias_is_held_until_a_sun_vector_comes(monkeypatch):
+    """After the history's fix every update holds the gyro bias the fix learned over the tumble
+    (the nadir alone in a slow turn with the orbit would move it along what it cannot observe); a
+    Sun vector ends the hold, in the step it comes."""
+    calls = []
+    update = AttitudeMEKF.update
+
+    def recorded(f, b_meas, r_ref, sigma, update_bias=True):
+        calls.append(update_bias)
+        return update(f, b_meas, r_ref, sigma, update_bias)
+
+    monkeypatch.setattr(AttitudeMEKF, "update", recorded)
+    estimator, q_true, _, biases = _estimate(1200.0, sun_seen=False, duration=1700.0)
+    held = [b for b in biases if b is not None]
+    assert estimator.bias_held and estimator.without_sun and len(held) > 100  # fixed a while before the end
+    assert len(calls) > 100 and not any(calls)
+    assert all(b == held[0] for b in held)
+    copy = AttitudeEstimator(sigma_v=GYRO_SIGMA * math.sqrt(GYRO_SAMPLE_TIME), sigma_bias0=SIGMA_BIAS0,
+                             coarse_sun_sigma=math.radians(2.0), nadir_history_time=1200.0)
+    copy.set_state(estimator.get_state())
+    assert copy.bias_held
+    # a coarse Sun vector (a sensor back): the bias is estimated again, from the nadir's update on
+    r = _position(1700.1)
+    A = np.array(rotations.attitude_matrix(q_true))
+    s = np.array(SUN_N) - np.array(r)
+    nadir_B, sun_B = tuple(A @ (-np.array(r) / np.linalg.norm(r))), tuple(A @ (s / np.linalg.norm(s)))
+    calls.clear()
+    estimator.step((nadir_B, True, (0.0, 0.0, 0.0), False, r, SUN_N), estimator.held_rate, STEP,
+                   coarse_sun=(sun_B, True))
+    assert not estimator.bias_held and not estimator.without_sun
+    assert calls == [True, True] and tuple(estimator.filter.bias) != held[-1]
 
 
 def test_the_history_is_part_of_the_state():
