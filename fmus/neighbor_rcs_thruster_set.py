@@ -18,7 +18,9 @@ The stuck-thruster fault and its management (appended after off-pulsing): `stuck
 (components.attitude.thruster_monitor) compares the gyro's rates (`omega_meas_B`) with the
 response the thrusters it opened should give (nominal layout, the inertia of a box of `mass` and
 edges a, b, c), closes the declared thrusters' latch valves and allocates the flags over the
-others; `disabled_mask` (bit i-1 for RCS thruster i) and `fault_time` say what and when.
+others (a pair declared together, one stuck off and one stuck on, is probed below 1 deg/s and the
+healthy one reopened); `disabled_mask` (bit i-1 for RCS thruster i, the valves closed now) and
+`fault_time` (the first declaration) say what and when.
 
 Mass properties and the orbit (appended last): with `propellant_mass_properties` the torques are about
 the centre of mass as propellant leaves the tank at the module's centre (the burn's

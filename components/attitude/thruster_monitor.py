@@ -37,6 +37,21 @@ declared per run.
 Operations choice (docs/models/mission.md, "Faults"): each declared thruster's latch valve is closed
 (components.attitude.thruster_set.ThrusterSet.disable), which also stops a thruster stuck open,
 and the flags are allocated over the others; the mission goes on.
+
+A declaration of two (one stuck off, the other stuck on) closes a healthy valve with the faulty
+one, and its torque direction then has one thruster left (a 525 km dispersed run with x+1 dead on a
+10.2 kg body spent 37 g of RCS with x+1 and x-1 closed, 17.5 g with x-1 left open). So the
+monitor tests it later: once every rate is below `probe_rate` (1 deg/s, past the detumble, where
+the controller rests between pulses) it reopens the thruster named stuck on and evaluates windows
+for that one hypothesis alone. Stuck on, it fires whenever it is closed and is declared again in
+two windows (a second or two of one thruster's torque): its valve is closed for good and the
+other's reopened, since one of the two was the fault. Not declared in `probe_windows` (10) windows
+that could show it (closed for at least half the window), it stays open, and the one named stuck
+off stays closed. Above `max_rate` the probe waits, as every window does (the slew that follows
+the detumble turns at up to 16 deg/s). A probe that has not decided in `probe_limit` (30)
+evaluated windows closes the valve again and leaves both closed: a stuck-on thruster the
+controller keeps commanding (z+near stuck on with z-near closed is the -z command's only thruster
+and part of +z's) fires for 30 of the monitor's windows at most.
 """
 import math
 
@@ -45,6 +60,7 @@ import numpy as np
 from ..core import checks
 
 STUCK_OFF, STUCK_ON = 1, 2  # the modes a detection names
+WAITING, TESTING, DONE = "waiting", "testing", "done"  # the probe of a declaration of two
 
 
 def declarable(group):
@@ -64,7 +80,8 @@ class ThrusterMonitor:
     (rad/s) at that sample time (s), scaled to the step as the gyro's white rate noise."""
 
     def __init__(self, torques, candidates, inertia, rate_sigma, sample_time, window=1.0, confirmations=2,
-                 gate=25.0, model_error=0.1, max_rate=math.radians(10.0)):
+                 gate=25.0, model_error=0.1, max_rate=math.radians(10.0), probe_rate=math.radians(1.0),
+                 probe_windows=10, probe_limit=30):
         J = np.array(inertia, dtype=float).reshape(3, 3)
         if not np.all(np.isfinite(J)) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise ValueError(f"inertia {J.tolist()} must be finite and positive definite (kg.m2)")
@@ -89,7 +106,19 @@ class ThrusterMonitor:
         if not (math.isfinite(self.model_error) and self.model_error >= 0.0):
             raise ValueError(f"model_error = {model_error!r} must be a finite fraction >= 0")
         self.max_rate = checks.positive("max_rate", max_rate, "rad/s")
+        self.probe_rate = checks.positive("probe_rate", probe_rate, "rad/s")
+        if isinstance(probe_windows, bool) or int(probe_windows) != probe_windows or probe_windows < 1:
+            raise ValueError(f"probe_windows = {probe_windows!r} must be an integer >= 1")
+        self.probe_windows = int(probe_windows)
+        if isinstance(probe_limit, bool) or int(probe_limit) != probe_limit or probe_limit < self.probe_windows:
+            raise ValueError(f"probe_limit = {probe_limit!r} must be an integer >= probe_windows "
+                             f"({self.probe_windows})")
+        self.probe_limit = int(probe_limit)
         self.detected = None  # (((thruster index, STUCK_OFF or STUCK_ON), ...), time) once declared
+        # the test of a declaration of two: {"on": index named stuck on, "off": the other, "state":
+        # WAITING/TESTING/DONE, "windows": telling windows, "tested": windows evaluated, "resolved":
+        # ((index, mode), time), or None while testing and when undecided}
+        self.probe = None
         self._candidate, self._count = None, 0
         self._restart()
 
@@ -104,18 +133,29 @@ class ThrusterMonitor:
 
     def step(self, t, omega, opened, h, excluded=()):
         """One step [t, t + h): `omega` the gyro's rates at t, `opened` the thrusters the software
-        opens over the step, `excluded` the thrusters already disabled. Returns the detection the
-        step declared, else None: (((index, mode), ...), time), two pairs when the response cannot
-        tell them apart."""
+        opens over the step, `excluded` the thrusters already disabled. Returns None, or what the
+        valves should do before the step: (close, reopen, time), two tuples of thruster indices
+        (a declaration closes one thruster, or two when the response cannot tell them apart; the
+        probe of such a pair reopens one and then closes or keeps it)."""
         w0, w1, w2 = (float(x) for x in omega)
         largest = max(abs(w0), abs(w1), abs(w2))
+        probe = self.probe
         if not largest <= self.max_rate or h > 0.1 * self.window:  # also a NaN
             self._restart()
             return None
-        declared = None
+        if probe is not None and probe["state"] == WAITING and largest < self.probe_rate:
+            # the window starts at the next step, the first with the reopened valve
+            probe["state"], probe["windows"], probe["tested"] = TESTING, 0, 0
+            self._candidate, self._count = None, 0
+            self._restart()
+            return (), (probe["on"],), float(t)
+        action = None
         self._rates.append((w0, w1, w2))
         if self._elapsed >= self.window - 1e-9:
-            declared = None if self.detected is not None else self._evaluate(excluded, t)
+            if self.detected is None:
+                action = self._declare(excluded, t)
+            elif probe is not None and probe["state"] == TESTING:
+                action = self._test(excluded, t)
             self._restart()
             self._rates.append((w0, w1, w2))
         columns = tuple(self.column[i] for i in opened if i in self.column)
@@ -138,9 +178,38 @@ class ThrusterMonitor:
         self._steps.append((columns, h))
         self._elapsed += h
         self._h = h
-        return declared
+        return action
 
-    def _evaluate(self, excluded, t):
+    def _declare(self, excluded, t):
+        hypothesis = self._evaluate(excluded, t, self.candidates, (STUCK_OFF, STUCK_ON))
+        if hypothesis is None:
+            return None
+        self.detected = (tuple(sorted(hypothesis)), float(t))
+        if len(hypothesis) == 2:
+            (on,) = (i for i, mode in hypothesis if mode == STUCK_ON)
+            (off,) = (i for i, mode in hypothesis if mode == STUCK_OFF)
+            self.probe = {"on": on, "off": off, "state": WAITING, "windows": 0, "tested": 0, "resolved": None}
+        return tuple(sorted(i for i, _ in hypothesis)), (), float(t)
+
+    def _test(self, excluded, t):
+        probe = self.probe
+        on, off = probe["on"], probe["off"]
+        closed = self._elapsed - sum(h for columns, h in self._steps if self.column[on] in columns)
+        if self._evaluate(excluded, t, (on,), (STUCK_ON,)) is not None:
+            probe["state"], probe["resolved"] = DONE, ((on, STUCK_ON), float(t))
+            return (on,), (off,), float(t)
+        probe["tested"] += 1
+        if closed >= 0.5 * self._elapsed:  # a window in which a stuck-on valve would have shown
+            probe["windows"] += 1
+        if probe["windows"] >= self.probe_windows and self._count == 0:
+            probe["state"], probe["resolved"] = DONE, ((off, STUCK_OFF), float(t))
+        elif probe["tested"] >= self.probe_limit:
+            probe["state"] = DONE  # undecided: both closed again
+            return (on,), (), float(t)
+        return None
+
+    def _evaluate(self, excluded, t, candidates, modes):
+        """The window's declaration among `candidates` in `modes` once confirmed, else None."""
         rates = np.array(self._rates)  # the samples at the window's steps, the last at its end
         n = len(rates)
         E = (rates - rates[0]) - np.array(self._predicted[:n])  # (n, 3)
@@ -161,12 +230,13 @@ class ThrusterMonitor:
 
         null = float(misfit(E))
         hypotheses, curves = [], []
-        for i in self.candidates:
+        for i in candidates:
             if i in excluded:
                 continue
             k = self.column[i]
-            hypotheses += [(i, STUCK_OFF), (i, STUCK_ON)]
-            curves += [-opened[:, k], elapsed - opened[:, k]]
+            for mode in modes:
+                hypotheses.append((i, mode))
+                curves.append(-opened[:, k] if mode == STUCK_OFF else elapsed - opened[:, k])
         hypothesis = None
         if hypotheses:
             curves = np.array(curves)  # (hypotheses, n)
@@ -181,8 +251,7 @@ class ThrusterMonitor:
         else:
             self._candidate, self._count = hypothesis, int(hypothesis is not None)
         if hypothesis is not None and self._count >= self.confirmations:
-            self.detected = (tuple(sorted(hypothesis)), float(t))
-            return self.detected
+            return hypothesis
         return None
 
     def get_state(self):
@@ -190,7 +259,10 @@ class ThrusterMonitor:
                 "gyroscopic": [list(g) for g in self._gyroscopic], "steps": [[list(c), h] for c, h in self._steps],
                 "elapsed": self._elapsed, "h": self._h,
                 "candidate": None if self._candidate is None else sorted(self._candidate), "count": self._count,
-                "detected": None if self.detected is None else [list(self.detected[0]), self.detected[1]]}
+                "detected": None if self.detected is None else [list(self.detected[0]), self.detected[1]],
+                "probe": None if self.probe is None else {
+                    **self.probe, "resolved": None if self.probe["resolved"] is None else
+                    [list(self.probe["resolved"][0]), self.probe["resolved"][1]]}}
 
     def set_state(self, state):
         self._rates = [tuple(float(x) for x in w) for w in state["rates"]]
@@ -204,3 +276,12 @@ class ThrusterMonitor:
         self._count = int(state["count"])
         d = state["detected"]
         self.detected = None if d is None else (tuple((int(i), int(mode)) for i, mode in d[0]), float(d[1]))
+        probe = state.get("probe")  # states saved before the probe carry none
+        if probe is None:
+            self.probe = None
+        else:
+            resolved = probe["resolved"]
+            self.probe = {"on": int(probe["on"]), "off": int(probe["off"]), "state": str(probe["state"]),
+                          "windows": int(probe["windows"]), "tested": int(probe["tested"]),
+                          "resolved": None if resolved is None else ((int(resolved[0][0]), int(resolved[0][1])),
+                                                                     float(resolved[1]))}

@@ -161,6 +161,28 @@ def test_a_disabled_thruster_never_fires_and_the_others_take_its_axis(dead):
     assert restored.disabled == {dead} and restored.commanded([1, -1, 1]) == s.commanded([1, -1, 1])
 
 
+@pytest.mark.parametrize("dead", range(12))
+def test_in_the_burn_a_disabled_thruster_leaves_the_side_torque_to_the_axial_thrusters(dead):
+    """In the burn with off-pulsing an x flag opens only what gives x: with an x thruster closed its
+    partner alone (half the torque, its side torque to the off-pulsing), never a y pair beside it;
+    with any other closed, the x pair as before. Reopened, the pairs again."""
+    s = ThrusterSet(off_pulsing=True)
+    s.disable(dead)
+    name = s.layout[dead][0]
+    for sign in (1, -1):
+        opened = s.commanded([sign, 1, -1], axial=True)
+        pair = ThrusterSet(off_pulsing=True).commanded([sign, 0, 0], axial=True)
+        if dead in pair:
+            assert opened == [i for i in pair if i != dead], (name, opened)
+        else:
+            assert opened == pair, (name, opened)
+        _, torque = s.force_and_torque([sign, 0, 0], axial=True)
+        assert sign * torque[0] >= 0.5 * s.levels[0] - 1e-15
+    s.enable(dead)
+    assert s.commanded([1, 1, -1], axial=True) == ThrusterSet(off_pulsing=True).commanded([1, 1, -1], axial=True)
+    assert s.commanded([1, 1, -1]) == ThrusterSet().commanded([1, 1, -1]) and not s.disabled
+
+
 def test_a_stuck_thruster_from_its_time_on_and_its_valve_closed():
     names = [name for name, *_ in thesis_layout()]
     off = ThrusterSet(stuck_thruster=1, stuck_time=0.03)  # x+1 stuck off after 30 ms of operation
