@@ -39,19 +39,17 @@ Operations choice (docs/models/mission.md, "Faults"): each declared thruster's l
 and the flags are allocated over the others; the mission goes on.
 
 A declaration of two (one stuck off, the other stuck on) closes a healthy valve with the faulty
-one, and its torque direction then has one thruster left (a 525 km dispersed run with x+1 dead on a
-10.2 kg body spent 37 g of RCS with x+1 and x-1 closed, 17.5 g with x-1 left open). So the
-monitor tests it later: once every rate is below `probe_rate` (1 deg/s, past the detumble, where
-the controller rests between pulses) it reopens the thruster named stuck on and evaluates windows
-for that one hypothesis alone. Stuck on, it fires whenever it is closed and is declared again in
-two windows (a second or two of one thruster's torque): its valve is closed for good and the
-other's reopened, since one of the two was the fault. Not declared in `probe_windows` (10) windows
-that could show it (closed for at least half the window), it stays open, and the one named stuck
-off stays closed. Above `max_rate` the probe waits, as every window does (the slew that follows
-the detumble turns at up to 16 deg/s). A probe that has not decided in `probe_limit` (30)
-evaluated windows closes the valve again and leaves both closed: a stuck-on thruster the
-controller keeps commanding (z+near stuck on with z-near closed is the -z command's only thruster
-and part of +z's) fires for 30 of the monitor's windows at most.
+one, and its torque direction then has one thruster left for good. So the monitor tests it later:
+once every rate is below `probe_rate` (1 deg/s, past the detumble) it reopens the thruster named
+stuck on and evaluates windows for that one hypothesis alone. Stuck on, it fires whenever it is
+closed and is declared again in two windows (a second or two of one thruster's torque): its valve
+is closed for good and the other's reopened, since one of the two was the fault. Not declared in
+`probe_windows` (10) windows that could show it (closed for at least half the window), it stays
+open, and the one named stuck off stays closed. Above `max_rate` the probe waits, as every window
+does (the slew that follows the detumble turns at up to 16 deg/s). A probe that has not decided in
+`probe_limit` (30) evaluated windows closes the valve again and leaves both closed: a stuck-on
+thruster the controller keeps commanding (z+near stuck on with z-near closed is the -z command's
+only thruster and part of +z's) fires for 30 of the monitor's windows at most.
 """
 import math
 

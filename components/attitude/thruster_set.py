@@ -272,7 +272,7 @@ class ThrusterSet:
         # In the burn with off-pulsing the axial thrusters take y and z at no RCS propellant, so an x
         # flag opens the x torque alone and leaves them its side torque and net force: a dead x+1's
         # partner x+2 fires alone rather than with a y pair (three thrusters for half the torque;
-        # 525 km run 82 spent 37 g of RCS that way, 17.5 g with x+2 alone)
+        # 525 km run 82 spent 37 g of RCS that way, 16.5 g with x+2 alone)
         self._burn_allocation = allocation_table(self.nominal_torques, self.nominal_forces, self.levels, self.force,
                                                  open_, axes=(1.0, 0.0, 0.0), force_weight=0.001)
 
