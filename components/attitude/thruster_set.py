@@ -321,13 +321,18 @@ class ThrusterSet:
 
     def firing(self, flags, axial=False, commanded=None):
         """Indices of the RCS thrusters that fire: the commanded ones (`commanded`, if already
-        known), less a stuck-off thruster, with a stuck-on one whose valve is still open."""
+        known), less a stuck-off thruster, with a stuck-on one whose valve is still open once the
+        set operates (a valve stuck open vents from the set's first step on: before it, in the
+        mission's attitude determination, the set does not step, and its torque would spin up a body
+        whose thrusters nothing watches or draws propellant for)."""
         on = self.commanded(flags, axial) if commanded is None else commanded
         stuck = self.stuck
         if stuck is None:
             return on
         if self.stuck_on:
-            return on if stuck in on or stuck in self.disabled else sorted(on + [stuck])
+            if stuck in on or stuck in self.disabled or self.operating_time <= 0.0:
+                return on
+            return sorted(on + [stuck])
         return [i for i in on if i != stuck]
 
     def axial_off(self, flags, axial=False):

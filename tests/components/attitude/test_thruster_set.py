@@ -201,6 +201,14 @@ def test_a_stuck_thruster_from_its_time_on_and_its_valve_closed():
     on.step([0, 0, 0], 1.0)
     assert on.propellant_mass() > spent
     on.disable(y_far)  # the latch valve closed: it stops
+    # stuck open from the start of its operation: it vents from the set's first step, not before
+    # (in the mission's determination the set does not step, and nothing would watch that torque)
+    early = ThrusterSet(stuck_thruster=5, stuck_on=True, stuck_time=0.0)
+    assert early.stuck == y_far and early.firing([0, 0, 0]) == [] and early.force_and_torque([0, 0, 0])[1] == (0.0,) * 3
+    early.step([0, 0, 0], 0.015)
+    assert early.firing([0, 0, 0]) == [y_far] and early.fire_time[y_far] == 0.0
+    early.step([0, 0, 0], 0.015)
+    assert early.fire_time[y_far] == pytest.approx(0.015)
     assert on.firing([0, 0, 0]) == [] and y_far not in on.firing([0, 1, 0])
     with pytest.raises(ValueError, match="stuck_thruster = 13 must be 0"):
         ThrusterSet(stuck_thruster=13)
