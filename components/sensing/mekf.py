@@ -7,7 +7,7 @@ Markley and Crassidis (2014, section 6.2; Lefferts, Markley and Shuster 1982):
 state       q_BN (scalar last, kept unit) and the gyro bias b (rad/s)
 error state dx = [dtheta, db]: q_true = dq(dtheta) (x) q, b_true = b + db       (6 x 1, cov. P)
 propagate   omega = omega_meas - b;  q <- exp(omega h) (x) q   (triad.propagate, exact for a held rate)
-            Phi = I + F h,  F = [[-[omega x], -I], [0, 0]]
+            Phi = I + F h,  F = [[-[omega x], -I], [0, 0]]  (exp(F h) above 0.1 rad per step)
             P <- Phi P Phi^T + G Q G^T h,  Q = diag(sigma_v^2 I, sigma_u^2 I)
 update      a unit vector measured in B, b_meas, of a known direction r in N:
             b_hat = A(q) r,  H = [[b_hat x], 0],  R = sigma^2 I
@@ -58,15 +58,37 @@ def _looped_product(A, B, transpose_b):
 _product = _looped_product if jit.ENABLED else _numpy_product
 
 
+# the angle per covariance step (rad) above which Phi is the exact transition: first order, Phi's
+# attitude block is not a rotation, and P grows by about (1 + angle^2) per step (a body spun up
+# by a thruster stuck open, hundreds of deg/s, overflowed it); the mission's nominal runs never
+# come near (26 deg/s over 0.115 s is 0.05 rad), so they keep the first order bit for bit
+EXACT_ANGLE = 0.1
+
+
 @njit(cache=True)
 def _propagated_covariance(P, w0, w1, w2, h, qv, qu):
     """Phi P Phi^T + Q h: Phi = I + F h, F = [[-[w x], -I], [0, 0]]; Q = diag(qv I, qu I) (G Q G^T = Q
-    for G = diag(-I, I))."""
+    for G = diag(-I, I)). Above EXACT_ANGLE per step Phi = exp(F h): the attitude block the
+    rotation exp(-[w x] h), the bias block -(integral of it over h) (Markley and Crassidis 2014,
+    eq. 6.83-6.84)."""
     phi = np.eye(6)
-    phi[0, 1], phi[0, 2], phi[1, 0] = w2 * h, -w1 * h, -w2 * h
-    phi[1, 2], phi[2, 0], phi[2, 1] = w0 * h, w1 * h, -w0 * h
-    for i in range(3):
-        phi[i, i + 3] = -h
+    rate = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
+    if rate * h <= EXACT_ANGLE:
+        phi[0, 1], phi[0, 2], phi[1, 0] = w2 * h, -w1 * h, -w2 * h
+        phi[1, 2], phi[2, 0], phi[2, 1] = w0 * h, w1 * h, -w0 * h
+        for i in range(3):
+            phi[i, i + 3] = -h
+    else:
+        angle = rate * h
+        s, c = math.sin(angle), math.cos(angle)
+        a, b, d = s / rate, (1.0 - c) / (rate * rate), (angle - s) / (rate * rate * rate)
+        W = np.array([[0.0, -w2, w1], [w2, 0.0, -w0], [-w1, w0, 0.0]])  # [w x]
+        W2 = W @ W
+        for i in range(3):
+            for j in range(3):
+                eye = 1.0 if i == j else 0.0
+                phi[i, j] = eye - a * W[i, j] + b * W2[i, j]
+                phi[i, j + 3] = -h * eye + b * W[i, j] - d * W2[i, j]
     out = _product(_product(phi, P, False), phi, True)
     for i in range(3):
         out[i, i] += qv * h
@@ -184,7 +206,7 @@ class AttitudeMEKF:
 
     def propagate(self, omega_meas, h, covariance=True):
         """Attitude over h with the bias-corrected rate held; the covariance too unless the
-        caller gathers several steps into one propagate_covariance (first order either way)."""
+        caller gathers several steps into one propagate_covariance (first order up to EXACT_ANGLE)."""
         self._need()
         w = self.rate(omega_meas)
         if not (math.isfinite(w[0]) and math.isfinite(w[1]) and math.isfinite(w[2])):

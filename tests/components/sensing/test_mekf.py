@@ -10,7 +10,8 @@ import pytest
 from components.attitude import rigid_body
 from components.core import rotations
 from components.sensing import triad
-from components.sensing.mekf import AttitudeMEKF, NeesMonitor, _inverse_quadratic_form
+from components.sensing.mekf import EXACT_ANGLE, AttitudeMEKF, NeesMonitor, _inverse_quadratic_form, \
+    _propagated_covariance
 
 H = 0.1
 GYRO_SIGMA = 5.5e-4  # rad/s per 10 Hz sample (the attitude-determination system's gyro)
@@ -110,6 +111,40 @@ def test_a_held_bias_is_a_consider_state_whose_covariance_stays_honest():
     assert np.allclose(filt.P, filt.P.T) and np.all(np.linalg.eigvalsh(filt.P) > 0.0)
     assert np.mean(np.abs(err) <= 3.0 * sig) > 0.97
     assert np.degrees(np.abs(err).max()) < 2.0  # the held bias was learned with the Sun: a small drift
+
+
+def test_the_covariance_transition_is_first_order_below_its_angle_and_exact_above():
+    """Up to EXACT_ANGLE per step Phi = I + F h (the mission's nominal runs, unchanged); above it
+    exp(F h), so that a body spun up to hundreds of deg/s (a thruster stuck open) keeps a finite
+    covariance (the first order grew it by (1 + angle^2) per step and overflowed)."""
+    from scipy.linalg import expm
+
+    rng = np.random.default_rng(3)
+    L = rng.normal(size=(6, 6))
+    P = L @ L.T * 1e-6 + np.eye(6) * 1e-8
+    qv, qu = 1e-9, 1e-12
+
+    def transition(w, h, exact):
+        W = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]])
+        F = np.zeros((6, 6))
+        F[:3, :3], F[:3, 3:] = -W, -np.eye(3)
+        return expm(F * h) if exact else np.eye(6) + F * h
+
+    Q = np.diag([qv] * 3 + [qu] * 3)
+    for w, h in (((0.2, -0.3, 0.25), 0.115), ((0.0, 0.0, 0.8), 0.125)):  # 0.05 and exactly 0.1 rad
+        assert np.linalg.norm(w) * h <= EXACT_ANGLE + 1e-12
+        phi = transition(w, h, exact=False)
+        assert np.allclose(_propagated_covariance(P, *w, h, qv, qu), phi @ P @ phi.T + Q * h, rtol=1e-13, atol=0.0)
+    for w, h in (((0.3, -5.0, 2.0), 0.1), ((16.0, 1.0, -0.5), 0.1), ((0.0, 1.2, 0.0), 0.1)):
+        phi = transition(w, h, exact=True)
+        assert np.allclose(_propagated_covariance(P, *w, h, qv, qu), phi @ P @ phi.T + Q * h, rtol=1e-12, atol=0.0)
+    spun = P.copy()
+    for _ in range(20000):  # 2000 s at 16 rad/s (920 deg/s)
+        spun = _propagated_covariance(spun, 16.0, 1.0, -0.5, 0.1, qv, qu)
+    # finite, and the attitude's sigma no more than its start plus what the bias' sigma integrates
+    # to over the 2000 s (a rotation only turns it; the first order grew P by about 1 + 1.6^2 a step)
+    drift = np.sqrt(np.max(np.diag(P)[3:])) * 2000.0 * math.sqrt(3.0)
+    assert np.all(np.isfinite(spun)) and np.sqrt(np.max(np.diag(spun)[:3])) < np.sqrt(np.max(np.diag(P)[:3])) + drift
 
 
 def test_bad_use_is_refused():
