@@ -68,9 +68,9 @@ EXACT_ANGLE = 0.1
 @njit(cache=True)
 def _propagated_covariance(P, w0, w1, w2, h, qv, qu):
     """Phi P Phi^T + Q h: Phi = I + F h, F = [[-[w x], -I], [0, 0]]; Q = diag(qv I, qu I) (G Q G^T = Q
-    for G = diag(-I, I)). Above EXACT_ANGLE per step Phi = exp(F h): the attitude block the
-    rotation exp(-[w x] h), the bias block -(integral of it over h) (Markley and Crassidis 2014,
-    eq. 6.83-6.84)."""
+    for G = diag(-I, I)). Above EXACT_ANGLE per step Phi = exp(F h) in closed form: the attitude
+    block the rotation exp(-[w x] h), the bias block minus its integral over h (the tests compare
+    it with scipy's expm)."""
     phi = np.eye(6)
     rate = math.sqrt(w0 * w0 + w1 * w1 + w2 * w2)
     if rate * h <= EXACT_ANGLE:
