@@ -34,6 +34,21 @@ model error covers that term's share too) and no step is longer than a tenth of 
 attitude loop's steps; a long step starts the window over). One fault is
 declared per run.
 
+Above `max_rate` the windows are of `fast_window` seconds (2 s) and fitted otherwise, so that a
+thruster that spins the body up past 10 deg/s is still found: y+far stuck open from the detumble's
+start gives 3.7 mN.m about y, more than the -y pair's 2.5 mN.m, and the body passes 10 deg/s in its
+first seconds (without these windows it spun up to 943 deg/s and the estimator overflowed). The
+residual is the same, but (1) the inertia error's share of the gyroscopic term is bounded per
+axis rather than scaled from the nominal term: with each principal moment within `inertia_error`
+(10 %, the dispersion's), (J_y - J_z)/J_x w_y w_z is off by at most inertia_error (J_y + J_z)/J_x
+|w_y w_z|, which vanishes when the body spins about one axis (the spin a stuck thruster drives)
+and is largest in a tumble about all three; and (2) the commands' effect is known only to a
+common scale 1 + b, b fitted with the offsets under a prior of sigma `scale_error` (0.2: a mass
+10 kg against the software's 12 kg is 0.2 alone). Without (2) a dispersed 10 kg body's
+continuous firing in a fast tumble reads as a thruster. A stuck-open far thruster against its
+axis' opposite pair needs b = -1.5 (3.7 against 2.5 mN.m): far outside the prior, so it is still
+named, with the opposite far thruster stuck off, as a pair, and probed below 1 deg/s like any pair.
+
 Operations choice (docs/models/mission.md, "Faults"): each declared thruster's latch valve is closed
 (components.attitude.thruster_set.ThrusterSet.disable), which also stops a thruster stuck open,
 and the flags are allocated over the others; the mission goes on.
@@ -75,11 +90,12 @@ class ThrusterMonitor:
     torques: {thruster index: nominal torque (N.m, B)} of every thruster the software may open
     (RCS and axial); candidates: the indices that may fail (the RCS thrusters); inertia: 3x3
     (kg.m2) as the software knows it; rate_sigma, sample_time: the gyro's noise of one sample
-    (rad/s) at that sample time (s), scaled to the step as the gyro's white rate noise."""
+    (rad/s) at that sample time (s), scaled to the step as the gyro's white rate noise; the
+    other arguments as in the module docstring."""
 
     def __init__(self, torques, candidates, inertia, rate_sigma, sample_time, window=1.0, confirmations=2,
                  gate=25.0, model_error=0.1, max_rate=math.radians(10.0), probe_rate=math.radians(1.0),
-                 probe_windows=10, probe_limit=30):
+                 probe_windows=10, probe_limit=30, fast_window=2.0, inertia_error=0.1, scale_error=0.2):
         J = np.array(inertia, dtype=float).reshape(3, 3)
         if not np.all(np.isfinite(J)) or np.any(np.linalg.eigvalsh(0.5 * (J + J.T)) <= 0.0):
             raise ValueError(f"inertia {J.tolist()} must be finite and positive definite (kg.m2)")
@@ -112,13 +128,28 @@ class ThrusterMonitor:
             raise ValueError(f"probe_limit = {probe_limit!r} must be an integer >= probe_windows "
                              f"({self.probe_windows})")
         self.probe_limit = int(probe_limit)
+        self.fast_window = checks.positive("fast_window", fast_window, "s")
+        self.inertia_error = float(inertia_error)
+        if not (math.isfinite(self.inertia_error) and self.inertia_error >= 0.0):
+            raise ValueError(f"inertia_error = {inertia_error!r} must be a finite fraction >= 0")
+        self.scale_error = checks.positive("scale_error", scale_error, "")
+        self._J_array = J
         self.detected = None  # (((thruster index, STUCK_OFF or STUCK_ON), ...), time) once declared
         # the test of a declaration of two: {"on": index named stuck on, "off": the other, "state":
         # WAITING/TESTING/DONE, "windows": telling windows, "tested": windows evaluated, "resolved":
         # ((index, mode), time), or None while testing and when undecided}
         self.probe = None
         self._candidate, self._count = None, 0
+        self._fast_candidate, self._fast_count = None, 0
         self._restart()
+        self._restart_fast()
+
+    def _restart_fast(self):
+        # the windows above max_rate: gyro rates at each step's start (the last at the window's
+        # end) and (columns of the thrusters opened, h) per step
+        self._fast_rates = []
+        self._fast_steps = []
+        self._fast_elapsed = 0.0
 
     def _restart(self):
         # per step of the window, in plain floats (the monitor runs at every 15 ms step)
@@ -138,9 +169,17 @@ class ThrusterMonitor:
         w0, w1, w2 = (float(x) for x in omega)
         largest = max(abs(w0), abs(w1), abs(w2))
         probe = self.probe
-        if not largest <= self.max_rate or h > 0.1 * self.window:  # also a NaN
+        if not largest == largest or h > 0.1 * self.window:  # a NaN or a long step
             self._restart()
+            self._restart_fast()
             return None
+        if largest > self.max_rate:
+            self._restart()
+            if self.detected is None:
+                return self._fast_step(t, (w0, w1, w2), opened, h, excluded)
+            return None
+        if self._fast_rates:
+            self._restart_fast()
         if probe is not None and probe["state"] == WAITING and largest < self.probe_rate:
             # the window starts at the next step, the first with the reopened valve
             probe["state"], probe["windows"], probe["tested"] = TESTING, 0, 0
@@ -178,10 +217,99 @@ class ThrusterMonitor:
         self._h = h
         return action
 
+    def _fast_step(self, t, omega, opened, h, excluded):
+        action = None
+        self._fast_rates.append(omega)
+        if self._fast_elapsed >= self.fast_window - 1e-9:
+            hypothesis = self._evaluate_fast(excluded)
+            if hypothesis is not None:
+                action = self._declared(hypothesis, t)
+            self._restart_fast()
+            self._fast_rates.append(omega)
+        self._fast_steps.append((tuple(self.column[i] for i in opened if i in self.column), h))
+        self._fast_elapsed += h
+        return action
+
+    def _evaluate_fast(self, excluded):
+        """A window above max_rate (module docstring): the slow windows' rate response, with the
+        inertia error's share of the gyroscopic term bounded per axis and the commands' effect
+        known to a common scale."""
+        rates = np.array(self._fast_rates)  # (n, 3), the last at the window's end
+        n = len(rates)
+        w = rates[:-1]
+        steps = np.array([h for _, h in self._fast_steps[:n - 1]])
+        opened = np.zeros((n - 1, len(self.index)))
+        for k, (columns, h) in enumerate(self._fast_steps[:n - 1]):
+            opened[k, list(columns)] = h
+
+        def cumulative(x):  # per step -> per sample, zero at the window's start
+            return np.concatenate((np.zeros((1,) + x.shape[1:]), np.cumsum(x, axis=0)))
+
+        J, J_inv = self._J_array, np.array(self._J_inv)
+        commanded = cumulative(opened @ self.signatures)  # J^-1 L h summed, (n, 3)
+        gyroscopic = cumulative(np.cross(w, w @ J.T) @ J_inv.T * steps[:, None])
+        E = (rates - rates[0]) - (commanded - gyroscopic)
+        # each principal moment within inertia_error: (J_y - J_z)/J_x w_y w_z is off by at most
+        # inertia_error (J_y + J_z)/J_x |w_y w_z|, and so on
+        Jd = np.diag(J)
+        after, next_ = [1, 2, 0], [2, 0, 1]
+        pace = np.abs(w[:, after] * w[:, next_]) * (Jd[after] + Jd[next_]) / Jd
+        sigma = self.rate_sigma * math.sqrt(self.sample_time / self._fast_steps[0][1])
+        variance = (sigma ** 2 + self.model_error ** 2 * cumulative(opened) ** 2 @ self.signatures ** 2
+                    + (self.inertia_error * cumulative(pace * steps[:, None])) ** 2)
+        weights = 1.0 / variance
+        total = np.sum(weights, axis=0)
+
+        def centred(x):  # about each axis' weighted mean (the free offsets)
+            return x - np.sum(weights * x, axis=-2, keepdims=True) / total
+
+        # the commands' true effect is (1 + b) times the one predicted (the mass, inertia and force
+        # the software assumes), b with a prior of sigma scale_error: fitted with the offsets
+        C = centred(commanded)
+        prior = np.sum(weights * C ** 2) + 1.0 / self.scale_error ** 2
+
+        def misfit(residual):
+            R = centred(residual)
+            return np.sum(weights * R ** 2, axis=(-2, -1)) - np.sum(weights * R * C, axis=(-2, -1)) ** 2 / prior
+
+        null = float(misfit(E))
+        elapsed = cumulative(steps)
+        hypotheses, curves = [], []
+        for i in self.candidates:
+            if i in excluded:
+                continue
+            k = self.column[i]
+            seconds = cumulative(opened[:, k])
+            hypotheses += [(i, STUCK_OFF), (i, STUCK_ON)]
+            curves += [-seconds, elapsed - seconds]
+        hypothesis = self._named(null, misfit, E, hypotheses, curves)
+        if hypothesis is not None and hypothesis == self._fast_candidate:
+            self._fast_count += 1
+        else:
+            self._fast_candidate, self._fast_count = hypothesis, int(hypothesis is not None)
+        if hypothesis is not None and self._fast_count >= self.confirmations:
+            return hypothesis
+        return None
+
+    def _named(self, null, misfit, E, hypotheses, curves):
+        """The hypotheses a window names (a frozenset of (index, mode)), or None: those within the
+        gate of the best, when the best beats no fault by more than the gate and they are declarable."""
+        if not hypotheses:
+            return None
+        curves = np.array(curves)  # (hypotheses, n)
+        signatures = np.array([self.signatures[self.column[i]] for i, _ in hypotheses])
+        fits = misfit(E[None, :, :] - curves[:, :, None] * signatures[:, None, :])
+        best = float(np.min(fits))
+        group = frozenset(hypotheses[k] for k in np.flatnonzero(fits < best + self.gate))
+        return group if null - best > self.gate and declarable(group) else None
+
     def _declare(self, excluded, t):
         hypothesis = self._evaluate(excluded, t, self.candidates, (STUCK_OFF, STUCK_ON))
         if hypothesis is None:
             return None
+        return self._declared(hypothesis, t)
+
+    def _declared(self, hypothesis, t):
         self.detected = (tuple(sorted(hypothesis)), float(t))
         if len(hypothesis) == 2:
             (on,) = (i for i, mode in hypothesis if mode == STUCK_ON)
@@ -235,15 +363,7 @@ class ThrusterMonitor:
             for mode in modes:
                 hypotheses.append((i, mode))
                 curves.append(-opened[:, k] if mode == STUCK_OFF else elapsed - opened[:, k])
-        hypothesis = None
-        if hypotheses:
-            curves = np.array(curves)  # (hypotheses, n)
-            signatures = np.array([self.signatures[self.column[i]] for i, _ in hypotheses])
-            fits = misfit(E[None, :, :] - curves[:, :, None] * signatures[:, None, :])
-            best = float(np.min(fits))
-            group = frozenset(hypotheses[k] for k in np.flatnonzero(fits < best + self.gate))
-            if null - best > self.gate and declarable(group):
-                hypothesis = group
+        hypothesis = self._named(null, misfit, E, hypotheses, curves)
         if hypothesis is not None and hypothesis == self._candidate:
             self._count += 1
         else:
@@ -257,6 +377,10 @@ class ThrusterMonitor:
                 "gyroscopic": [list(g) for g in self._gyroscopic], "steps": [[list(c), h] for c, h in self._steps],
                 "elapsed": self._elapsed, "h": self._h,
                 "candidate": None if self._candidate is None else sorted(self._candidate), "count": self._count,
+                "fast_rates": [list(w) for w in self._fast_rates],
+                "fast_steps": [[list(c), h] for c, h in self._fast_steps], "fast_elapsed": self._fast_elapsed,
+                "fast_candidate": None if self._fast_candidate is None else sorted(self._fast_candidate),
+                "fast_count": self._fast_count,
                 "detected": None if self.detected is None else [list(self.detected[0]), self.detected[1]],
                 "probe": None if self.probe is None else {
                     **self.probe, "resolved": None if self.probe["resolved"] is None else
@@ -272,6 +396,13 @@ class ThrusterMonitor:
         self._candidate = None if state["candidate"] is None else frozenset(
             (int(i), int(mode)) for i, mode in state["candidate"])
         self._count = int(state["count"])
+        # states saved before the windows above max_rate carry none
+        self._fast_rates = [tuple(float(x) for x in w) for w in state.get("fast_rates", [])]
+        self._fast_steps = [(tuple(int(k) for k in c), float(h)) for c, h in state.get("fast_steps", [])]
+        self._fast_elapsed = float(state.get("fast_elapsed", 0.0))
+        fast = state.get("fast_candidate")
+        self._fast_candidate = None if fast is None else frozenset((int(i), int(mode)) for i, mode in fast)
+        self._fast_count = int(state.get("fast_count", 0))
         d = state["detected"]
         self.detected = None if d is None else (tuple((int(i), int(mode)) for i, mode in d[0]), float(d[1]))
         probe = state.get("probe")  # states saved before the probe carry none
