@@ -17,8 +17,17 @@ GYRO_SIGMA, GYRO_SAMPLE_TIME = 5.5e-4, 0.1  # the mission's gyro (BMG160)
 NAMES = [name for name, *_ in thesis_layout()]
 
 
+def dispersed_inertia(mass, second_moments):
+    """The box's inertia with its second moments of mass along x, y, z scaled by 1 + each of
+    `second_moments` (the campaigns' inertia dispersion: a real body, each principal moment within
+    as much)."""
+    J = np.diag(np.array(box_inertia(mass, 0.1, 0.2, 0.3), dtype=float).reshape(3, 3))
+    moments = (J.sum() / 2.0 - J) * (1.0 + np.asarray(second_moments, dtype=float))
+    return np.diag(moments.sum() - moments)
+
+
 def fly(stuck=0, stuck_on=False, stuck_time=5.0, seed=1, mass=12.0, seconds=40.0, omega0=(0.02, -0.01, 0.015),
-        bias_jump=(0.0, 0.0, 0.0)):
+        bias_jump=(0.0, 0.0, 0.0), second_moments=(0.0, 0.0, 0.0), **monitor):
     """Hold zero rate with a deadband on the gyro (its calibrated bias removed); returns the set,
     the largest rate after the fault (deg/s) and the final rates."""
     rng = np.random.default_rng(seed)
@@ -26,8 +35,8 @@ def fly(stuck=0, stuck_on=False, stuck_time=5.0, seed=1, mass=12.0, seconds=40.0
     s = ThrusterSet(min_on_time=STEP, misalignment=[tuple(rng.uniform(-tilt, tilt, 2)) for _ in range(16)],
                     stuck_thruster=stuck, stuck_on=stuck_on, stuck_time=stuck_time)
     s.monitor = ThrusterMonitor(dict(enumerate(s.nominal_torques)), s.rcs, box_inertia(12.0, 0.1, 0.2, 0.3),
-                                GYRO_SIGMA, GYRO_SAMPLE_TIME)
-    body = RigidBody(box_inertia(mass, 0.1, 0.2, 0.3), omega0=omega0)
+                                GYRO_SIGMA, GYRO_SAMPLE_TIME, **monitor)
+    body = RigidBody(dispersed_inertia(mass, second_moments), omega0=omega0)
     bias = (1e-3, -5e-4, 2e-4)
     gyro = Gyro(bias=bias, sigma=GYRO_SIGMA, sigma_sample_time=GYRO_SAMPLE_TIME, seed=seed, bias_jump=bias_jump,
                 jump_time=stuck_time)
@@ -100,7 +109,8 @@ def test_the_monitor_state_round_trips_and_bad_values_are_named():
     for kwargs, message in (({"window": 0.0}, "window = 0.0"), ({"confirmations": 0}, "confirmations = 0"),
                             ({"model_error": -0.1}, "model_error"), ({"rate_sigma": float("nan")}, "rate_sigma"),
                             ({"probe_windows": 0}, "probe_windows = 0"), ({"probe_rate": -1.0}, "probe_rate"),
-                            ({"probe_limit": 5}, "probe_limit = 5")):
+                            ({"probe_limit": 5}, "probe_limit = 5"), ({"fast_window": 0.0}, "fast_window"),
+                            ({"inertia_error": -0.1}, "inertia_error"), ({"scale_error": 0.0}, "scale_error")):
         args = {"torques": torques, "candidates": range(12), "inertia": np.eye(3), "rate_sigma": GYRO_SIGMA,
                 "sample_time": GYRO_SAMPLE_TIME, **kwargs}
         with pytest.raises(ValueError, match=message):
@@ -154,3 +164,52 @@ def test_a_probe_under_way_round_trips():
                                     box_inertia(12.0, 0.1, 0.2, 0.3), GYRO_SIGMA, GYRO_SAMPLE_TIME)
     other.set_state(s.get_state())
     assert other.monitor.get_state() == s.monitor.get_state() and other.disabled == s.disabled == {0}
+
+
+FAST = math.radians(15.0)  # the campaigns' largest tumble per axis
+
+
+@pytest.mark.parametrize("name,opposite,omega0", [("y+far", "y-far", (FAST, FAST, FAST)),
+                                                  ("y+far", "y-far", (-FAST, FAST, -FAST)),
+                                                  ("z+far", "z-far", (FAST, -FAST, 0.0))])
+def test_a_far_thruster_stuck_open_in_a_fast_tumble_is_declared_before_the_body_spins_up(name, opposite, omega0):
+    """A far thruster stuck open from the start outdoes its axis' opposite pair (3.7 against
+    2.5 mN.m): in a 15 deg/s tumble the body never falls below 10 deg/s. The windows above 10 deg/s
+    name it with the opposite far thruster stuck off (the same torque at the same times), both
+    close, the body is detumbled on the thrusters left and the probe below 1 deg/s closes the stuck
+    one for good. Without those windows it spins past 25 deg/s in 40 s (y+far about 60 in a minute)
+    and nothing is declared."""
+    index, other = NAMES.index(name), NAMES.index(opposite)
+    s, largest, omega = fly(stuck=index + 1, stuck_on=True, stuck_time=0.0, omega0=omega0, seconds=60.0,
+                            second_moments=(0.1, -0.1, 0.1))
+    assert s.monitor.detected is not None, "not declared"
+    declared, when = s.monitor.detected
+    assert set(declared) == {(index, STUCK_ON), (other, STUCK_OFF)} and when < 8.0
+    assert largest < 20.0  # deg/s
+    assert s.monitor.probe["resolved"][0] == (index, STUCK_ON) and s.disabled == {index}
+    assert max(abs(w) for w in omega) < math.radians(0.2)
+    blind, largest, _ = fly(stuck=index + 1, stuck_on=True, stuck_time=0.0, omega0=omega0, seconds=40.0,
+                            second_moments=(0.1, -0.1, 0.1), fast_window=1e6)
+    assert blind.monitor.detected is None and largest > 25.0  # and still spinning up
+
+
+@pytest.mark.parametrize("seed", range(6))
+def test_no_fault_declared_in_fast_tumbles_of_a_dispersed_body(seed):
+    """Tumbles up to 15 deg/s per axis of a body 10-14 kg (the software assumes 12 kg) with its
+    second moments within 10 %, detumbled through the windows above 10 deg/s: none declared."""
+    rng = np.random.default_rng(200 + seed)
+    s, _, omega = fly(seed=seed, mass=rng.uniform(10.0, 14.0), omega0=tuple(rng.uniform(-FAST, FAST, 3)),
+                      second_moments=tuple(rng.uniform(-0.1, 0.1, 3)), stuck_time=0.0, seconds=30.0)
+    assert s.monitor.detected is None and not s.disabled
+    assert max(abs(w) for w in omega) < math.radians(0.2)
+
+
+def test_a_fast_window_under_way_round_trips():
+    s, _, _ = fly(stuck=NAMES.index("y+far") + 1, stuck_on=True, stuck_time=0.0, omega0=(FAST, FAST, FAST),
+                  seconds=2.5)
+    assert s.monitor.detected is None and s.monitor.get_state()["fast_steps"]  # a window above 10 deg/s
+    other = ThrusterSet(stuck_thruster=NAMES.index("y+far") + 1, stuck_on=True, stuck_time=0.0)
+    other.monitor = ThrusterMonitor(dict(enumerate(other.nominal_torques)), other.rcs,
+                                    box_inertia(12.0, 0.1, 0.2, 0.3), GYRO_SIGMA, GYRO_SAMPLE_TIME)
+    other.set_state(s.get_state())
+    assert other.monitor.get_state() == s.monitor.get_state()
