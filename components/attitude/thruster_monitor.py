@@ -28,11 +28,11 @@ gyroscopic term can hide), or more than two, name nothing: they are alternatives
 both thrusters of a pair would leave its torque direction with none (a 475 km dispersed run with
 x+1 dead and a 13.7 deg/s tumble closed x+1 and x+2 and never finished its detumble).
 `confirmations` (2) windows in a row naming the same thrusters and modes declare the fault, so a
-single disturbed window (a gyro bias jump) never does. Windows run only while every rate is below
-`max_rate` (10 deg/s: in a faster tumble the gyroscopic term's inertia error hides a thruster; the
-model error covers that term's share too) and no step is longer than a tenth of the window (the
-attitude loop's steps; a long step starts the window over). One fault is
-declared per run.
+single disturbed window (a gyro bias jump) never does. These windows run only while every rate is
+below `max_rate` (10 deg/s: in a faster tumble the gyroscopic term's inertia error, scaled this way,
+hides a thruster; the model error covers that term's share too; above it, the fast windows below)
+and no step is longer than a tenth of the window (the attitude loop's steps; a long step starts
+the window over). One fault is declared per run.
 
 Above `max_rate` the windows are of `fast_window` seconds (2 s) and fitted otherwise, so that a
 thruster that spins the body up past 10 deg/s is still found: y+far stuck open from the detumble's
