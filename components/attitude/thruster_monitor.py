@@ -282,14 +282,18 @@ class ThrusterMonitor:
             seconds = cumulative(opened[:, k])
             hypotheses += [(i, STUCK_OFF), (i, STUCK_ON)]
             curves += [-seconds, elapsed - seconds]
-        hypothesis = self._named(null, misfit, E, hypotheses, curves)
-        if hypothesis is not None and hypothesis == self._fast_candidate:
-            self._fast_count += 1
+        return self._confirmed(self._named(null, misfit, E, hypotheses, curves), fast=True)
+
+    def _confirmed(self, hypothesis, fast=False):
+        """`hypothesis` once `confirmations` windows in a row (the slow and the fast ones each on
+        their own) have named it, else None."""
+        candidate, count = (self._fast_candidate, self._fast_count) if fast else (self._candidate, self._count)
+        count = count + 1 if hypothesis is not None and hypothesis == candidate else int(hypothesis is not None)
+        if fast:
+            self._fast_candidate, self._fast_count = hypothesis, count
         else:
-            self._fast_candidate, self._fast_count = hypothesis, int(hypothesis is not None)
-        if hypothesis is not None and self._fast_count >= self.confirmations:
-            return hypothesis
-        return None
+            self._candidate, self._count = hypothesis, count
+        return hypothesis if hypothesis is not None and count >= self.confirmations else None
 
     def _named(self, null, misfit, E, hypotheses, curves):
         """The hypotheses a window names (a frozenset of (index, mode)), or None: those within the
@@ -363,14 +367,7 @@ class ThrusterMonitor:
             for mode in modes:
                 hypotheses.append((i, mode))
                 curves.append(-opened[:, k] if mode == STUCK_OFF else elapsed - opened[:, k])
-        hypothesis = self._named(null, misfit, E, hypotheses, curves)
-        if hypothesis is not None and hypothesis == self._candidate:
-            self._count += 1
-        else:
-            self._candidate, self._count = hypothesis, int(hypothesis is not None)
-        if hypothesis is not None and self._count >= self.confirmations:
-            return hypothesis
-        return None
+        return self._confirmed(self._named(null, misfit, E, hypotheses, curves))
 
     def get_state(self):
         return {"rates": [list(w) for w in self._rates], "predicted": [list(p) for p in self._predicted],
