@@ -76,6 +76,14 @@ STUCK_OFF, STUCK_ON = 1, 2  # the modes a detection names
 WAITING, TESTING, DONE = "waiting", "testing", "done"  # the probe of a declaration of two
 
 
+def fraction(name, value):
+    """`value` as a float, a finite fraction >= 0 (a model error), else a ValueError naming it."""
+    x = float(value)
+    if not (math.isfinite(x) and x >= 0.0):
+        raise ValueError(f"{name} = {value!r} must be a finite fraction >= 0")
+    return x
+
+
 def declarable(group):
     """Whether a window's hypotheses within the gate of its best name a fault: one, or two as one
     thruster stuck off and another stuck on (the same torque at the same times). Two of one mode
@@ -116,9 +124,7 @@ class ThrusterMonitor:
             raise ValueError(f"confirmations = {confirmations!r} must be an integer >= 1")
         self.confirmations = int(confirmations)
         self.gate = checks.positive("gate", gate, "")
-        self.model_error = float(model_error)
-        if not (math.isfinite(self.model_error) and self.model_error >= 0.0):
-            raise ValueError(f"model_error = {model_error!r} must be a finite fraction >= 0")
+        self.model_error = fraction("model_error", model_error)
         self.max_rate = checks.positive("max_rate", max_rate, "rad/s")
         self.probe_rate = checks.positive("probe_rate", probe_rate, "rad/s")
         if isinstance(probe_windows, bool) or int(probe_windows) != probe_windows or probe_windows < 1:
@@ -129,9 +135,7 @@ class ThrusterMonitor:
                              f"({self.probe_windows})")
         self.probe_limit = int(probe_limit)
         self.fast_window = checks.positive("fast_window", fast_window, "s")
-        self.inertia_error = float(inertia_error)
-        if not (math.isfinite(self.inertia_error) and self.inertia_error >= 0.0):
-            raise ValueError(f"inertia_error = {inertia_error!r} must be a finite fraction >= 0")
+        self.inertia_error = fraction("inertia_error", inertia_error)
         self.scale_error = checks.positive("scale_error", scale_error, "")
         self._J_array = J
         self.detected = None  # (((thruster index, STUCK_OFF or STUCK_ON), ...), time) once declared
