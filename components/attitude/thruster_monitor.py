@@ -177,10 +177,11 @@ class ThrusterMonitor:
             self._restart()
             self._restart_fast()
             return None
+        columns = tuple(self.column[i] for i in opened if i in self.column)
         if largest > self.max_rate:
             self._restart()
             if self.detected is None:
-                return self._fast_step(t, (w0, w1, w2), opened, h, excluded)
+                return self._fast_step(t, (w0, w1, w2), columns, h, excluded)
             return None
         if self._fast_rates:
             self._restart_fast()
@@ -199,7 +200,6 @@ class ThrusterMonitor:
                 action = self._test(excluded, t)
             self._restart()
             self._rates.append((w0, w1, w2))
-        columns = tuple(self.column[i] for i in opened if i in self.column)
         tx = ty = tz = 0.0
         for k in columns:
             x, y, z = self._torque_rows[k]
@@ -221,7 +221,7 @@ class ThrusterMonitor:
         self._h = h
         return action
 
-    def _fast_step(self, t, omega, opened, h, excluded):
+    def _fast_step(self, t, omega, columns, h, excluded):
         action = None
         self._fast_rates.append(omega)
         if self._fast_elapsed >= self.fast_window - 1e-9:
@@ -230,7 +230,7 @@ class ThrusterMonitor:
                 action = self._declared(hypothesis, t)
             self._restart_fast()
             self._fast_rates.append(omega)
-        self._fast_steps.append((tuple(self.column[i] for i in opened if i in self.column), h))
+        self._fast_steps.append((columns, h))
         self._fast_elapsed += h
         return action
 
@@ -259,7 +259,8 @@ class ThrusterMonitor:
         after, next_ = [1, 2, 0], [2, 0, 1]
         pace = np.abs(w[:, after] * w[:, next_]) * (Jd[after] + Jd[next_]) / Jd
         sigma = self.rate_sigma * math.sqrt(self.sample_time / self._fast_steps[0][1])
-        variance = (sigma ** 2 + self.model_error ** 2 * cumulative(opened) ** 2 @ self.signatures ** 2
+        seconds = cumulative(opened)  # each thruster's seconds open up to each sample
+        variance = (sigma ** 2 + self.model_error ** 2 * seconds ** 2 @ self.signatures ** 2
                     + (self.inertia_error * cumulative(pace * steps[:, None])) ** 2)
         weights = 1.0 / variance
         total = np.sum(weights, axis=0)
@@ -277,16 +278,8 @@ class ThrusterMonitor:
             return np.sum(weights * R ** 2, axis=(-2, -1)) - np.sum(weights * R * C, axis=(-2, -1)) ** 2 / prior
 
         null = float(misfit(E))
-        elapsed = cumulative(steps)
-        hypotheses, curves = [], []
-        for i in self.candidates:
-            if i in excluded:
-                continue
-            k = self.column[i]
-            seconds = cumulative(opened[:, k])
-            hypotheses += [(i, STUCK_OFF), (i, STUCK_ON)]
-            curves += [-seconds, elapsed - seconds]
-        return self._confirmed(self._named(null, misfit, E, hypotheses, curves), fast=True)
+        return self._confirmed(self._named(null, misfit, E, excluded, self.candidates, (STUCK_OFF, STUCK_ON), seconds,
+                                           cumulative(steps)), fast=True)
 
     def _confirmed(self, hypothesis, fast=False):
         """`hypothesis` once `confirmations` windows in a row (the slow and the fast ones each on
@@ -299,9 +292,20 @@ class ThrusterMonitor:
             self._candidate, self._count = hypothesis, count
         return hypothesis if hypothesis is not None and count >= self.confirmations else None
 
-    def _named(self, null, misfit, E, hypotheses, curves):
+    def _named(self, null, misfit, E, excluded, candidates, modes, seconds, elapsed):
         """The hypotheses a window names (a frozenset of (index, mode)), or None: those within the
-        gate of the best, when the best beats no fault by more than the gate and they are declarable."""
+        gate of the best, when the best beats no fault by more than the gate and they are declarable.
+        Each of `candidates` not `excluded`, in each of `modes`, bends E by its signature times a
+        curve: stuck off, minus the seconds it was open (`seconds`, per sample and thruster); stuck
+        on, the seconds it was closed (`elapsed` less those)."""
+        hypotheses, curves = [], []
+        for i in candidates:
+            if i in excluded:
+                continue
+            k = self.column[i]
+            for mode in modes:
+                hypotheses.append((i, mode))
+                curves.append(-seconds[:, k] if mode == STUCK_OFF else elapsed - seconds[:, k])
         if not hypotheses:
             return None
         curves = np.array(curves)  # (hypotheses, n)
@@ -363,15 +367,7 @@ class ThrusterMonitor:
             return np.sum(weights * (residual - mean) ** 2, axis=(-2, -1))
 
         null = float(misfit(E))
-        hypotheses, curves = [], []
-        for i in candidates:
-            if i in excluded:
-                continue
-            k = self.column[i]
-            for mode in modes:
-                hypotheses.append((i, mode))
-                curves.append(-opened[:, k] if mode == STUCK_OFF else elapsed - opened[:, k])
-        return self._confirmed(self._named(null, misfit, E, hypotheses, curves))
+        return self._confirmed(self._named(null, misfit, E, excluded, candidates, modes, opened, elapsed))
 
     def get_state(self):
         return {"rates": [list(w) for w in self._rates], "predicted": [list(p) for p in self._predicted],
