@@ -75,6 +75,16 @@ def _call_values(typingctx, fn, component, vr, n, values):
     return sig, codegen
 
 
+# The loop's functions pass the run's tables (Tables: about seventy arrays) to one another at every
+# component and step. With numba's reference counting each such call increfs and decrefs every
+# array in them, atomically: 9 % of the default mission's time and most of the master's own cost
+# per FMU call. They allocate nothing, and Python holds every array for the run, so they are
+# compiled without the runtime's reference counting (numba's own `_nrt` option, which its
+# string functions use the same way). The run's results are the same bit for bit.
+_loop_function = njit(cache=True, _nrt=False)
+NO_COMPONENTS = np.empty(0, dtype=np.int64)  # fixed_span's `active` for _row_due (it allocates nothing itself)
+
+
 class Tables(NamedTuple):
     """The run's transfers as flat arrays (built by `build_tables`); addresses as int64."""
     component: np.ndarray        # [n] fmi2Component
@@ -141,7 +151,7 @@ class Tables(NamedTuple):
     scratch_bits: np.ndarray
 
 
-@njit(cache=True)
+@_loop_function
 def _gather(T, m):
     """SetOp.gather of set operation m into its input buffer; True when the values differ from
     the ones last sent (or those are unknown)."""
@@ -167,7 +177,7 @@ def _gather(T, m):
     return differ
 
 
-@njit(cache=True)
+@_loop_function
 def _take_changed(source, idx, sent, s, L):
     """sent[s:s+L] = source[idx[s:s+L]]; True when a value changed."""
     changed = False
@@ -179,7 +189,7 @@ def _take_changed(source, idx, sent, s, L):
     return changed
 
 
-@njit(cache=True)
+@_loop_function
 def _set_inputs(T, ci, status_out):
     """InstanceTable.setters[ci]: each set operation gathered and sent when changed."""
     for p in range(T.set_ptr[ci], T.set_ptr[ci + 1]):
@@ -193,7 +203,7 @@ def _set_inputs(T, ci, status_out):
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _get_outputs(T, ci, status_out):
     """InstanceTable.getters[ci]: the connected outputs read into the shared buffers."""
     for g in range(T.get_ptr[ci], T.get_ptr[ci + 1]):
@@ -204,7 +214,7 @@ def _get_outputs(T, ci, status_out):
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _step(T, ci, t, dt, status_out):
     """The batched step of component ci (InstanceTable._batched_stepper's step)."""
     lay = T.io_layout
@@ -228,7 +238,7 @@ def _step(T, ci, t, dt, status_out):
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _stop_fired(T, changed, status_out):
     """Reads the stop signals of the components that changed; 1 when one is true, -1 on error."""
     for j in range(len(T.stop_ci)):
@@ -247,7 +257,7 @@ def _stop_fired(T, changed, status_out):
     return 0
 
 
-@njit(cache=True)
+@_loop_function
 def _record(T, rows, times, rec, t, active, status_out):
     """Recorder.record: the active components' inputs set and feedthrough outputs read
     (ScheduledAlgorithm.refresh_for_record; `active` is empty for a fixed-step run), then the
@@ -276,7 +286,7 @@ def _record(T, rows, times, rec, t, active, status_out):
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _row_due(T, rows, times, rec, t, active, status_out):
     """After a step that does not end the span: the recorder's count (rec[1]) goes on, and a
     row due (rec[2] steps since the last) is recorded here; False when it cannot be (the rows
@@ -290,13 +300,13 @@ def _row_due(T, rows, times, rec, t, active, status_out):
     return _record(T, rows, times, rec, t, active, status_out)
 
 
-@njit(cache=True)
+@_loop_function
 def _refresh_one(T, ci, status_out):
     """A refreshed component's inputs sent (where changed) and its connected outputs read."""
     return _set_inputs(T, ci, status_out) and _get_outputs(T, ci, status_out)
 
 
-@njit(cache=True)
+@_loop_function
 def _needed(L, refresh, tc, t1, tol):
     """L.needed[ci] for the refreshed components after a step ending at t1. A lazily refreshed
     one (L.lazy) is refreshed now only when one of its readers would otherwise read an output
@@ -325,7 +335,7 @@ def _needed(L, refresh, tc, t1, tol):
         L.needed[ci] = need
 
 
-@njit(cache=True)
+@_loop_function
 def _catch_up(T, L, refresh, status_out):
     """The refreshes the steps left out (L.stale), in the refresh order: before a recorded row
     and at a span's end (the next step may be another mode's), the outputs are then those the
@@ -338,7 +348,7 @@ def _catch_up(T, L, refresh, status_out):
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _step_mode(T, L, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed, status_out):
     """One macro step's components (ScheduledAlgorithm._advance): each due one stepped from its
     own time (multiples run ahead), then the refreshed feedthrough ones whose inputs changed:
@@ -380,7 +390,7 @@ def _step_mode(T, L, order, mult, refresh, h_mode, t, t1, stop, tol, tc, changed
     return True
 
 
-@njit(cache=True)
+@_loop_function
 def _read_signals(T, changed, status_out):
     """After a step: the event times and condition signals of the components that changed read
     (as _advance and _pick do), then the stop signals; returns the span's flags, FAILED on error."""
@@ -408,7 +418,7 @@ def _read_signals(T, changed, status_out):
     return flags | (STOP_FIRED if fired > 0 else 0)
 
 
-@njit(cache=True)
+@_loop_function
 def scheduled_span(T, L, order, mult, refresh, h_mode, t, stop, tol, max_steps, spent, tc, changed, status_out, rows,
                    times, rec):
     """Up to max_steps macro steps of one mode from t (ScheduledAlgorithm._advance, the schedule's
@@ -447,7 +457,7 @@ def scheduled_span(T, L, order, mult, refresh, h_mode, t, stop, tol, max_steps, 
     return steps, t, spent, flags
 
 
-@njit(cache=True)
+@_loop_function
 def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, changed, status_out, rows, times, rec):
     """Up to max_steps Gauss-Seidel steps from step k (FixedStepAlgorithm.run): the components
     stepped in order (multiples), then every component's inputs set and its feedthrough outputs
@@ -455,7 +465,7 @@ def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, c
     after a step whose stop signal is true and at the last step (Python records it)."""
     steps, flags = 0, 0
     status_out[0] = 0
-    none = np.empty(0, dtype=np.int64)
+    none = NO_COMPONENTS
     for ci in range(len(changed)):
         changed[ci] = True  # a fixed-step run reads the stop signals at every step
     while steps < max_steps and k < n_steps:
