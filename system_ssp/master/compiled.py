@@ -26,7 +26,7 @@ operation, get operation or signal read) and Python raises the StepFailed the Py
 """
 import ctypes
 import os
-from typing import NamedTuple
+from typing import Any, NamedTuple
 
 from llvmlite import ir
 from numba import njit, types
@@ -81,7 +81,8 @@ def _call_values(typingctx, fn, component, vr, n, values):
 # per FMU call. They allocate nothing, and Python holds every array for the run, so they are
 # compiled without the runtime's reference counting (numba's own `_nrt` option, which its
 # string functions use the same way). The run's results are the same bit for bit.
-_loop_function = njit(cache=True, _nrt=False)
+_LOOP_OPTIONS: dict[str, Any] = {"cache": True, "_nrt": False}  # numba's typing of njit leaves the option out
+_loop_function = njit(**_LOOP_OPTIONS)
 NO_COMPONENTS = np.empty(0, dtype=np.int64)  # fixed_span's `active` for _row_due (it allocates nothing itself)
 
 
