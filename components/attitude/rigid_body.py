@@ -147,9 +147,12 @@ class RigidBody:
         wheel_torque / wheel_momentum (B frame): the wheel motors' torque on the wheels (N.m,
         held over the step) and the wheels' momentum h_w at the step start (N.m.s); see the
         module docstring. Left at zero: the wheel-less model, bit for bit."""
-        for name, v in (("torque_B", torque), ("wheel_torque_B", wheel_torque), ("wheel_momentum_B", wheel_momentum)):
-            if not all(math.isfinite(x) for x in v):
-                raise ValueError(f"{name} {list(v)} must be finite")
+        isfinite = math.isfinite
+        if not (all(map(isfinite, torque)) and all(map(isfinite, wheel_torque)) and all(map(isfinite, wheel_momentum))):
+            for name, v in (("torque_B", torque), ("wheel_torque_B", wheel_torque),
+                            ("wheel_momentum_B", wheel_momentum)):
+                if not all(map(isfinite, v)):
+                    raise ValueError(f"{name} {list(v)} must be finite")
         tw, hw = tuple(wheel_torque), tuple(wheel_momentum)
         if self.integrator == "euler":
             q, w = self.q, self.omega
@@ -170,7 +173,7 @@ class RigidBody:
         self.euler_integrated = angles
         self.q = rotations.normalized(q)
         self.omega = w
-        self.omega_dot = tuple((w[i] - w_start[i]) / h for i in range(3))
+        self.omega_dot = ((w[0] - w_start[0]) / h, (w[1] - w_start[1]) / h, (w[2] - w_start[2]) / h)
 
     # ---- derived quantities ------------------------------------------------------------
     def euler123(self):
