@@ -114,8 +114,10 @@ class NeighborSlave(Fmi2Slave):
         return table
 
     def _get_plan(self, cls, key):
-        """(vector getters, [(index into them, picker of the elements or None for a scalar)]) for
-        the value references `key`, or None when one of them has no getter of type cls."""
+        """The plan of a get of the value references `key`, or None when one of them has no getter
+        of type cls: ([(getter, picker of its elements or None for a scalar)], None) when each
+        getter is read in one run of elements (the usual list: each array in order), else
+        (vector getters, [(index into them, picker or None)])."""
         getters = self._accessor_table(cls, "getter")
         sources, slots, runs = [], {}, []
         for vr in key:
@@ -139,7 +141,10 @@ class NeighborSlave(Fmi2Slave):
                 runs[-1][1].append(i)  # the next element of the same vector
             else:
                 runs.append([s, [i]])
-        return sources, [(s, None if idx is None else _picker(idx)) for s, idx in runs]
+        picked = [(s, None if idx is None else _picker(idx)) for s, idx in runs]
+        if len(runs) == len(sources):  # then the runs are in the order of their getters
+            return [(sources[s], pick) for s, pick in picked], None
+        return sources, picked
 
     def _get(self, cls, kind, vrs, fallback):
         key = vrs if type(vrs) is tuple else tuple(vrs)
@@ -150,8 +155,15 @@ class NeighborSlave(Fmi2Slave):
         if plan is None:
             return fallback(self, vrs)
         sources, runs = plan
+        out: list = []
+        if runs is None:  # each getter called once, in order, and its elements taken
+            for get, pick in sources:
+                if pick is None:
+                    out.append(get())
+                else:
+                    out.extend(pick(get()))
+            return list(map(kind, out))
         vectors = [get() for get in sources]
-        out = []
         for s, pick in runs:
             if pick is None:
                 out.append(vectors[s])

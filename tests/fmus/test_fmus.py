@@ -216,6 +216,7 @@ def test_get_and_set_plans_give_what_each_value_reference_asks():
 
     sys.path.insert(0, str(FMU_SOURCES))
     from neighbor_rigid_body import RigidBody
+    from pythonfmu.variables import Real
 
     body = RigidBody(instance_name="b")
     vr = {v.name: v.value_reference for v in body.vars.values()}
@@ -226,6 +227,12 @@ def test_get_and_set_plans_give_what_each_value_reference_asks():
         assert body.get_real(ask) == [0.8, 0.25, 0.6, 0.8, 0.005, 0.0]
         assert body.get_real(tuple(ask)) == [0.8, 0.25, 0.6, 0.8, 0.005, 0.0]
     assert all(type(x) is float for x in body.get_real(ask))
+    # each array whole and in order, a scalar between them: each getter called once (the usual plan)
+    ordered = tuple([vr[f"q_BN[{i}]"] for i in (1, 2, 3, 4)] + [vr["max_substep"]]
+                    + [vr[f"omega_BN_B[{i}]"] for i in (1, 2, 3)])
+    for _ in range(2):
+        assert body.get_real(ordered) == [0.6, 0.0, 0.0, 0.8, 0.005, 0.0, 0.0, 0.25]
+    assert body._get_plans[Real][ordered][1] is None and body._get_plans[Real][tuple(ask)][1] is not None
     body.set_real([vr["torque_B[2]"], vr["max_substep"], vr["torque_B[1]"]], [0.5, 0.001, -0.5])
     assert body.values["max_substep"] == 0.001 and body.get_real([vr["torque_B[1]"], vr["torque_B[2]"]]) == [-0.5, 0.5]
     with pytest.raises(TypeError, match="is not of type Real"):  # a Boolean asked for as Real: pythonfmu says so
