@@ -147,12 +147,9 @@ class RigidBody:
         wheel_torque / wheel_momentum (B frame): the wheel motors' torque on the wheels (N.m,
         held over the step) and the wheels' momentum h_w at the step start (N.m.s); see the
         module docstring. Left at zero: the wheel-less model, bit for bit."""
-        isfinite = math.isfinite
-        if not (all(map(isfinite, torque)) and all(map(isfinite, wheel_torque)) and all(map(isfinite, wheel_momentum))):
-            for name, v in (("torque_B", torque), ("wheel_torque_B", wheel_torque),
-                            ("wheel_momentum_B", wheel_momentum)):
-                if not all(map(isfinite, v)):
-                    raise ValueError(f"{name} {list(v)} must be finite")
+        for name, v in (("torque_B", torque), ("wheel_torque_B", wheel_torque), ("wheel_momentum_B", wheel_momentum)):
+            if not all(map(math.isfinite, v)):
+                raise ValueError(f"{name} {list(v)} must be finite")
         tw, hw = tuple(wheel_torque), tuple(wheel_momentum)
         if self.integrator == "euler":
             q, w = self.q, self.omega
