@@ -131,6 +131,20 @@ def _start_resource_tracker():
         signal.signal(signal.SIGHUP, previous)
 
 
+class _SyncCancelRace(logging.Filter):
+    """Drops the one record a Ctrl-C can make dask.distributed log with a traceback: its `sync()`
+    (2026.8) answers a KeyboardInterrupt by scheduling a cancel() that reads `future`, and when the
+    interrupt comes before the event loop has assigned it, tornado logs the NameError. There was
+    no future to cancel, so nothing is lost; the runner says it was interrupted."""
+
+    def filter(self, record):
+        exc = record.exc_info[1] if record.exc_info else None
+        return not (isinstance(exc, NameError) and "'future'" in str(exc))
+
+
+SYNC_CANCEL_RACE = _SyncCancelRace()
+
+
 def _client(workers, scheduler):
     import dask
     from dask.distributed import Client, LocalCluster
@@ -246,6 +260,8 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     client = cluster = None
     if todo:  # a scheduler that does not answer is said before the folder is touched
         client, cluster = _client(workers, scheduler)
+    tornado_log = logging.getLogger("tornado.application")
+    tornado_log.addFilter(SYNC_CANCEL_RACE)
     try:
         out = _prepare_folder(spec, out)
         columns = _columns(spec)
@@ -266,6 +282,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
         if cluster is not None:
             cluster.close()
             shutil.rmtree(cluster.neighbor_scratch, ignore_errors=True)
+        tornado_log.removeFilter(SYNC_CANCEL_RACE)
     rows = sorted(_read_rows(out), key=lambda r: r["run"])
     _write_rows(out / "runs.parquet", rows, columns)
     summary = summarize(spec, rows, units)
