@@ -18,11 +18,23 @@ sun_position_au_nb = njit(cache=True)(sun.sun_position_au)
 
 
 @njit(cache=True)
+def gmst_rotation(jd):
+    """(cos, sin) of GMST at the UTC Julian date jd."""
+    th = gmst_nb((jd - J2000_JD) / DAYS_PER_CENTURY)
+    return math.cos(th), math.sin(th)
+
+
+@njit(cache=True)
+def rotated(r, c, s):
+    """R3(GMST) r_N (tuple) with (c, s) = gmst_rotation(jd)."""
+    return (c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
+
+
+@njit(cache=True)
 def earth_fixed(r, jd):
     """r_E = R3(GMST) r_N (tuple), GMST of the UTC Julian date jd."""
-    th = gmst_nb((jd - J2000_JD) / DAYS_PER_CENTURY)
-    c, s = math.cos(th), math.sin(th)
-    return (c * r[0] + s * r[1], -s * r[0] + c * r[1], r[2])
+    c, s = gmst_rotation(jd)
+    return rotated(r, c, s)
 
 
 @njit(cache=True)

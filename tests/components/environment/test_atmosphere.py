@@ -9,7 +9,7 @@ import pytest
 
 from components.core import time_utils
 from components.environment import atmosphere, geodesy, space_weather, sun
-from components.environment.atmosphere import jacchia_roberts
+from components.environment.atmosphere import base, jacchia_roberts
 from fmu_helpers import check_declarations, instantiate
 from paths import DATA, REPO
 
@@ -176,6 +176,28 @@ def test_jacchia_roberts_space_weather_selection(sw):
         m.density(equator(400e3), time_utils.julian_date("1999-06-01T00:00:00Z"))
     with pytest.raises(ValueError, match="before the first entry"):  # the numba kernel raises too
         m.kernel(equator(400e3), time_utils.julian_date("1999-06-01T00:00:00Z"), m.kernel_data)
+
+
+def test_jacchia_roberts_kernel_keeps_the_terms_of_one_time(sw):
+    """The kernel computes what depends on the time alone once per time (the orbit's quadrature asks
+    for 16 positions at one time): every density, asked in any order, is the one computed from
+    scratch, composed of the model's pieces as the kernel did before, bit for bit."""
+    m = atmosphere.make_density_model("jacchia_roberts", space_weather=sw)
+    rng = np.random.default_rng(5)
+    positions = [u / np.linalg.norm(u) * (R_EQ + rng.uniform(150e3, 900e3)) for u in rng.normal(size=(16, 3))]
+    times = [JD_2023 + 0.37, JD_2023 + 0.37 + 1e-9, JD_2023 + 41.8]
+
+    def from_scratch(r, jd):
+        lat, _, h = base.geodetic(r, jd)
+        s = base.sun_position_au_nb((jd - time_utils.J2000_JD) / time_utils.DAYS_PER_CENTURY)
+        ha = math.atan2(s[0] * r[1] - s[1] * r[0], s[0] * r[0] + s[1] * r[1])
+        dec = math.atan2(s[2], math.sqrt(s[0] * s[0] + s[1] * s[1]))
+        return float(jacchia_roberts.jr_density(h / 1e3, lat, ha, dec, *m.indices(jd), jd))
+
+    for order in (range(48), rng.permutation(48)):
+        for k in order:
+            r, jd = positions[k % 16], times[k // 16]
+            assert m.kernel(r, jd, m.kernel_data) == from_scratch(r, jd)
 
 
 def test_jacchia_roberts_constant_indices_and_solar_activity():
