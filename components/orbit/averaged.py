@@ -37,9 +37,10 @@ the trapezoidal rule over N equally spaced eccentric longitudes F_k (spectrally 
 periodic integrand), weighted by dM = (r / a) dF. Default N = 16: thesis lifetimes change by
 < 1e-5 relative from N = 12 to 24 (Jacchia-Roberts, 525 km, 86.37 y). The density is the atmosphere kernel at each
 node's actual 3D position at the current time (the orbit is averaged as a snapshot: within one
-orbit the Sun moves 0.06 deg and the space weather is constant). The whole average is one call
-of a compiled function (numba, when installed) with the model's kernel bound in; NRLMSIS's kernel
-calls pymsis for each node (slow: N pymsis calls per evaluation, about 4 ms).
+orbit the Sun moves 0.06 deg and the space weather is constant). The whole integration of a call
+of advance_to (its RK4 steps, four averages each) is one call of a compiled function (numba, when
+installed) with the model's kernel bound in; NRLMSIS's kernel calls pymsis for each node (slow:
+N pymsis calls per evaluation, about 4 ms).
 
 J2 secular drift (first order): dRAAN/dt and dargp/dt from components.orbit.elements.
 j2_secular_rates, and dM/dt = n + 3/4 n J2 (R/p)^2 eta (2 - 3 sin^2 i) (Vallado Eq. 9-41;
@@ -67,6 +68,7 @@ from ..core.jit import njit
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
 
 from ..environment import geodesy
+from ..environment.atmosphere import base, exponential, harris_priester, jacchia_roberts
 from ..mission.neighbor import SPACECRAFT
 from . import elements
 from .propulsion import ImpulseWindow
@@ -209,6 +211,169 @@ def _drag_function(kernel):
 
 
 @njit(cache=True)
+def _j2_mean_anomaly(a, e, i, mu, j2, r_eq, two):
+    """j2_mean_anomaly_rate; `two` is 2.0 given as a value: LLVM turns pow(x, 2.0) with a constant
+    2.0 into x * x, which differs from libm's pow (Python's **) in the last bit about once in
+    1,200 values."""
+    n = math.sqrt(mu / a ** 3.0)
+    p = a * (1.0 - e * e)
+    si = math.sin(i)
+    return 0.75 * n * j2 * (r_eq / p) ** two * math.sqrt(1.0 - e * e) * (2.0 - 3.0 * si * si)
+
+
+# advance_to's parameters, one float64 array (prm[...]) for the compiled integration
+_MU, _J2, _R_EQ, _OMEGA_ATM, _JD_EPOCH, _DAY_OFFSET, _MAX_STEP, _THRUST_STEP, _MAX_DA_STEP, _REENTRY, _TWO = range(11)
+_NO_THRUST = np.zeros(3)
+# the first argument of the ValueError the compiled integration raises when the elements leave
+# the closed-orbit domain (advance_to words it; numba cannot format a message)
+_OUTSIDE_DOMAIN = "mean elements left the closed-orbit domain"
+
+
+@njit
+def _rates_kernel(y, t, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data):
+    """d/dt of the elements y at time t: drag (when `drag`), J2, the mean motion and the thrust
+    (f_N, retro as _thrust_rates', when thrust_on)."""
+    if not (y[0] > 0.0 and y[1] * y[1] + y[2] * y[2] < 1.0):
+        raise ValueError(_OUTSIDE_DOMAIN, y[0], y[1], y[2], t)
+    mu = prm[_MU]
+    if drag:
+        d = _drag_rates_kernel(y, prm[_JD_EPOCH] + t / DAY, mu, bc, prm[_OMEGA_ATM], n_nodes, kernel, kernel_data)
+    else:
+        d = np.zeros(6)
+    draan, dargp, dM = 0.0, 0.0, 0.0
+    if prm[_J2] != 0.0:
+        e = math.hypot(y[1], y[2])
+        draan, dargp = elements.j2_secular_core(y[0], e, y[3], mu, prm[_J2], prm[_R_EQ])
+        dM = _j2_mean_anomaly(y[0], e, y[3], mu, prm[_J2], prm[_R_EQ], prm[_TWO])
+    d[1] -= y[2] * dargp
+    d[2] += y[1] * dargp
+    d[4] += draan
+    d[5] += math.sqrt(mu / y[0] ** 3.0) + dargp + dM
+    if thrust_on:
+        thrust = _thrust_rates(y, mu, f_N, retro)
+        for j in range(6):
+            d[j] += thrust[j]
+    return d
+
+
+@njit
+def _rk4_kernel(y, t, h, k1, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data):
+    """One classical RK4 step of h from (t, y) with k1 = the rates there: numpy's operations on the
+    six elements, in the same order (the same bits), written as loops."""
+    total = k1.copy()  # k1 + 2 k2 + 2 k3 + k4, summed in that order
+    k = k1
+    stage_y = np.empty(6)
+    for stage in range(3):
+        c = h if stage == 2 else 0.5 * h
+        for j in range(6):
+            stage_y[j] = y[j] + c * k[j]
+        k = _rates_kernel(stage_y, t + c, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data)
+        weight = 1.0 if stage == 2 else 2.0  # 1.0 * k is k
+        for j in range(6):
+            total[j] += weight * k[j]
+    sixth = h / 6.0
+    out = np.empty(6)
+    for j in range(6):
+        out[j] = y[j] + sixth * total[j]
+    return out
+
+
+@njit(cache=True)
+def _perigee_margin(y, reentry_altitude):
+    return y[0] * (1.0 - math.hypot(y[1], y[2])) - R_EQ - reentry_altitude
+
+
+@njit
+def _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data):
+    """OrbitAveraged.advance_to's integration from (t, y) toward t_end: RK4 steps (module
+    docstring) while more than min_step is left. Returns (y, t reached, drag evaluations, re-entry
+    time or -1.0): at re-entry the state there, located by secant iteration on the step's length
+    (to < 1 s or 1 m)."""
+    evaluations = 0
+    per_rates = 1 if drag else 0
+    while t_end - t > min_step:
+        h = min(t_end - t, prm[_MAX_STEP])
+        to_midnight = DAY - (prm[_DAY_OFFSET] + t) % DAY
+        if to_midnight > 1e-3:
+            h = min(h, to_midnight)
+        if thrust_on:
+            h = min(h, prm[_THRUST_STEP])
+        k1 = _rates_kernel(y, t, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data)
+        if k1[0] != 0.0:
+            h = min(h, prm[_MAX_DA_STEP] / abs(k1[0]))
+        y1 = _rk4_kernel(y, t, h, k1, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data)
+        evaluations += 4 * per_rates
+        if _perigee_margin(y1, prm[_REENTRY]) < 0.0:
+            lo, glo, hi, ghi = 0.0, _perigee_margin(y, prm[_REENTRY]), h, _perigee_margin(y1, prm[_REENTRY])
+            tau, yt = hi, y1
+            for _ in range(40):
+                tau = lo + (hi - lo) * glo / (glo - ghi)
+                tau = min(max(tau, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
+                yt = _rk4_kernel(y, t, tau, k1, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, kernel_data)
+                evaluations += 3 * per_rates
+                g = _perigee_margin(yt, prm[_REENTRY])
+                if g < 0.0:
+                    hi, ghi = tau, g
+                else:
+                    lo, glo = tau, g
+                if hi - lo < 1.0 or abs(g) < 1.0:
+                    break
+            yt[4] %= TWO_PI
+            yt[5] %= TWO_PI
+            return yt, t + tau, evaluations, t + tau
+        t, y = t + h, y1
+        y[4] %= TWO_PI
+        y[5] %= TWO_PI
+    return y, t, evaluations, -1.0
+
+
+# _advance_kernel with each of the product's atmosphere kernels bound in, cached like every kernel
+# here (components.core.jit): a kernel named as a module's attribute in a module's function is
+# cached with it, a closure's is not (it took 2-4 s to compile in every process; the drag closure
+# of drag_rates, which the integration called before, 1 s)
+@njit(cache=True)
+def _advance_jacchia_roberts(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
+    return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
+                           jacchia_roberts.jacchia_roberts_kernel, kernel_data)
+
+
+@njit(cache=True)
+def _advance_harris_priester(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
+    return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
+                           harris_priester.harris_priester_kernel, kernel_data)
+
+
+@njit(cache=True)
+def _advance_exponential(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
+    return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
+                           exponential.exponential_kernel, kernel_data)
+
+
+@njit(cache=True)
+def _advance_without_drag(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
+    return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
+                           base.vacuum_kernel, kernel_data)
+
+
+_ADVANCE = {jacchia_roberts.jacchia_roberts_kernel: _advance_jacchia_roberts,
+            harris_priester.harris_priester_kernel: _advance_harris_priester,
+            exponential.exponential_kernel: _advance_exponential, base.vacuum_kernel: _advance_without_drag}
+
+
+def _advance_function(kernel):
+    """_advance_kernel with the atmosphere's `kernel` bound in: cached for the product's kernels,
+    else (NRLMSIS, a user's kernel) a closure compiled once per kernel and process, as _drag_function."""
+    f = _ADVANCE.get(kernel)
+    if f is None:
+        @njit(cache=False)
+        def f(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
+            return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
+                                   kernel, kernel_data)
+        _ADVANCE[kernel] = f
+    return f
+
+
+@njit(cache=True)
 def _state_N(y, mu):
     """(r_N, v_N) arrays of the mean elements y (two-body)."""
     F = _eccentric_longitude(y[5], y[1], y[2])
@@ -261,10 +426,7 @@ def quaternion_to_dcm(q):
 
 def j2_mean_anomaly_rate(a, e, i, mu=MU_EARTH, j2=J2, r_eq=R_EQ):
     """First-order J2 secular part of dM/dt (rad/s, without n): 3/4 n J2 (R/p)^2 eta (2 - 3 sin^2 i)."""
-    n = math.sqrt(mu / a ** 3)
-    p = a * (1.0 - e * e)
-    si = math.sin(i)
-    return 0.75 * n * j2 * (r_eq / p) ** 2 * math.sqrt(1.0 - e * e) * (2.0 - 3.0 * si * si)
+    return _j2_mean_anomaly(float(a), float(e), float(i), float(mu), float(j2), float(r_eq), 2.0)
 
 
 # ---- the model ---------------------------------------------------------------------------------
@@ -391,41 +553,6 @@ class OrbitAveraged:
         return _drag_function(self.atmosphere.kernel)(y, jd, self.mu, bc, self.omega_atm, self.n_nodes,
                                                       self.atmosphere.kernel_data)
 
-    def j2_rates(self, y):
-        """(dRAAN/dt, dargp/dt, dM/dt - n) of J2 (rad/s)."""
-        if self.j2 == 0.0:
-            return 0.0, 0.0, 0.0
-        e = math.hypot(y[1], y[2])
-        draan, dargp = elements.j2_secular_rates(y[0], e, y[3], self.mu, self.j2, self.r_eq)
-        return draan, dargp, j2_mean_anomaly_rate(y[0], e, y[3], self.mu, self.j2, self.r_eq)
-
-    def rates(self, y, t, mass, thrust=None):
-        """d/dt of the elements y at time t. `thrust`: None or (f_N array m/s^2, retro magnitude m/s^2)."""
-        if not (y[0] > 0.0 and y[1] * y[1] + y[2] * y[2] < 1.0):
-            raise ValueError(f"mean elements left the closed-orbit domain (a = {y[0]!r} m, "
-                             f"e = {math.hypot(y[1], y[2])!r}) at t = {t!r} s")
-        d = self.drag_rates(y, t, mass)
-        draan, dargp, dM = self.j2_rates(y)
-        d[1] -= y[2] * dargp
-        d[2] += y[1] * dargp
-        d[4] += draan
-        d[5] += math.sqrt(self.mu / y[0] ** 3) + dargp + dM
-        if thrust is not None:
-            d += _thrust_rates(y, self.mu, thrust[0], thrust[1])
-        return d
-
-    # ---- integration -----------------------------------------------------------------------
-    def _rk4(self, y, t, h, mass, thrust, k1=None):
-        if k1 is None:
-            k1 = self.rates(y, t, mass, thrust)
-        k2 = self.rates(y + 0.5 * h * k1, t + 0.5 * h, mass, thrust)
-        k3 = self.rates(y + 0.5 * h * k2, t + 0.5 * h, mass, thrust)
-        k4 = self.rates(y + h * k3, t + h, mass, thrust)
-        return y + h / 6.0 * (k1 + 2.0 * k2 + 2.0 * k3 + k4)
-
-    def _perigee_margin(self, y):
-        return y[0] * (1.0 - math.hypot(y[1], y[2])) - R_EQ - self.reentry_altitude
-
     def thrust_acceleration(self, F_thrust_B, q_BN=(0.0, 0.0, 0.0, 1.0), retrograde=False, mass=SPACECRAFT.mass):
         """None when the thrust is zero, else (f_N m/s^2, retro magnitude m/s^2) for _thrust_rates."""
         F = np.array([float(x) for x in F_thrust_B])
@@ -456,51 +583,30 @@ class OrbitAveraged:
                 F_thrust_B = tuple(float(f) + e for f, e in zip(F_thrust_B, extra))
         thrust = self.thrust_acceleration(F_thrust_B, q_BN, retrograde, mass)
         self._out_cache = None
-        t, y = self.t, self.y
-        # a step shorter than the rounding of the time is no step; anything longer is integrated
-        # (a relative tolerance would drop the 0.1 s steps of a run years after its epoch)
-        while not self.reentered and t_end - t > 64.0 * math.ulp(max(1.0, abs(t_end))):
-            h = min(t_end - t, self.max_step)
-            to_midnight = DAY - (self._day_offset + t) % DAY
-            if to_midnight > 1e-3:
-                h = min(h, to_midnight)
-            if thrust is not None:
-                h = min(h, self.thrust_step)
-            k1 = self.rates(y, t, mass, thrust)
-            if k1[0] != 0.0:
-                h = min(h, self.max_da_step / abs(k1[0]))
-            y1 = self._rk4(y, t, h, mass, thrust, k1)
-            if self._perigee_margin(y1) < 0.0:
-                y, t = self._locate_reentry(y, t, h, mass, thrust, k1)
-                self.reentered = True
-                self.reentry_time = t
-                break
-            t, y = t + h, y1
-            y[4] %= TWO_PI
-            y[5] %= TWO_PI
-        self.y = y
+        if not self.reentered:
+            f_N, retro = (_NO_THRUST, 0.0) if thrust is None else thrust
+            drag = self.atmosphere is not None
+            kernel, data = (self.atmosphere.kernel, self.atmosphere.kernel_data) if drag else (base.vacuum_kernel, ())
+            prm = np.array([self.mu, self.j2, self.r_eq, self.omega_atm, self.jd_epoch, self._day_offset,
+                            self.max_step, self.thrust_step, self.max_da_step, self.reentry_altitude, 2.0])
+            # a step shorter than the rounding of the time is no step; anything longer is integrated
+            # (a relative tolerance would drop the 0.1 s steps of a run years after its epoch)
+            min_step = 64.0 * math.ulp(max(1.0, abs(t_end)))
+            try:
+                y, _, evaluations, reentry_time = _advance_function(kernel)(
+                    self.y, self.t, t_end, min_step, prm, self.Cd * self.area / mass, self.n_nodes, drag,
+                    f_N, retro, thrust is not None, data)
+            except ValueError as err:
+                if err.args[:1] != (_OUTSIDE_DOMAIN,):
+                    raise
+                a, ex, ey, t = err.args[1:]
+                e = math.hypot(ex, ey)
+                raise ValueError(f"{_OUTSIDE_DOMAIN} (a = {a!r} m, e = {e!r}) at t = {t!r} s") from None
+            self.y = y
+            self.evaluations += evaluations
+            if reentry_time >= 0.0:
+                self.reentered, self.reentry_time = True, reentry_time
         self.t = t_end
-
-    def _locate_reentry(self, y0, t0, h, mass, thrust, k1):
-        """(state, time) where the perigee margin crosses zero in the step (t0, t0 + h]: secant
-        iteration on the step length, to < 1 s or 1 m."""
-        g0 = self._perigee_margin(y0)
-        lo, glo, hi, ghi = 0.0, g0, h, self._perigee_margin(self._rk4(y0, t0, h, mass, thrust, k1))
-        tau, yt = hi, None
-        for _ in range(40):
-            tau = lo + (hi - lo) * glo / (glo - ghi)
-            tau = min(max(tau, lo + 1e-3 * (hi - lo)), hi - 1e-3 * (hi - lo))
-            yt = self._rk4(y0, t0, tau, mass, thrust, k1)
-            g = self._perigee_margin(yt)
-            if g < 0.0:
-                hi, ghi = tau, g
-            else:
-                lo, glo = tau, g
-            if hi - lo < 1.0 or abs(g) < 1.0:
-                break
-        yt[4] %= TWO_PI
-        yt[5] %= TWO_PI
-        return yt, t0 + tau
 
     # ---- outputs ---------------------------------------------------------------------------
     def state_vectors(self):

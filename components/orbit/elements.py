@@ -24,6 +24,7 @@ import math
 import numpy as np
 
 from ..core.constants import MU_EARTH, R_EQ
+from ..core.jit import njit
 
 J2_EGM96 = -math.sqrt(5.0) * -0.484165371736e-3  # = 1.0826266835531513e-3
 
@@ -275,7 +276,13 @@ def j2_secular_rates(a, e, i, mu=MU_EARTH, j2=J2_EGM96, r_eq=R_EQ):
 
     with n = sqrt(mu / a^3) and p = a (1 - e^2)."""
     a, e = _check_a_e(a, e)
-    n = mean_motion(a, mu)
+    return j2_secular_core(a, e, float(i), _check_mu(mu), float(j2), float(r_eq))
+
+
+@njit(cache=True)
+def j2_secular_core(a, e, i, mu, j2, r_eq):
+    """j2_secular_rates without the checks, compiled (the orbit-averaged model's integration calls it)."""
+    n = math.sqrt(mu / a ** 3.0)  # mean_motion
     p = a * (1.0 - e * e)
     k = n * r_eq * r_eq * j2 / (p * p)
     si = math.sin(i)

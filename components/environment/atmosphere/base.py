@@ -43,6 +43,12 @@ def geodetic(r, jd):
     return geodetic_nb(earth_fixed(r, jd))
 
 
+@njit(cache=True)
+def vacuum_kernel(r, jd, data):
+    """A kernel of no atmosphere: density 0 (the orbit-averaged model binds it in without drag)."""
+    return 0.0
+
+
 def _as_position(r_N):
     r = np.asarray(r_N, dtype=np.float64).reshape(3)
     if not np.all(np.isfinite(r)) or not (r @ r) > 0.0:
