@@ -123,6 +123,7 @@ class DeorbitTrackingController:
         # reaches its torque, |s_i| >= e_i level_i / (J_ii G_i), the law's deadband in s
         self.deadband_per_e = tuple(self.levels[i] / (self.J[i][i] * self.G[i]) for i in range(3))
         self.bits = tc.impulse_bit_rates(self.levels, [self.J[i][i] for i in range(3)], min_on_time)
+        self._layer_of = None  # the sigma_attitude self.e was sized for
         self.boundary_layer((0.0, 0.0, 0.0))
         self.q_d0 = None if q_d0 is None else rotations.normalized(tuple(float(x) for x in q_d0), "q_d0")
         self.q_d = self.q_d0  # None: latch the measured q at the first enabled step
@@ -141,10 +142,13 @@ class DeorbitTrackingController:
             self.e = self.e_fixed
             return self.e
         sig = tuple(float(x) for x in sigma_attitude)
+        if sig == self._layer_of:  # an estimate's sigmas change with its covariance, not at every step
+            return self.e
         if len(sig) != 3 or not all(math.isfinite(x) and x >= 0.0 for x in sig):
             raise ValueError(f"sigma_attitude {list(sig)} must be three finite numbers >= 0 (rad)")
         self.e = tuple(max(self.e_fixed[i], max(n * math.hypot(self.rate_sigma, 0.5 * k * sig[i]), m * self.bits[i])
                            / self.deadband_per_e[i]) for i in range(3))
+        self._layer_of = sig
         return self.e
 
     # ---- desired attitude ----------------------------------------------------------------

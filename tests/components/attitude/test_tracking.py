@@ -151,6 +151,10 @@ def test_boundary_layer_sized_for_the_estimate():
     assert thesis.command(Q0, omega)[1][1] != 0 and ctl.command(Q0, omega)[1] == [0, 0, 0]
     with pytest.raises(ValueError, match="sigma_attitude .* must be three finite numbers >= 0"):
         ctl.boundary_layer((0.0, -1e-3, 0.0))
+    # the layer is kept while the sigmas repeat (most steps): any sequence gives a fresh law's e
+    for sigma in ((1e-3, 2e-3, 5e-4), (1e-3, 2e-3, 5e-4), (2e-3, 2e-3, 5e-4), (1e-3, 2e-3, 5e-4)):
+        fresh = dtr.DeorbitTrackingController(J_BOX, knowledge_sigmas=3.0, impulse_bits=1.0, rate_sigma=1e-4)
+        assert ctl.boundary_layer(sigma) == fresh.boundary_layer(sigma) == ctl.e
     with pytest.raises(ValueError, match="knowledge_sigmas = -1.0 must be a finite number >= 0"):
         dtr.DeorbitTrackingController(J_BOX, knowledge_sigmas=-1.0)
 
