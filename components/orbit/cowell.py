@@ -44,6 +44,7 @@ import numpy as np
 from ..core.jit import njit
 from ..core import rotations, time_utils
 from ..environment import atmosphere, geodesy
+from ..environment.atmosphere import base, exponential, harris_priester, jacchia_roberts
 from ..core.checks import positive
 from ..environment.gravity import accel_zonal, zonal_coefficients
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
@@ -62,12 +63,6 @@ _A, _B, _C, _E3, _E5 = (np.ascontiguousarray(x) for x in (dop853.A, dop853.B, do
 
 # indices into the force-parameter vector `fp`
 _MU, _REQ, _DRAG, _BC, _JD0, _WE, _TX, _TY, _TZ, _TMAG, _RETRO = range(11)
-
-
-@njit(cache=True)
-def _zero_density(r_N, jd_utc, data):
-    """Density kernel used when drag is off (never called then: drag flag is 0)."""
-    return 0.0
 
 
 @njit(cache=True)
@@ -99,7 +94,9 @@ def geodetic_altitude_nb(x, y, z):
 # argument by the identity of its dispatcher object: the cache never matches one in another
 # process, so cache=True only added a ~0.5 MB entry per run to the user's cache (for ever), and
 # once an index held more entries than numba keeps their dispatchers alive, saving it raised
-# ReferenceError inside fmi2DoStep. Compiled in each process instead (about 1 s).
+# ReferenceError inside fmi2DoStep. The product's kernels are bound in by the cached functions
+# below (the kernel a module's global, their signatures without it); any other kernel is passed
+# to _advance, compiled in each process (4-6 s).
 @njit(cache=False)
 def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
     x = y[0]
@@ -221,6 +218,39 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
     return t, y, h_abs, reentered, steps, rejected
 
 
+@njit(cache=True)
+def _advance_jacchia_roberts(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
+                             max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, jacchia_roberts.jacchia_roberts_kernel, kdata, A, B, C,
+                    E3, E5, reentry_altitude, max_steps)
+
+
+@njit(cache=True)
+def _advance_harris_priester(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
+                             max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, harris_priester.harris_priester_kernel, kdata, A, B, C,
+                    E3, E5, reentry_altitude, max_steps)
+
+
+@njit(cache=True)
+def _advance_exponential(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
+                         max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, exponential.exponential_kernel, kdata, A, B, C,
+                    E3, E5, reentry_altitude, max_steps)
+
+
+@njit(cache=True)
+def _advance_without_drag(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
+                          max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, base.vacuum_kernel, kdata, A, B, C,
+                    E3, E5, reentry_altitude, max_steps)
+
+
+_CACHED_ADVANCE = {jacchia_roberts.jacchia_roberts_kernel: _advance_jacchia_roberts,
+                   harris_priester.harris_priester_kernel: _advance_harris_priester,
+                   exponential.exponential_kernel: _advance_exponential, base.vacuum_kernel: _advance_without_drag}
+
+
 class CowellOrbit:
     """Cowell propagation of r, v in N; see the module docstring.
 
@@ -271,7 +301,7 @@ class CowellOrbit:
             raise ValueError("drag is on but no density_model was given; give a model from "
                              "components.environment.atmosphere.make_density_model or drag=False")
         self.density_model = density_model
-        self._kernel = density_model.kernel if self.drag else _zero_density
+        self._kernel = density_model.kernel if self.drag else base.vacuum_kernel  # not called: drag flag 0
         self._kdata = (density_model.kernel_data or ()) if self.drag else ()
         self.t = time_utils.check_time(t0, "t0")
         self.t_state = self.t
@@ -343,10 +373,12 @@ class CowellOrbit:
         if t == self.t:
             return
         if not self.reentered:
-            ts, y, h, reentered, steps, _ = _advance(
-                self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
-                self.zonal_degree, self._kernel, self._kdata, _A, _B, _C, _E3, _E5,
-                self.reentry_altitude, MAX_INTERNAL_STEPS)
+            args = (self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
+                    self.zonal_degree)
+            tail = (self._kdata, _A, _B, _C, _E3, _E5, self.reentry_altitude, MAX_INTERNAL_STEPS)
+            cached = _CACHED_ADVANCE.get(self._kernel)
+            ts, y, h, reentered, steps, _ = (cached(*args, *tail) if cached is not None
+                                             else _advance(*args, self._kernel, *tail))
             self.t_state, self.y, self.h, self.steps = float(ts), y, float(h), self.steps + int(steps)
             if reentered:
                 self.reentered = True

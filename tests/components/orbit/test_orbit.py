@@ -6,9 +6,9 @@ import math
 import numpy as np
 import pytest
 
-from components.core import constants, rotations
-from components.environment import atmosphere, geodesy, gravity
-from components.orbit import cowell
+from components.core import constants, jit, rotations
+from components.environment import atmosphere, geodesy, gravity, space_weather
+from components.orbit import averaged, cowell
 from components.orbit import elements as oe
 from fmu_helpers import check_declarations, instantiate
 
@@ -378,3 +378,18 @@ def test_orbit_fmu_cartesian_start_equals_the_elements(build_one, tmp_path):
     with pytest.raises(ValueError, match="r0_N"):
         oe.initial_elements({"cartesian0": True, **{f"r0_N[{k}]": 0.0 for k in (1, 2, 3)},
                              **{f"v0_N[{k}]": 0.0 for k in (1, 2, 3)}})
+
+
+@pytest.mark.skipif(not jit.ENABLED, reason="numba's cache")
+def test_the_product_atmospheres_are_bound_in_by_cached_functions():
+    """Both integrators bind the product's atmosphere kernels in through functions numba caches
+    across processes: a kernel passed as an argument is compiled again in every process (the Cowell
+    integration 4-6 s, the averaged one 2-4 s). NRLMSIS (pymsis from compiled code) and a user's
+    kernel take that path."""
+    sw = space_weather.SpaceWeather.from_file()
+    for name in atmosphere.MODELS:
+        if name == "msis":
+            continue
+        kernel = atmosphere.make_density_model(name, space_weather=sw, inclination=0.9).kernel
+        for integration in (averaged._advance_function(kernel), cowell._CACHED_ADVANCE[kernel]):
+            assert type(integration._cache).__name__ == "FunctionCache", (name, integration)
