@@ -242,7 +242,7 @@ def _rates_kernel(y, t, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel, k
         d = np.zeros(6)
     draan, dargp, dM = 0.0, 0.0, 0.0
     if prm[_J2] != 0.0:
-        e = math.hypot(y[1], y[2])
+        e = math.hypot(y[1], y[2])  # the C library's; CPython's differs by an ulp in 1 value of 700
         draan, dargp = elements.j2_secular_core(y[0], e, y[3], mu, prm[_J2], prm[_R_EQ])
         dM = _j2_mean_anomaly(y[0], e, y[3], mu, prm[_J2], prm[_R_EQ], prm[_TWO])
     d[1] -= y[2] * dargp
