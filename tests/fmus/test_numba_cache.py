@@ -4,6 +4,7 @@ folder. components.core.jit keeps the compiled code of our FMUs' private package
 cache under the package's name (its digest is of the package's code)."""
 import json
 import os
+import shutil
 import subprocess
 import sys
 
@@ -12,6 +13,9 @@ import numpy as np
 import pytest
 
 pytest.importorskip("numba")
+
+from components.core import jit  # noqa: E402
+from components.orbit import averaged  # noqa: E402
 
 RUN = r"""
 import json, sys
@@ -24,15 +28,16 @@ np.save(sys.argv[2], np.array([r[name] for name in case["outputs"]]))
 """
 
 # Per FMU: its run, the kernel whose cache file is checked and the package prefix. Orbit's DOP853
-# takes the atmosphere's kernel as an argument; numba cannot cache that (the type is the identity
-# of a dispatcher object), and while it tried, every run added an entry to the user's cache.
+# is cached with the Jacchia-Roberts kernel bound in by a module's function; numba cannot cache it
+# with the kernel as an argument (the type is the identity of a dispatcher object), and while it
+# tried, every run added an entry to the user's cache.
 CASES = {
     "RigidBody": ({"stop": 0.3, "interval": 0.015, "outputs": ["omega_BN_B[1]", "q_BN[4]"],
                    "starts": {"omega0[1]": 0.2, "omega0[2]": -0.1, "torque_B[3]": 1e-3}},
                   "rigid_body.rk4_steps", "nc_rigidbody_"),
     "Orbit": ({"stop": 20.0, "interval": 10.0, "outputs": ["r_BN_N[1]", "density"],
                "starts": {"density_model": "jacchia_roberts"}},
-              "jacchia_roberts.jacchia_roberts_kernel", "nc_orbit_"),
+              "cowell._advance_jacchia_roberts", "nc_orbit_"),
 }
 
 
@@ -63,3 +68,23 @@ def test_a_second_run_from_a_new_folder_loads_the_kernels_compiled_by_the_first(
     assert stamps[1] == stamps[0], sorted(set(stamps[1]) ^ set(stamps[0]))
     np.testing.assert_array_equal(results[1], results[0])
     assert np.ptp(results[0][0]) > 0.0  # the body turned, the spacecraft moved: the kernels ran
+
+
+@pytest.mark.skipif(not jit.ENABLED, reason="numba's cache")
+def test_a_cached_kernel_outside_an_fmu_is_stamped_with_the_whole_package(tmp_path):
+    """numba checks only the cached function's own file, but the orbit's integration holds the
+    atmosphere's code: outside an FMU every cache entry of the components package is stamped with
+    the digest of all its sources, so an edited atmosphere compiles the orbit again (before, the
+    orbit kept the old density)."""
+    locator = averaged._advance_jacchia_roberts._cache._impl.locator
+    root = jit.components_root_of(averaged.__file__)
+    assert type(locator).__name__ == "ComponentsCacheLocator"
+    assert locator.get_source_stamp() == jit.components_digest(root)
+    copy = tmp_path / "components"
+    shutil.copytree(root, copy, ignore=shutil.ignore_patterns("__pycache__"))
+    before = jit.components_digest(str(copy))
+    assert before == jit.components_digest(root)  # the names and contents, not where they are
+    kernel = copy / "environment" / "atmosphere" / "jacchia_roberts.py"
+    kernel.write_text(kernel.read_text().replace("return rho * 1.0e3", "return rho * 2.0e3"))
+    jit.components_digest.cache_clear()
+    assert jit.components_digest(str(copy)) != before
