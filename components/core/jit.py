@@ -37,6 +37,8 @@ ENABLED = numba is not None and os.environ.get("NEIGHBOR_COSIM_NUMBA", "1") != "
 
 # an FMU's private package folder: builder.build_fmu names it <prefix>_<class>_<code digest>
 _FMU_PACKAGE = re.compile(r"nc3?_[a-z0-9]+_[0-9a-f]{12}")
+
+
 def components_root_of(py_file):
     """The folder of the components package (this one's, or a copy's) that py_file lies in, or None."""
     folder = os.path.dirname(os.path.abspath(py_file))
