@@ -1,6 +1,7 @@
 """numba only makes the kernels faster: with it switched off (NEIGHBOR_COSIM_NUMBA=0, the path
-a host without numba takes) the atmospheres, the Cowell orbit, the orbit-averaged model and the
-attitude filter's matrix arithmetic give the same results to 1e-12."""
+a host without numba takes) the atmospheres, the Cowell orbit, the orbit-averaged model, the
+attitude filter's matrix arithmetic and the estimator's compiled step give the same results to
+1e-12."""
 import json
 import os
 import subprocess
@@ -16,7 +17,7 @@ import numpy as np
 from components.core import jit
 from components.environment import atmosphere, space_weather
 from components.orbit import averaged, cowell
-from components.sensing import mekf
+from components.sensing import mekf, triad
 from components.core import rotations
 
 out = {"numba": jit.ENABLED}
@@ -46,6 +47,24 @@ for k in range(40):
         b = [A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] + 1e-3 * math.sin(7 * k + i) for i in range(3)]
         nis.append(filt.update(b, r, 2e-3)[0])
 out["mekf"] = list(filt.q) + filt.bias.tolist() + np.diag(filt.P).tolist() + nis + [filt.attitude_nees(q_true)]
+est = mekf.AttitudeEstimator(inertia=np.diag([0.05, 0.1, 0.1]), accel_sigma=5e-4)
+u, y, outputs = np.zeros(mekf.U_SIZE), np.zeros(mekf.Y_SIZE), []
+u[mekf.U_R_BN:mekf.U_R_BN + 3], u[mekf.U_R_SN:mekf.U_R_SN + 3] = (6.8e6, 0.0, 0.0), (0.0, 1.5e11, 0.0)
+u[mekf.U_NADIR_VALID] = u[mekf.U_SUN_VALID] = 1.0
+q, w = rotations.normalized((0.1, 0.2, 0.3, 0.9)), (0.05, 0.01, -0.02)
+sun_N = rotations.normalized((-6.8e6, 1.5e11, 0.0))
+for k in range(300):  # 4.5 s of a slow tumble: the first fix, vector updates every 0.5 s, the steps between
+    q = triad.propagate(q, w, 0.015)
+    A = rotations.attitude_matrix(q)
+    for at, r in ((mekf.U_NADIR, (-1.0, 0.0, 0.0)), (mekf.U_SUN, sun_N)):
+        if k % 33 == 0:
+            u[at:at + 3] = [A[i][0] * r[0] + A[i][1] * r[1] + A[i][2] * r[2] + 1e-3 * math.cos(k + i) for i in range(3)]
+    u[mekf.U_RATE:mekf.U_RATE + 3] = (w[0] + 1e-3 + 5e-4 * math.sin(k), w[1] - 2e-3, w[2] + 5e-4 * math.cos(k))
+    u[mekf.U_TORQUE:mekf.U_TORQUE + 3] = (1e-4, 0.0, -1e-4)
+    u[mekf.U_Q_TRUE:mekf.U_Q_TRUE + 4], u[mekf.U_RATE_TRUE:mekf.U_RATE_TRUE + 3] = q, w
+    outputs.append(est.step_packed(u, 0.015, True, y))
+    outputs.extend(y.tolist())
+out["estimator"] = outputs + [est.consistency.total]
 print(json.dumps(out))
 """
 
