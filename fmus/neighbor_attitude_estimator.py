@@ -27,10 +27,13 @@ attitudes fit it alike, as for a body at rest, or while its largest 1-sigma exce
 `attitude_valid` uses `valid_sigma_without_sun` until a Sun vector is seen again.
 """
 import math
+from operator import itemgetter
 
+import numpy as np
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import rigid_body
+from components.core.names import element_names
 from components.sensing import mekf, triad
 
 
@@ -40,7 +43,7 @@ class AttitudeEstimator(NeighborSlave):
 
     def __init__(self, **kwargs):
         super().__init__(**kwargs)
-        self._out = None  # the outputs, computed at the end of initialization and of each step
+        self._out = None  # the outputs (mekf's Y_* positions), computed at the end of initialization and of each step
         self.parameter("nadir_sigma", math.radians(0.25), "rad", "Horizon sensor error angle RMS, >= 0")
         self.parameter("sun_sigma", math.radians(0.5) / 3.0, "rad", "Sun sensor error angle RMS, >= 0")
         self.parameter("gyro_sigma", 5.5e-4, "rad/s", "Gyro rate noise RMS per sample, >= 0")
@@ -55,7 +58,7 @@ class AttitudeEstimator(NeighborSlave):
                              "Output q_est_BN before the first fix (unit, scalar last)")
         self.attitude_measurement_inputs()
         self.output_array("q_est_BN", 4, self._q, "1", "Estimated attitude quaternion q_BN, scalar last")
-        self.output_array("omega_est_B", 3, lambda: self._outputs()["omega"], "rad/s",
+        self.output_array("omega_est_B", 3, lambda: self._outputs()[mekf.Y_RATE:mekf.Y_RATE + 3], "rad/s",
                           "Estimated angular velocity in B (the rate filter on the bias-corrected gyro; the raw "
                           "gyro before the first sample)")
         self.output_array("bias_est_B", 3, lambda: list(self.model.filter.bias), "rad/s", "Estimated gyro bias")
@@ -80,11 +83,11 @@ class AttitudeEstimator(NeighborSlave):
         self.input_array("omega_true_B", [0.0, 0.0, 0.0], "rad/s", "True angular velocity in B (truth feedback)")
         self.input_array("omega_dot_true_B", [0.0, 0.0, 0.0], "rad/s2",
                          "True angular acceleration in B (truth feedback)")
-        self.output_array("omega_dot_est_B", 3, lambda: self._outputs()["omega_dot"], "rad/s2",
+        self.output_array("omega_dot_est_B", 3, lambda: self._outputs()[mekf.Y_RATE_DOT:mekf.Y_RATE_DOT + 3], "rad/s2",
                           "Estimated angular acceleration in B over the last step, from the commanded torque")
-        self.output("attitude_error", lambda: self._outputs()["attitude_error"], "rad",
+        self.output("attitude_error", lambda: self._outputs()[mekf.Y_ATTITUDE_ERROR], "rad",
                     "Angle between q_est_BN and q_true_BN after the last step (0 before the first fix)")
-        self.output("rate_error", lambda: self._outputs()["rate_error"], "rad/s",
+        self.output("rate_error", lambda: self._outputs()[mekf.Y_RATE_ERROR], "rad/s",
                     "Norm of omega_est_B - omega_true_B after the last step")
         self.parameter("use_coarse_sun", False, None,
                        "Use the coarse Sun vector (coarse_sun_B) whenever the fine Sun sensor's is not valid", bool)
@@ -130,6 +133,13 @@ class AttitudeEstimator(NeighborSlave):
         self.parameter("history_fix_sigma", 0.0, "rad",
                        "The history's fix is taken only once its largest 1-sigma attitude error per axis is this or "
                        "less, else tried again after 120 s more history (>= 0; 0: any)")
+        # a step's inputs packed in mekf's U_* order, and its outputs (Y_*)
+        self._pick_packed = itemgetter(*element_names("nadir_B", 3), "nadir_valid", *element_names("sun_B", 3),
+                                       "sun_valid", *element_names("r_BN_N", 3), *element_names("r_SN_N", 3),
+                                       *element_names("omega_meas_B", 3), *element_names("torque_cmd_B", 3),
+                                       *element_names("coarse_sun_B", 3), "coarse_sun_valid",
+                                       *element_names("q_true_BN", 4), *element_names("omega_true_B", 3))
+        self._packed, self._packed_out = np.zeros(mekf.U_SIZE), np.zeros(mekf.Y_SIZE)
 
     def build_model(self):
         v = self.values
@@ -149,7 +159,7 @@ class AttitudeEstimator(NeighborSlave):
                                       history_fix_sigma=v["history_fix_sigma"])
 
     def _q(self):
-        return self._outputs()["q"]
+        return self._outputs()[mekf.Y_Q:mekf.Y_Q + 4]
 
     def _outputs(self):
         # before the end of initialization: from the values as they stand (not kept)
@@ -181,8 +191,7 @@ class AttitudeEstimator(NeighborSlave):
         error = 0.0
         if not truth and model.filter.initialized:
             error = triad.error_angle(q, q_true)
-        return {"q": q, "omega": w, "omega_dot": w_dot, "attitude_error": error,
-                "rate_error": math.sqrt(sum((a - b) ** 2 for a, b in zip(w, w_true)))}
+        return [*q, *w, *w_dot, error, math.sqrt(sum((a - b) ** 2 for a, b in zip(w, w_true)))]
 
     def exit_initialization_mode(self):
         super().exit_initialization_mode()
@@ -190,13 +199,17 @@ class AttitudeEstimator(NeighborSlave):
 
     def do_step(self, current_time, step_size):
         v = self.values
-        if not v["truth_feedback"]:
-            measurements = (self.vector("nadir_B", 3), v["nadir_valid"], self.vector("sun_B", 3), v["sun_valid"],
-                            self.vector("r_BN_N", 3), self.vector("r_SN_N", 3))
-            self.model.step(measurements, self.vector("omega_meas_B", 3), step_size, self.vector("torque_cmd_B", 3),
-                            (self.vector("coarse_sun_B", 3), v["coarse_sun_valid"]))
-            self.model.check(self.vector("q_true_BN", 4))
-        self._refresh()
+        if v["truth_feedback"]:
+            self._refresh()
+            return True
+        model, u = self.model, self._packed
+        u[:] = self._pick_packed(v)
+        # the step, the NEES against q_true_BN and the outputs, compiled between vector updates
+        if model.step_packed(u, step_size, True, self._packed_out) == 0:
+            self._out = self._packed_out.tolist()
+        else:  # before the first fix, or a NEES the compiled code leaves to check()
+            model.check(self.vector("q_true_BN", 4))
+            self._refresh()
         return True
 
     def _set_fmu_state(self, state):
