@@ -217,6 +217,10 @@ class ThrusterSet:
         self._burn_allocation = None  # the same for the x flags in the burn with off-pulsing
         self.monitor = None  # the fault detection (components.attitude.thruster_monitor), if flown
         self.fault_time = -1.0  # when it declared a stuck thruster (-1: never)
+        # the thrusters one set of flags opens (_plan), kept until the flags or the state that
+        # decides them (minimum on-times owed, valves, the stuck fault's clock) change
+        self._plan_version = 0
+        self._plan_key, self._plan_value = None, None
 
     def follow_propellant(self, mass0, tank):
         """From now on the torques are about the centre of mass of a body of `mass0` kg from whose
@@ -264,6 +268,7 @@ class ThrusterSet:
         self._allocate()
 
     def _allocate(self):
+        self._plan_version += 1
         open_ = [i for i in self.rcs if i not in self.disabled]
         if len(open_) == len(self.rcs):
             self._allocation = self._burn_allocation = None
@@ -281,7 +286,8 @@ class ThrusterSet:
         thrusters flight software opens for `flags` (with the axial ones left on in the burn);
         a declared fault closes its thrusters' valves before they fire in this step."""
         # the axial thrusters' nominal torques cancel only when all four fire
-        opened = self.commanded(flags, axial) + self.axial_on(flags, axial)
+        commanded, _, axial_on, _ = self._plan(flags, axial)
+        opened = commanded + axial_on
         action = self.monitor.step(t, omega_meas, opened, h, self.disabled)
         if action is not None:
             close, reopen, when = action
@@ -318,6 +324,19 @@ class ThrusterSet:
             if f and not (pulsing and axis > 0):
                 on.update(self.pairs[(axis, int(f))])
         return sorted(on)
+
+    def _plan(self, flags, axial):
+        """(commanded, firing, axial_on, axial_off) for `flags` and `axial` in the set's state:
+        the outputs, the fault detection and the step of one mission step ask for the same, so the
+        last answer is kept while neither the flags nor that state changes (callers do not change
+        the lists)."""
+        key = (flags[0], flags[1], flags[2], bool(axial), self._plan_version)
+        if key != self._plan_key:
+            commanded = self.commanded(flags, axial)
+            self._plan_value = (commanded, self.firing(flags, axial, commanded), self.axial_on(flags, axial),
+                                self.axial_off(flags, axial))
+            self._plan_key = key
+        return self._plan_value
 
     def firing(self, flags, axial=False, commanded=None):
         """Indices of the RCS thrusters that fire: the commanded ones (`commanded`, if already
@@ -358,13 +377,14 @@ class ThrusterSet:
         """(net force of the RCS thrusters firing for `flags` (N, B), torque (N.m, B)), the torque
         with the axial thrusters' left on when `axial` (the burn: their force is the propulsion's;
         their torque, zero when aligned and all on, is a disturbance here)."""
+        _, firing, axial_on, _ = self._plan(flags, axial)
         fx = fy = fz = tx = ty = tz = 0.0
-        for i in self.firing(flags, axial):
+        for i in firing:
             f, t = self.forces[i], self.torques[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
         ax = ay = az = 0.0
-        for i in self.axial_on(flags, axial):
+        for i in axial_on:
             t, f = self.torques[i], self.forces[i]
             tx, ty, tz = tx + t[0], ty + t[1], tz + t[2]
             ax, ay, az = ax + f[0], ay + f[1], az + f[2]
@@ -377,24 +397,27 @@ class ThrusterSet:
     def step(self, flags, h, axial=False):
         """Advance h seconds with `flags` (and `axial`, the burn) held: firing times, the minimum
         on-time, the axial thrusters' off time and the operating time."""
-        commanded = self.commanded(flags, axial)
+        commanded, firing, axial_on, axial_off = self._plan(flags, axial)
         for i in commanded:
             started = self.on_left[i] <= 0.0
-            left = (self.min_on_time if started else self.on_left[i]) - h
-            self.on_left[i] = max(0.0, left)
+            left = max(0.0, (self.min_on_time if started else self.on_left[i]) - h)
+            if left != self.on_left[i]:
+                self.on_left[i] = left
+                self._plan_version += 1  # a minimum on-time owed, or paid
         fx = fy = fz = 0.0
-        firing = self.firing(flags, axial, commanded)
         for i in firing:
             self.fire_time[i] += h
             f = self.forces[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
-        for i in self.axial_on(flags, axial):
+        for i in axial_on:
             f = self.deviations[i]
             fx, fy, fz = fx + f[0], fy + f[1], fz + f[2]
         p = self.impulse
         self.impulse = (p[0] + fx * h, p[1] + fy * h, p[2] + fz * h)
-        self.axial_off_time += h * len(self.axial_off(flags, axial))
+        self.axial_off_time += h * len(axial_off)
         self.operating_time += h
+        if self.stuck_thruster is not None:
+            self._plan_version += 1  # the fault's clock decides what fires
         if firing:
             self._move_center_of_mass()
 
@@ -413,6 +436,7 @@ class ThrusterSet:
     def set_state(self, state):
         self.fire_time = list(state["fire_time"])
         self.on_left = list(state["on_left"])
+        self._plan_version += 1
         self.axial_off_time = float(state["axial_off_time"])
         self.operating_time = float(state["operating_time"])
         self.disabled, self._allocation, self._burn_allocation = set(), None, None
