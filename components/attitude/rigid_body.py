@@ -223,15 +223,6 @@ def _acceleration(w0, w1, w2, J, Ji, t, tw, h0, h1, h2):
 
 
 @njit(cache=True)
-def _qrate(q1, q2, q3, q4, w1, w2, w3):
-    """q_dot = 1/2 Xi(q) omega (Eq. 19; rotations.quaternion_rate)."""
-    return (0.5 * (q4 * w1 - q3 * w2 + q2 * w3),
-            0.5 * (q3 * w1 + q4 * w2 - q1 * w3),
-            0.5 * (-q2 * w1 + q1 * w2 + q4 * w3),
-            0.5 * (-q1 * w1 - q2 * w2 - q3 * w3))
-
-
-@njit(cache=True)
 def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
     """n classical RK4 sub-steps of dt on (q, omega) with the torque held, h_w following the held
     wheel torque, h_w(s) = h_w + tw s (the wheel's own exact integration); `angles` (Eq. 31) gain
@@ -243,21 +234,21 @@ def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
     for k in range(n):
         s0 = k * dt
         sm, s1 = s0 + 0.5 * dt, s0 + dt
-        k1q = _qrate(qa, qb, qc, qd, wa, wb, wc)
+        k1q = rotations.quaternion_rate_kernel(qa, qb, qc, qd, wa, wb, wc)
         k1w = _acceleration(wa, wb, wc, J, Ji, torque, tw, hw[0] + tw[0] * s0, hw[1] + tw[1] * s0, hw[2] + tw[2] * s0)
         q2 = (qa + 0.5 * dt * k1q[0], qb + 0.5 * dt * k1q[1], qc + 0.5 * dt * k1q[2], qd + 0.5 * dt * k1q[3])
         w2 = (wa + 0.5 * dt * k1w[0], wb + 0.5 * dt * k1w[1], wc + 0.5 * dt * k1w[2])
-        k2q = _qrate(q2[0], q2[1], q2[2], q2[3], w2[0], w2[1], w2[2])
+        k2q = rotations.quaternion_rate_kernel(q2[0], q2[1], q2[2], q2[3], w2[0], w2[1], w2[2])
         k2w = _acceleration(w2[0], w2[1], w2[2], J, Ji, torque, tw,
                             hw[0] + tw[0] * sm, hw[1] + tw[1] * sm, hw[2] + tw[2] * sm)
         q3 = (qa + 0.5 * dt * k2q[0], qb + 0.5 * dt * k2q[1], qc + 0.5 * dt * k2q[2], qd + 0.5 * dt * k2q[3])
         w3 = (wa + 0.5 * dt * k2w[0], wb + 0.5 * dt * k2w[1], wc + 0.5 * dt * k2w[2])
-        k3q = _qrate(q3[0], q3[1], q3[2], q3[3], w3[0], w3[1], w3[2])
+        k3q = rotations.quaternion_rate_kernel(q3[0], q3[1], q3[2], q3[3], w3[0], w3[1], w3[2])
         k3w = _acceleration(w3[0], w3[1], w3[2], J, Ji, torque, tw,
                             hw[0] + tw[0] * sm, hw[1] + tw[1] * sm, hw[2] + tw[2] * sm)
         q4 = (qa + dt * k3q[0], qb + dt * k3q[1], qc + dt * k3q[2], qd + dt * k3q[3])
         w4 = (wa + dt * k3w[0], wb + dt * k3w[1], wc + dt * k3w[2])
-        k4q = _qrate(q4[0], q4[1], q4[2], q4[3], w4[0], w4[1], w4[2])
+        k4q = rotations.quaternion_rate_kernel(q4[0], q4[1], q4[2], q4[3], w4[0], w4[1], w4[2])
         k4w = _acceleration(w4[0], w4[1], w4[2], J, Ji, torque, tw,
                             hw[0] + tw[0] * s1, hw[1] + tw[1] * s1, hw[2] + tw[2] * s1)
         c = dt / 6.0

@@ -272,11 +272,8 @@ def _fused_vector_update(x, P, b0, b1, b2, r0, r1, r2, variance, update_bias):
     y = np.empty(3)
     y[0], y[1], y[2] = b0 - b_hat[0], b1 - b_hat[1], b2 - b_hat[2]
     P_new, dx, nis = _vector_update(P, b_hat, y, variance, update_bias)
-    w1, w2, w3 = dx[0], dx[1], dx[2]
-    ok, n0, n1, n2, n3 = _normalized_quaternion(q1 + 0.5 * (q4 * w1 - q3 * w2 + q2 * w3),
-                                                q2 + 0.5 * (q3 * w1 + q4 * w2 - q1 * w3),
-                                                q3 + 0.5 * (-q2 * w1 + q1 * w2 + q4 * w3),
-                                                q4 + 0.5 * (-q1 * w1 - q2 * w2 - q3 * w3))
+    d1, d2, d3, d4 = rotations.quaternion_rate_kernel(q1, q2, q3, q4, dx[0], dx[1], dx[2])
+    ok, n0, n1, n2, n3 = _normalized_quaternion(q1 + d1, q2 + d2, q3 + d3, q4 + d4)
     if not ok:
         return False, nis, y
     P[:, :] = P_new
