@@ -21,6 +21,7 @@ from collections import OrderedDict
 from operator import itemgetter
 from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
 
+import numpy as np
 from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.fmi2slave import Fmi2Slave
 from pythonfmu.variables import Boolean, Integer, Real, String
@@ -31,6 +32,12 @@ from components.mission.neighbor import SPACECRAFT
 _TYPES = {float: Real, int: Integer, bool: Boolean, str: String}
 _KINDS = {cls: kind for kind, cls in _TYPES.items()}
 Scalar = Union[float, int, bool, str]
+# Values shared with the runtime (share_values): a variable's code is its role | its kind << 4
+# (kinds 0 Real, 1 Integer, 2 Boolean, the runtime's numbers); the flags say which outputs in the
+# array are current. neighbor_core.c carries the same numbers.
+SHARED_INPUT, SHARED_STATE_OUTPUT, SHARED_FEEDTHROUGH_OUTPUT = 1, 2, 3
+FRESH_STATE, FRESH_FEEDTHROUGH = 0, 1
+_SHARED_KINDS = {Real: 0, Integer: 1, Boolean: 2}
 # The moving-target inputs of the RCS controller family (declared by `target_inputs`), named here
 # once because a controller's outputs depend on them before they are declared.
 TARGET_INPUTS = element_names("q_target_BN", 4) + element_names("omega_target_B", 3)
@@ -60,6 +67,9 @@ def _picker(indices):
         i = indices[0]
         return lambda vector: (vector[i],)
     return itemgetter(*indices)
+
+
+_SHARED = object()  # marks a get or set plan served by the shared array
 
 
 class ParameterError(ValueError):
@@ -95,9 +105,11 @@ class NeighborSlave(Fmi2Slave):
         self.start_time = 0.0  # from fmi2SetupExperiment; models that keep time start there
         self._accessors = {}  # (type, "getter" or "setter") -> {value reference: function}
         self._input_names = {}  # type -> {value reference: name} of the inputs
+        self._input_vrs = {}  # input name -> value reference
         self._array_elements = {}  # value reference of an array output's element -> (vector getter, index)
         self._get_plans = {cls: {} for cls in _KINDS}  # type -> {value references: plan (_get_plan)}
         self._set_plans = {cls: {} for cls in _KINDS}  # type -> {value references: input names or None}
+        self.shared = None  # share_values: every Real/Integer/Boolean input and output by value reference
 
     # ---- the FMI get and set calls ----------------------------------------------------------
     # pythonfmu's own look up each variable and check its type on every call. Ours follow a plan
@@ -151,9 +163,21 @@ class NeighborSlave(Fmi2Slave):
         plans = self._get_plans[cls]
         plan = plans.get(key, False)
         if plan is False:
-            plan = plans[key] = self._get_plan(cls, key)
+            plan = plans[key] = self._shared_plan(cls, key) or self._get_plan(cls, key)
         if plan is None:
             return fallback(self, vrs)
+        if plan[0] is _SHARED:  # the values the runtime reads too, published when stale
+            _, index, needs = plan
+            flags = self.share_flags
+            if not all(flags[f] for f in needs):
+                self.publish()
+            return list(map(kind, self.shared[index].tolist()))
+        if self.shared is not None:
+            self._input_version += 1  # inputs written in the array do not count versions
+        return self._values_of_plan(plan, kind)
+
+    def _values_of_plan(self, plan, kind):
+        """The values of a get plan (_get_plan) from the variables' getters."""
         sources, runs = plan
         out: list = []
         if runs is None:  # each getter called once, in order, and its elements taken
@@ -180,6 +204,14 @@ class NeighborSlave(Fmi2Slave):
         if names is False:
             inputs = self._input_names.get(cls, {})
             names = plans[key] = [inputs[vr] for vr in key] if all(vr in inputs for vr in key) else None
+            if names and self.shared is not None:
+                names = plans[key] = (_SHARED, list(key))
+        if names and names[0] is _SHARED and len(values) == len(names[1]):
+            self.shared[names[1]] = list(map(_KINDS[cls], values))
+            self.share_flags[FRESH_FEEDTHROUGH] = 0
+            return
+        if names and names[0] is _SHARED:
+            names = None  # a count mismatch: pythonfmu's error
         if names and len(values) == len(names):
             self.values.update(zip(names, map(_KINDS[cls], values)))
             self._input_version += 1
@@ -192,6 +224,9 @@ class NeighborSlave(Fmi2Slave):
                 name = inputs.get(vr)
                 if name is None:
                     setters[vr](value)
+                elif self.shared is not None:
+                    self.shared[vr] = kind(value)
+                    self.share_flags[FRESH_FEEDTHROUGH] = 0
                 else:
                     store[name] = kind(value)
                     changed = True
@@ -248,6 +283,7 @@ class NeighborSlave(Fmi2Slave):
                                      f"{value!r}: expected a finite number")
             self.values[name] = kind(value)
             self._model = None  # rebuilt from the new parameter values on next use
+            self._outputs_stale()
 
         self._register(name, kind, Fmi2Causality.parameter, Fmi2Variability.fixed, unit, description,
                        setter=setter, initial=Fmi2Initial.exact)
@@ -264,12 +300,17 @@ class NeighborSlave(Fmi2Slave):
         self.values[name] = kind(start)
 
         def setter(value, name=name):  # pythonfmu's own calls; ours store in place (_set)
+            if self.shared is not None:
+                self.shared[self._input_vrs[name]] = kind(value)
+                self.share_flags[FRESH_FEEDTHROUGH] = 0
+                return
             self.values[name] = kind(value)
             self._input_version += 1
 
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
         var = self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
         self._input_names.setdefault(_TYPES[kind], {})[var.value_reference] = name
+        self._input_vrs[name] = var.value_reference
         return name
 
     def input_array(self, name: str, starts: Sequence[Scalar], unit: Optional[str], description: str,
@@ -325,7 +366,7 @@ class NeighborSlave(Fmi2Slave):
         declared = ControllerSignals(q, w, w_dot, enabled, (), (), "")
 
         def gated():
-            return command() if self.values[enabled] else ([0.0, 0.0, 0.0], [0, 0, 0])
+            return command() if self.input_value(enabled) else ([0.0, 0.0, 0.0], [0, 0, 0])
 
         deps = list(reads(declared)) + [enabled]
         torque = self.output_array("torque_cmd_B", 3, lambda: self.feedthrough(gated)[0], "N.m",
@@ -384,6 +425,104 @@ class NeighborSlave(Fmi2Slave):
             return box_inertia(v["mass"], v["edge_a"], v["edge_b"], v["edge_c"])
         return [[v[element] for element in row] for row in matrix_names("inertia_B", 3, 3)]
 
+    # ---- values shared with the runtime ----------------------------------------------------
+    # A wrapper that calls share_values() at the end of its __init__ keeps every Real, Integer and
+    # Boolean input and output in one float64 array by value reference, which the binary reads and
+    # writes in memory (neighbor_core.c): fmi2Set* of inputs and fmi2Get* of fresh outputs do not
+    # enter Python. The wrapper then reads its inputs with vector() or input_value() (not
+    # self.values) and ends each do_step with publish_after_step(), which writes every output; an output
+    # read while stale (after a parameter, a state or, for one that depends on inputs, an input
+    # changed) is published first. The getters stay the outputs' definition: the generic publish
+    # evaluates them, and a wrapper's faster publish must write the same values.
+    def share_values(self) -> None:
+        n = len(self.vars)
+        self.shared = np.zeros(n)
+        self.share_codes = np.zeros(n, np.int32)
+        self.share_flags = np.zeros(4, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH, two spare
+        outputs = {cls: [] for cls in _SHARED_KINDS}
+        for vr, var in self.vars.items():
+            code = _SHARED_KINDS.get(type(var))
+            if code is None:
+                continue
+            meta = self.fmu_meta[var.name]
+            if meta["causality"] == "input":
+                role = SHARED_INPUT
+                self.shared[vr] = self.values[var.name]
+            elif meta["causality"] == "output":
+                role = SHARED_FEEDTHROUGH_OUTPUT if meta["depends_on"] else SHARED_STATE_OUTPUT
+                outputs[type(var)].append(vr)
+            else:
+                continue
+            self.share_codes[vr] = role | code << 4
+        self._vr_of = {var.name: vr for vr, var in self.vars.items()}
+        self._publish_plans = [(vrs, self._get_plan(cls, tuple(vrs)), _KINDS[cls])
+                               for cls, vrs in outputs.items() if vrs]
+        self._vector_keys = {}  # input vectors now read from the array
+
+    def publish(self) -> None:
+        """Write every shared output from its getter and mark the outputs fresh (a wrapper may
+        override this with a faster one that writes the same values)."""
+        shared = self.shared
+        self._input_version += 1  # one feedthrough computation per publish, on the inputs as they are
+        for vrs, plan, kind in self._publish_plans:
+            shared[vrs] = self._values_of_plan(plan, kind)
+        self.mark_published()
+
+    def publish_after_step(self) -> None:
+        """The end of a sharing wrapper's do_step: publish, or when an output cannot be computed
+        from the inputs as they are, leave the outputs stale so that the get that reads them
+        raises the error (where it was raised before the values were shared)."""
+        try:
+            self.publish()
+        except Exception:
+            self._outputs_stale()
+
+    def mark_published(self) -> None:
+        """A wrapper's publish wrote every shared output: they are fresh."""
+        self.share_flags[FRESH_STATE] = self.share_flags[FRESH_FEEDTHROUGH] = 1
+
+    def shared_slice(self, variables: Iterable[tuple]) -> slice:
+        """shared_indices(variables) as a slice, for variables declared one after the other."""
+        at = self.shared_indices(variables)
+        if not (np.diff(at) == 1).all():
+            raise ValueError(f"{variables} are not consecutive variables")
+        return slice(int(at[0]), int(at[-1]) + 1)
+
+    def _outputs_stale(self) -> None:
+        if self.shared is not None:
+            self.share_flags[FRESH_STATE] = self.share_flags[FRESH_FEEDTHROUGH] = 0
+
+    def _shared_plan(self, cls, key):
+        """A get of shared variables of type cls only: (_SHARED, their indices, the flags that must
+        be set), else None."""
+        if self.shared is None or not key:
+            return None
+        code = _SHARED_KINDS.get(cls)
+        needs = set()
+        for vr in key:
+            c = int(self.share_codes[vr]) if 0 <= vr < len(self.share_codes) else 0
+            if not c or c >> 4 != code:
+                return None
+            if c & 15 == SHARED_STATE_OUTPUT:
+                needs.add(FRESH_STATE)
+            elif c & 15 == SHARED_FEEDTHROUGH_OUTPUT:
+                needs.update((FRESH_STATE, FRESH_FEEDTHROUGH))
+        return _SHARED, list(key), sorted(needs)
+
+    def shared_indices(self, variables: Iterable[tuple]) -> np.ndarray:
+        """The value references, as an index array into the shared array, of `variables`
+        ((name, n) pairs: n > 1 an array's elements name[1]..name[n], 1 the scalar `name`), in
+        order: what a compiled step reads or writes."""
+        names = [e for name, n in variables for e in (element_names(name, n) if n > 1 else (name,))]
+        return np.array([self._vr_of[name] for name in names], dtype=np.int64)
+
+    def input_value(self, name: str) -> Scalar:
+        """The current value of input `name` (from the shared array when values are shared)."""
+        if self.shared is None:
+            return self.values[name]
+        vr = self._input_vrs[name]
+        return _KINDS[type(self.vars[vr])](self.shared[vr])
+
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute: Callable[[], Any]) -> Any:
         """Value of `compute()` cached until an input or parameter changes.
@@ -404,7 +543,17 @@ class NeighborSlave(Fmi2Slave):
         """[values of name[1] .. name[n]] (the element names are built once, not per call)."""
         pick = self._vector_keys.get((name, n))
         if pick is None:
-            pick = self._vector_keys[(name, n)] = _picker(list(element_names(name, n)))
+            names = list(element_names(name, n))
+            if self.shared is not None and all(e in self._input_vrs for e in names):  # shared inputs
+                vrs = [self._input_vrs[e] for e in names]
+                kind = _KINDS[type(self.vars[vrs[0]])]
+                if vrs == list(range(vrs[0], vrs[0] + n)) and kind is float:
+                    window = slice(vrs[0], vrs[0] + n)
+                    pick = self._vector_keys[(name, n)] = lambda _, s=self.shared: s[window].tolist()
+                else:
+                    pick = self._vector_keys[(name, n)] = lambda _, s=self.shared: list(map(kind, s[vrs].tolist()))
+            else:
+                pick = self._vector_keys[(name, n)] = _picker(names)
         return list(pick(self.values))
 
     @property
@@ -424,6 +573,7 @@ class NeighborSlave(Fmi2Slave):
                          tolerance: Optional[float] = None) -> None:
         self.start_time = float(start_time or 0.0)
         self._model = None  # rebuilt so that a model that keeps time starts at start_time
+        self._outputs_stale()
 
     def exit_initialization_mode(self) -> None:
         # Build (and so validate) the model from the final parameter values.
@@ -434,11 +584,15 @@ class NeighborSlave(Fmi2Slave):
         return {
             "values": copy.deepcopy(self.values),
             "model": None if self._model is None else self._model.get_state(),
+            "shared": None if self.shared is None else self.shared.copy(),
         }
 
     def _set_fmu_state(self, state):
         self.values = copy.deepcopy(state["values"])
         self._input_version += 1  # never a version an earlier cache entry could carry
         self._model = None
+        if self.shared is not None:
+            self.shared[:] = state["shared"]  # in place: the runtime holds the array's address
+            self._outputs_stale()
         if state["model"] is not None:
             self.model.set_state(state["model"])

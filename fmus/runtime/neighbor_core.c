@@ -82,6 +82,7 @@ static struct {
     void (*DecRef)(PyObject *);
     PyObject *(*ImportAddModule)(const char *);
     PyObject *(*ModuleGetDict)(PyObject *);
+    void *(*LongAsVoidPtr)(PyObject *);
 } py;
 
 static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
@@ -101,6 +102,7 @@ static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
     S(ErrOccurred, "PyErr_Occurred"), S(ErrFetch, "PyErr_Fetch"), S(ErrNormalize, "PyErr_NormalizeException"),
     S(ErrClear, "PyErr_Clear"), S(IncRef, "Py_IncRef"), S(DecRef, "Py_DecRef"),
     S(ImportAddModule, "PyImport_AddModule"), S(ModuleGetDict, "PyModule_GetDict"),
+    S(LongAsVoidPtr, "PyLong_AsVoidPtr"),
 #undef S
 };
 
@@ -422,7 +424,20 @@ typedef struct {
     char **strings;  /* String results, valid until the next call */
     size_t n_strings;
     int broken;  /* a fatal error: every later call returns Fatal */
+    /* Values shared with the model (NeighborSlave.share_values; NULL when it does not): the value
+     * of every variable by value reference, each one's code (0: through Python; else its role |
+     * its kind << 4) and the freshness flags. The arrays belong to the slave object. */
+    double *sh_values;
+    const int *sh_codes;
+    const int *sh_spans;  /* FMI 3.0: elements per value reference (arrays), else NULL */
+    int *sh_flags;
+    size_t sh_n;
+    PyObject *m_publish;  /* the slave's publish: writes every shared output, marks them fresh */
 } Instance;
+
+/* Roles of shared variables and the flags (NeighborSlave's SHARED_* and FRESH_* numbers) */
+enum { SH_INPUT = 1, SH_STATE_OUTPUT = 2, SH_FEEDTHROUGH_OUTPUT = 3 };
+enum { FRESH_STATE = 0, FRESH_FEEDTHROUGH = 1 };
 
 enum { KIND_REAL, KIND_INTEGER, KIND_BOOLEAN, KIND_STRING };
 static const char *GET_NAMES[] = {"get_real", "get_integer", "get_boolean", "get_string"};
@@ -617,7 +632,51 @@ static void uri_to_path(const char *uri, char *out, size_t size) {
     out[k] = '\0';
 }
 
+/* Point the instance at the slave's shared values (after instantiation and reset, which builds new
+   arrays). GIL held. 0 with a Python error pending if the slave's answer is malformed. */
+static int link_shared(Instance *inst) {
+    inst->sh_values = NULL;
+    inst->sh_codes = NULL;
+    inst->sh_spans = NULL;
+    inst->sh_flags = NULL;
+    inst->sh_n = 0;
+    if (inst->m_publish) {
+        py.DecRef(inst->m_publish);
+        inst->m_publish = NULL;
+    }
+    PyObject *fn = py.DictGetItemString(loader, "shared_memory");  /* borrowed */
+    if (!fn) return 1;  /* a loader without it: every value through Python */
+    py.IncRef(inst->slave);
+    PyObject *args = tuple_of(1, inst->slave);
+    PyObject *res = py.CallObject(fn, args);
+    py.DecRef(args);
+    if (!res) return 0;
+    int ok = 1;
+    if (res != py.DictGetItemString(loader, "NONE")) {
+        void *values = py.LongAsVoidPtr(py.TupleGetItem(res, 0));
+        void *codes = py.LongAsVoidPtr(py.TupleGetItem(res, 1));
+        void *flags = py.LongAsVoidPtr(py.TupleGetItem(res, 2));
+        long n = py.LongAsLong(py.TupleGetItem(res, 3));
+        void *spans = py.LongAsVoidPtr(py.TupleGetItem(res, 4));  /* NULL (0) without arrays */
+        inst->m_publish = method(inst, "publish");
+        if (py.ErrOccurred() || !values || !codes || !flags || n < 0 || !inst->m_publish) {
+            ok = 0;
+        } else {
+            inst->sh_values = (double *)values;
+            inst->sh_codes = (const int *)codes;
+            inst->sh_flags = (int *)flags;
+            inst->sh_spans = (const int *)spans;
+            inst->sh_n = (size_t)n;
+        }
+    }
+    py.DecRef(res);
+    return ok;
+}
+
 static void release_instance(Instance *inst) {
+    if (inst->m_publish) py.DecRef(inst->m_publish);
+    inst->m_publish = NULL;
+    inst->sh_values = NULL;
     for (int k = 0; k < 4; k++) {
         if (inst->m_get[k]) py.DecRef(inst->m_get[k]);
         if (inst->m_set[k]) py.DecRef(inst->m_set[k]);
@@ -719,6 +778,7 @@ static Instance *new_instance(const char *call_name, const char *name, const cha
             }
             inst->m_do_step = method(inst, "do_step");
             if (!inst->log_queue || !inst->m_do_step) status = fail(inst, call_name);
+            else if (!link_shared(inst)) status = fail(inst, call_name);
             drain_log(inst);
         }
     }
@@ -763,6 +823,7 @@ static Status reset_instance(void *c, const char *what) {
     py.IncRef(inst->slave);
     PyObject *res = call(inst, fn, tuple_of(1, inst->slave), what, &status);
     if (res) py.DecRef(res);  /* a fresh model in the same slave object: the bound methods stay valid */
+    if (res && !link_shared(inst)) status = fail(inst, what);  /* but its shared arrays are new */
     LEAVE();
     return status;
 }
@@ -771,8 +832,99 @@ static Status reset_instance(void *c, const char *what) {
  * `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
  * which expands arrays; `expected` is then the host's nValues); Booleans are written as
  * `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
+/* The shared-memory path of a get or set. A value reference stands for sh_spans[vr] elements from
+   vr on (FMI 3.0: an array's elements, 0 for a value reference inside an array) or one (FMI 2.0,
+   no spans). all_shared is 1 when every element is a shared variable of this kind (a get: any
+   role; a set: an input) and they are n_values in all; 0 otherwise (the call then goes through
+   Python, which gives the same values or the error). */
+static size_t span_of(const Instance *inst, unsigned int vr) {
+    return inst->sh_spans ? (size_t)inst->sh_spans[vr] : 1;
+}
+
+static int all_shared(const Instance *inst, int kind, const unsigned int vr[], size_t nvr, size_t n_values,
+                      int set, int *needs) {
+    if (!inst->sh_values || kind == KIND_STRING) return 0;
+    int need = 0;
+    size_t count = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        if (vr[i] >= inst->sh_n) return 0;
+        size_t span = span_of(inst, vr[i]);
+        if (!span || vr[i] + span > inst->sh_n) return 0;
+        for (size_t j = 0; j < span; j++) {
+            int code = inst->sh_codes[vr[i] + j];
+            int role = code & 15;
+            if (!role || (code >> 4) != kind || (set && role != SH_INPUT)) return 0;
+            if (role == SH_STATE_OUTPUT) need |= 1;
+            else if (role == SH_FEEDTHROUGH_OUTPUT) need |= 3;
+        }
+        count += span;
+    }
+    if (count != n_values) return 0;
+    if (needs) *needs = need;
+    return 1;
+}
+
+static void copy_shared_out(const Instance *inst, int kind, const unsigned int vr[], size_t nvr, void *out,
+                            size_t bool_size) {
+    const double *v = inst->sh_values;
+    size_t k = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        size_t span = span_of(inst, vr[i]);
+        for (size_t j = 0; j < span; j++, k++) {
+            double x = v[vr[i] + j];
+            switch (kind) {
+            case KIND_REAL: ((double *)out)[k] = x; break;
+            case KIND_INTEGER: ((int *)out)[k] = (int)x; break;
+            default:
+                if (bool_size == 1) ((unsigned char *)out)[k] = x != 0.0;
+                else ((int *)out)[k] = x != 0.0;
+            }
+        }
+    }
+}
+
+/* A get of shared variables: from memory, after one call of the model's publish when an output
+   asked for is not fresh (a step, a parameter or, for a feedthrough output, an input changed). */
+static Status get_shared(Instance *inst, int kind, const unsigned int vr[], size_t nvr, void *out,
+                         size_t bool_size, int needs, const char *what) {
+    int stale = ((needs & 1) && !inst->sh_flags[FRESH_STATE]) || ((needs & 2) && !inst->sh_flags[FRESH_FEEDTHROUGH]);
+    if (stale) {
+        int gil = py.GILStateEnsure();
+        Status status = ST_OK;
+        PyObject *res = call(inst, inst->m_publish, NULL, what, &status);
+        if (res) py.DecRef(res);
+        py.GILStateRelease(gil);
+        if (!res) return status;
+    }
+    copy_shared_out(inst, kind, vr, nvr, out, bool_size);
+    return ST_OK;
+}
+
+static void set_shared(Instance *inst, int kind, const unsigned int vr[], size_t nvr, const void *in,
+                       size_t bool_size) {
+    double *v = inst->sh_values;
+    size_t k = 0;
+    for (size_t i = 0; i < nvr; i++) {
+        size_t span = span_of(inst, vr[i]);
+        for (size_t j = 0; j < span; j++, k++) {
+            double *dst = &v[vr[i] + j];
+            switch (kind) {
+            case KIND_REAL: *dst = ((const double *)in)[k]; break;
+            case KIND_INTEGER: *dst = (double)((const int *)in)[k]; break;
+            default: *dst = (bool_size == 1 ? ((const unsigned char *)in)[k] : ((const int *)in)[k]) ? 1.0 : 0.0;
+            }
+        }
+    }
+    inst->sh_flags[FRESH_FEEDTHROUGH] = 0;  /* the outputs that depend on inputs */
+}
+
 static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr, void *out, size_t expected,
                          int via_loader, size_t bool_size, const char *what) {
+    Instance *shared = (Instance *)c;
+    int needs = 0;
+    if (shared && !shared->broken && (!via_loader || shared->sh_spans) &&
+        all_shared(shared, kind, vr, nvr, expected, 0, &needs))
+        return get_shared(shared, kind, vr, nvr, out, bool_size, needs, what);
     ENTER(c, what)
     PyObject *res;
     if (via_loader) {
@@ -821,6 +973,12 @@ static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr,
 
 static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr, const void *in, size_t n_in,
                          int via_loader, size_t bool_size, const char *what) {
+    Instance *shared = (Instance *)c;
+    if (shared && !shared->broken && (!via_loader || shared->sh_spans) &&
+        all_shared(shared, kind, vr, nvr, n_in, 1, NULL)) {
+        set_shared(shared, kind, vr, nvr, in, bool_size);
+        return ST_OK;
+    }
     ENTER(c, what)
     PyObject *values = py.ListNew((Py_ssize_t)n_in);
     for (size_t i = 0; i < n_in; i++) {
@@ -912,7 +1070,7 @@ static Status unsupported(void *c, const char *what) {
 
 /* doStep: OK, Discard when the model could not complete the step (do_step returned False). */
 static Status do_step(void *c, double t, double h, const char *what) {
-    ENTER(c, what)
+    ENTER(c, what)  /* a sharing model's step publishes its outputs (or leaves them stale) itself */
     PyObject *res = call(inst, inst->m_do_step, tuple_of(2, py.FloatFromDouble(t), py.FloatFromDouble(h)), what,
                          &status);
     if (res) {

@@ -4,8 +4,9 @@ the model.
 The binary executes this file from the FMU's resources into a module of its own, named after a
 hash of this code and the FMU's GUID or instantiation token (it is never imported, so the loaders
 of different FMU builds cannot collide; a library loaded again reuses it) and calls `instantiate`,
-`reset`, `drain` and `describe`; the FMI 3.0 binary also `get_values` and `set_values`, which
-expand array variables into the model's elements. The model's code is one package with a name private to the FMU build
+`reset`, `drain`, `describe` and `shared_memory`; the FMI 3.0 binary also `get_values` and
+`set_values`, which expand array variables into the model's elements. The model's code is one
+package with a name private to the FMU build
 (resources/<package>/, named in neighbor_runtime.txt): two FMUs, or two builds of one FMU, in one
 process never share code or data; two instances of the same build share the loaded modules.
 """
@@ -161,6 +162,31 @@ def set_values(slave, kind, vrs, values):
     if len(values) != len(elements):
         raise ValueError(f"{len(values)} values given for {len(elements)} elements of value references {vrs}")
     getattr(slave, f"set_{KINDS[kind]}")(elements, values)
+
+
+def shared_memory(slave):
+    """(address of the values, of the codes, of the flags, number of value references, address of
+    the spans or 0) of the arrays a slave shares with the binary (NeighborSlave.share_values), or
+    None: its values then cross through get_*/set_*. For FMI 3.0 the spans give how many elements
+    each value reference stands for (an array's, 1 for a scalar, 0 inside an array). The arrays
+    stay the slave's (the binary asks again after a reset)."""
+    shared = getattr(slave, "shared", None)
+    if shared is None:
+        return None
+    values, codes, flags = shared, slave.share_codes, slave.share_flags
+    if not (values.dtype.str == "<f8" and codes.dtype.str == "<i4" and flags.dtype.str == "<i4"
+            and values.flags.c_contiguous and codes.flags.c_contiguous and len(codes) == len(values)
+            and len(flags) >= 2):
+        raise TypeError("the slave's shared arrays are not float64/int32 C arrays of one length")
+    spans = 0
+    arrays = getattr(slave, "_neighbor_arrays", None)
+    if arrays is not None:
+        inner = slave._neighbor_inner
+        span_array = [0 if vr in inner else arrays.get(vr, 1) for vr in range(len(values))]
+        slave.share_spans = codes.copy()  # int32, kept with the slave
+        slave.share_spans[:] = span_array
+        spans = slave.share_spans.ctypes.data
+    return values.ctypes.data, codes.ctypes.data, flags.ctypes.data, len(values), spans
 
 
 def reset(slave):
