@@ -35,6 +35,9 @@ class DetumbleController(NeighborSlave):
                        "Settle criterion: done once the rates have stayed within omega_tol for this long (>= 0); "
                        "0: the thesis' single-sample test")
         self.target_inputs("not used by the detumble law (rates to omega_d only)")
+        self.share_values()
+        self._inputs_at = self.shared_indices(detumble.READS)
+        self._outputs_at = self.shared_indices(detumble.PUBLISHED)
 
     def build_model(self):
         return detumble.DetumbleController(self.vector("Kp", 3), self.vector("Kd", 3), self.vector("omega_d", 3),
@@ -48,6 +51,12 @@ class DetumbleController(NeighborSlave):
         return self.model.done(self.vector("omega_BN_B", 3))
 
     def do_step(self, current_time, step_size):
-        self.model.advance(self.vector("omega_BN_B", 3), step_size, self.values["enabled"])
-        self._input_version += 1  # the settle count changed: `done` computed before the step is stale
+        # advance (the settle count) and publish in one compiled call: `done` follows the new count
+        self.model.step_into(self.shared, self._inputs_at, self._outputs_at, step_size)
+        self.mark_published()
         return True
+
+    def publish(self):
+        # the getters' values (NeighborSlave.publish: the gated command and the stop test)
+        self.model.step_into(self.shared, self._inputs_at, self._outputs_at, 0.0, stepping=False)
+        self.mark_published()

@@ -36,6 +36,9 @@ class RcsThrusters(NeighborSlave):
                     "Firing time summed over the axes (the thesis' ThrustTime)")
         self.output("propellant_mass", lambda: self.model.propellant_mass(), "kg",
                     "Propellant used, 2 F t_fire / (Isp g0) (Eq. 74)")
+        self.share_values()
+        self._inputs_at = self.shared_indices((("torque_cmd_B", 3),))
+        self._outputs_at = self.shared_indices(thrusters.PUBLISHED)
 
     def build_model(self):
         return thrusters.ThrusterPairs(self.values["thrust"], self.values["edge_a"], self.values["edge_c"],
@@ -48,5 +51,11 @@ class RcsThrusters(NeighborSlave):
         return self.model.flags(self.vector("torque_cmd_B", 3))
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.vector("torque_cmd_B", 3), step_size)
+        self.model.step_into(self.shared, self._inputs_at, self._outputs_at, step_size)
+        self.mark_published()
         return True
+
+    def publish(self):
+        # the getters' values (NeighborSlave.publish) in one compiled call
+        self.model.step_into(self.shared, self._inputs_at, self._outputs_at, 0.0, stepping=False)
+        self.mark_published()

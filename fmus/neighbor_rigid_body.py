@@ -92,6 +92,9 @@ class RigidBody(NeighborSlave):
                              "Fractional error of the body's second moment of mass along body x, y, z (the integral "
                              "of x_i^2 dm) against the nominal inertia (the box, or inertia_B) the flight software "
                              "assumes, in [-0.5, 0.5]; 0: the nominal inertia")
+        self.share_values()
+        self._inputs_at = self.shared_indices((("torque_B", 3), ("wheel_torque_B", 3), ("wheel_momentum_B", 3)))
+        self._outputs_at = self.shared_indices(rigid_body.PUBLISHED)
 
     def build_model(self):
         J = mass_properties.with_moment_errors(self.inertia(rigid_body.box_inertia), self.vector("inertia_error", 3))
@@ -103,7 +106,13 @@ class RigidBody(NeighborSlave):
     def do_step(self, current_time, step_size):
         v = self.values
         if v["propellant_mass_properties"]:
-            self.model.follow_propellant(v["propellant_used"] + v["rcs_propellant"], v["mass"], self._tank)
-        self.model.step(self.vector("torque_B", 3), step_size, self.vector("wheel_torque_B", 3),
-                        self.vector("wheel_momentum_B", 3))
+            self.model.follow_propellant(self.input_value("propellant_used") + self.input_value("rcs_propellant"),
+                                         v["mass"], self._tank)
+        self.model.step_from(self.shared, self._inputs_at, step_size)
+        self.publish_after_step()
         return True
+
+    def publish(self):
+        # the outputs the getters define (NeighborSlave.publish), written by one compiled call
+        self.model.publish_into(self.shared, self._outputs_at)
+        self.mark_published()

@@ -21,7 +21,14 @@ w_dot of the previous `StateChange`; zero before the first step).
 """
 import math
 
+import numpy as np
+
+from ..core.jit import njit
 from . import thruster_control as tc
+
+# detumble_into's outputs, in the order of its `outputs` indices, and inputs
+PUBLISHED = (("torque_cmd_B", 3), ("thrust_flag", 3), ("done", 1))
+READS = (("omega_BN_B", 3), ("omega_dot_BN_B", 3), ("enabled", 1))
 
 
 class DetumbleController:
@@ -36,6 +43,9 @@ class DetumbleController:
         self.levels = tc.check_levels(torque_level if torque_level is not None else tc.pair_torques())
         self.signed_stop_test = bool(signed_stop_test)
         self.settle = tc.SettleTimer(settle_time)
+        # the law's constants as detumble_into reads them
+        self.constants = np.array(self.Kp + self.Kd + self.omega_d + self.omega_tol + tuple(self.levels)
+                                  + (float(self.signed_stop_test), self.settle.dwell))
 
     def command(self, omega, omega_dot):
         """Quantized torque command (N.m) and thrust flags (-1/0/1) for the current rates."""
@@ -59,8 +69,48 @@ class DetumbleController:
             return all(omega[i] - self.omega_d[i] <= self.omega_tol[i] for i in range(3))
         return all(abs(omega[i] - self.omega_d[i]) <= self.omega_tol[i] for i in range(3))
 
+    def step_into(self, values, inputs, outputs, h, stepping=True):
+        """The FMU's step (stepping: advance by h) or publish in one compiled call: omega,
+        omega_dot and enabled at values[inputs] (READS), then the gated command and the stop test
+        written to values[outputs] (PUBLISHED)."""
+        self.settle.time_inside = detumble_into(self.constants, values, inputs, outputs, h, self.settle.time_inside,
+                                                stepping)
+
     def get_state(self):
         return {"time_inside": self.settle.time_inside}  # the command is a function of the inputs
 
     def set_state(self, state):
         self.settle.time_inside = float(state["time_inside"])
+
+
+@njit(cache=True)
+def detumble_into(k, values, inputs, outputs, h, time_inside, stepping):
+    """DetumbleController on its constants k (Kp, Kd, omega_d, omega_tol, levels, signed test,
+    settle time): the stop test on omega = values[inputs[0:3]]; with `stepping` the settle count
+    advanced by h (advance); then values[outputs] = the command for omega and omega_dot
+    (values[inputs[3:6]]), zero when values[inputs[6]] (enabled) is 0, its flags, and done. The
+    same operations as command, done and advance. Returns the settle count."""
+    signed = k[15] != 0.0
+    inside = True
+    for i in range(3):
+        d = values[inputs[i]] - k[6 + i]
+        if not ((d if signed else abs(d)) <= k[9 + i]):
+            inside = False
+    enabled = values[inputs[6]] != 0.0
+    if stepping:
+        time_inside = time_inside + h if (inside and enabled) else 0.0
+    for i in range(3):
+        torque, flag = 0.0, 0
+        if enabled:
+            w, level = values[inputs[i]], k[12 + i]
+            raw = k[i] * (k[6 + i] - w) - k[3 + i] * values[inputs[3 + i]]
+            if raw >= level:
+                torque, flag = level, 1
+            elif raw <= -level:
+                torque, flag = -level, -1
+            if abs(w - k[6 + i]) <= k[9 + i]:
+                torque, flag = 0.0, 0
+        values[outputs[i]] = torque
+        values[outputs[3 + i]] = flag
+    values[outputs[6]] = 1.0 if (inside and time_inside >= k[16]) else 0.0
+    return time_inside

@@ -70,8 +70,39 @@ def check_inertia(inertia):
     return J
 
 
+# The state array (RigidBody.x), which the compiled step and publish read and write in place
+# (RAW_Q: the unnormalized quaternion of a step that could not normalize it, for its error)
+Q, OMEGA, OMEGA_DOT, ANGLES, CENTER, J_ROWS, JINV_ROWS, RAW_Q, STATE_SIZE = 0, 4, 7, 10, 13, 16, 25, 34, 38
+# publish_into's outputs, in the order of its `outputs` indices
+PUBLISHED = (("q_BN", 4), ("omega_BN_B", 3), ("omega_dot_BN_B", 3), ("euler123", 3), ("H_B", 3),
+             ("euler_integrated", 3), ("center_of_mass_B", 3))
+_INPUT_NAMES = ("torque_B", "wheel_torque_B", "wheel_momentum_B")
+NINE = np.arange(9)  # step()'s inputs: the whole of its own array
+
+
+def _state_view(start, n):
+    """A property over x[start:start + n], read as a tuple of floats."""
+    def get(self):
+        return tuple(self.x[start:start + n].tolist())
+
+    def put(self, value):
+        self.x[start:start + n] = value
+
+    return property(get, put)
+
+
 class RigidBody:
-    """Attitude state (q_BN, omega_BN_B) of a rigid body under a body-frame torque."""
+    """Attitude state (q_BN, omega_BN_B) of a rigid body under a body-frame torque.
+
+    The state lives in one float array `x` (q, omega, omega_dot, the integrated angles, the
+    centre of mass, J and its inverse) so that the compiled RK4 step and publish_into work on it
+    in place; the attributes are views of it."""
+
+    q = _state_view(Q, 4)
+    omega = _state_view(OMEGA, 3)
+    omega_dot = _state_view(OMEGA_DOT, 3)
+    euler_integrated = _state_view(ANGLES, 3)
+    center_of_mass = _state_view(CENTER, 3)
 
     def __init__(self, inertia, q0=(0.0, 0.0, 0.0, 1.0), omega0=(0.0, 0.0, 0.0), integrator="rk4",
                  max_substep=0.005, euler0=None):
@@ -85,10 +116,9 @@ class RigidBody:
             raise ValueError(f"omega0 {list(omega0)} must be finite")
         self.integrator = integrator
         self.max_substep = float(max_substep)
-        self.J = tuple(tuple(row) for row in J.tolist())
-        self.Jinv = tuple(tuple(row) for row in np.linalg.inv(J).tolist())
-        self._J9 = tuple(x for row in self.J for x in row)  # the RK4 kernel's flat, typed copies
-        self._Ji9 = tuple(x for row in self.Jinv for x in row)
+        self.x = np.zeros(STATE_SIZE)
+        self._inputs = np.zeros(9)  # step()'s torques in the compiled step's form
+        self.set_inertia(tuple(map(tuple, J.tolist())), tuple(map(tuple, np.linalg.inv(J).tolist())))
         self.J0 = self.J  # the inertia at takeover, before any propellant is drawn
         self.drawn = 0.0  # kg of propellant the inertia has followed (follow_propellant)
         self.center_of_mass = (0.0, 0.0, 0.0)  # m in B, from the takeover centre of mass
@@ -111,8 +141,8 @@ class RigidBody:
         """Hold the inertia J (and its inverse) from now on: the mass properties as the tank empties
         (components.attitude.mass_properties), applied between steps."""
         self.J, self.Jinv = J, Jinv
-        self._J9 = tuple(x for row in J for x in row)
-        self._Ji9 = tuple(x for row in Jinv for x in row)
+        self.x[J_ROWS:J_ROWS + 9] = [x for row in J for x in row]
+        self.x[JINV_ROWS:JINV_ROWS + 9] = [x for row in Jinv for x in row]
 
     def follow_propellant(self, drawn, mass0, tank):
         """The inertia about the centre of mass once `drawn` kg left the tank at `tank` (m, B) of a
@@ -147,30 +177,31 @@ class RigidBody:
         wheel_torque / wheel_momentum (B frame): the wheel motors' torque on the wheels (N.m,
         held over the step) and the wheels' momentum h_w at the step start (N.m.s); see the
         module docstring. Left at zero: the wheel-less model, bit for bit."""
-        for name, v in (("torque_B", torque), ("wheel_torque_B", wheel_torque), ("wheel_momentum_B", wheel_momentum)):
-            if not all(map(math.isfinite, v)):
-                raise ValueError(f"{name} {list(v)} must be finite")
-        tw, hw = tuple(wheel_torque), tuple(wheel_momentum)
+        u = self._inputs
+        for k, (name, v) in enumerate(zip(_INPUT_NAMES, (torque, wheel_torque, wheel_momentum))):
+            if len(v) != 3:
+                raise ValueError(f"{name} {list(v)} must have 3 elements")
+            u[3 * k:3 * k + 3] = v
+        self.step_from(u, NINE, h)
+
+    def step_from(self, values, inputs, h):
+        """step() with the torque, wheel torque and wheel momentum at values[inputs[0:9]] (the
+        FMU passes the array it shares with the runtime): one compiled call."""
         if self.integrator == "euler":
-            q, w = self.q, self.omega
-            q_dot = rotations.quaternion_rate(q, w)
-            w_dot = self.angular_acceleration(w, torque, tw, hw)
-            self.q = tuple(q[i] + q_dot[i] * h for i in range(4))
-            self.omega = tuple(w[i] + w_dot[i] * h for i in range(3))
-            self.omega_dot = w_dot
-            # Eq. 31 after StateChange, with the new rates (Appendix C-D)
-            self.euler_integrated = tuple(self.euler_integrated[i] + self.omega[i] * h for i in range(3))
-            return
-        n = max(1, math.ceil(h / self.max_substep - 1e-9))
-        w_start = self.omega
-        q, w, angles = rk4_steps(self.q, w_start, self.euler_integrated, self._J9, self._Ji9,
-                                 (float(torque[0]), float(torque[1]), float(torque[2])),
-                                 (float(tw[0]), float(tw[1]), float(tw[2])), (float(hw[0]), float(hw[1]), float(hw[2])),
-                                 h / n, n)
-        self.euler_integrated = angles
-        self.q = rotations.normalized(q)
-        self.omega = w
-        self.omega_dot = ((w[0] - w_start[0]) / h, (w[1] - w_start[1]) / h, (w[2] - w_start[2]) / h)
+            error = euler_step_into(self.x, values, inputs, h)
+        else:
+            error = rk4_step_into(self.x, values, inputs, h, max(1, math.ceil(h / self.max_substep - 1e-9)))
+        if error:
+            if error <= 3:
+                name = _INPUT_NAMES[error - 1]
+                raise ValueError(f"{name} {values[inputs[3 * error - 3:3 * error]].tolist()} must be finite")
+            rotations.normalized(tuple(self.x[RAW_Q:RAW_Q + 4].tolist()))  # raises its error
+
+    def publish_into(self, values, outputs):
+        """Write q, omega, omega_dot, the 1-2-3 angles, H_B, the integrated angles and the centre
+        of mass (PUBLISHED) to values[outputs] in one compiled call."""
+        if not publish_into(self.x, values, outputs):
+            rotations.euler123(self.q)  # raises the quaternion's error
 
     # ---- derived quantities ------------------------------------------------------------
     def euler123(self):
@@ -263,3 +294,85 @@ def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
                       wb + c * (k1w[1] + 2 * k2w[1] + 2 * k3w[1] + k4w[1]),
                       wc + c * (k1w[2] + 2 * k2w[2] + 2 * k3w[2] + k4w[2]))
     return (qa, qb, qc, qd), (wa, wb, wc), (ea, eb, ec)
+
+
+@njit(cache=True)
+def euler_step_into(x, values, inputs, h):
+    """The thesis scripts' StateChange on the state array x in place: one explicit Euler step of h
+    with the inputs at values[inputs[0:9]] as in rk4_step_into, q not normalized, then Eq. 31's
+    angles += the new omega h (Appendix C-D). Returns 0, or 1-3 when that input vector is not
+    finite (nothing changed)."""
+    for k in range(9):
+        if not math.isfinite(values[inputs[k]]):
+            return k // 3 + 1
+    torque = (values[inputs[0]], values[inputs[1]], values[inputs[2]])
+    tw = (values[inputs[3]], values[inputs[4]], values[inputs[5]])
+    J = (x[16], x[17], x[18], x[19], x[20], x[21], x[22], x[23], x[24])
+    Ji = (x[25], x[26], x[27], x[28], x[29], x[30], x[31], x[32], x[33])
+    q1, q2, q3, q4, w1, w2, w3 = x[0], x[1], x[2], x[3], x[4], x[5], x[6]
+    q_dot = rotations.quaternion_rate_kernel(q1, q2, q3, q4, w1, w2, w3)
+    w_dot = _acceleration(w1, w2, w3, J, Ji, torque, tw, values[inputs[6]], values[inputs[7]], values[inputs[8]])
+    x[0], x[1], x[2], x[3] = q1 + q_dot[0] * h, q2 + q_dot[1] * h, q3 + q_dot[2] * h, q4 + q_dot[3] * h
+    x[4], x[5], x[6] = w1 + w_dot[0] * h, w2 + w_dot[1] * h, w3 + w_dot[2] * h
+    x[7], x[8], x[9] = w_dot
+    x[10], x[11], x[12] = x[10] + x[4] * h, x[11] + x[5] * h, x[12] + x[6] * h
+    return 0
+
+
+@njit(cache=True)
+def rk4_step_into(x, values, inputs, h, n):
+    """RigidBody's RK4 communication step on its state array x in place: the torque, wheel torque
+    and wheel momentum at values[inputs[0:9]], n sub-steps of h / n (rk4_steps), the quaternion
+    normalized (rotations.normalized) and omega_dot the mean over the step; the same operations
+    as the step in Python. Returns 0, or 1-3 when that input vector is not finite (nothing
+    changed), or 4 when the quaternion's norm is zero or not finite (the angles are updated, the
+    quaternion is left in x[RAW_Q:])."""
+    for k in range(9):
+        if not math.isfinite(values[inputs[k]]):
+            return k // 3 + 1
+    torque = (values[inputs[0]], values[inputs[1]], values[inputs[2]])
+    tw = (values[inputs[3]], values[inputs[4]], values[inputs[5]])
+    hw = (values[inputs[6]], values[inputs[7]], values[inputs[8]])
+    J = (x[16], x[17], x[18], x[19], x[20], x[21], x[22], x[23], x[24])
+    Ji = (x[25], x[26], x[27], x[28], x[29], x[30], x[31], x[32], x[33])
+    w0 = (x[4], x[5], x[6])
+    q, w, angles = rk4_steps((x[0], x[1], x[2], x[3]), w0, (x[10], x[11], x[12]), J, Ji, torque, tw, hw, h / n, n)
+    x[10], x[11], x[12] = angles
+    norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
+    if not math.isfinite(norm) or norm < 1e-12:
+        x[34], x[35], x[36], x[37] = q
+        return 4
+    x[0], x[1], x[2], x[3] = q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
+    x[4], x[5], x[6] = w
+    x[7], x[8], x[9] = (w[0] - w0[0]) / h, (w[1] - w0[1]) / h, (w[2] - w0[2]) / h
+    return 0
+
+
+@njit(cache=True)
+def publish_into(x, values, outputs):
+    """values[outputs] = q, omega, omega_dot, the 1-2-3 angles of q (rotations.euler123), the body's
+    J omega (angular_momentum), the integrated angles and the centre of mass from the state x (22
+    values, PUBLISHED); the same operations as those methods. False (nothing written) when q has a
+    zero or non-finite norm."""
+    q1, q2, q3, q4 = x[0], x[1], x[2], x[3]
+    norm = math.sqrt(q1 * q1 + q2 * q2 + q3 * q3 + q4 * q4)
+    if not math.isfinite(norm) or norm < 1e-12:
+        return False
+    a, b, c, d = q1 / norm, q2 / norm, q3 / norm, q4 / norm
+    a00 = a * a - b * b - c * c + d * d
+    a10 = 2 * (a * b - c * d)
+    a20 = 2 * (a * c + b * d)
+    a21 = 2 * (b * c - a * d)
+    a22 = -a * a - b * b + c * c + d * d
+    s = max(-1.0, min(1.0, a20))
+    for i in range(10):  # q, omega, omega_dot
+        values[outputs[i]] = x[i]
+    values[outputs[10]] = math.atan2(-a21, a22)
+    values[outputs[11]] = math.asin(s)
+    values[outputs[12]] = math.atan2(-a10, a00)
+    w0, w1, w2 = x[4], x[5], x[6]
+    for i in range(3):
+        values[outputs[13 + i]] = x[16 + 3 * i] * w0 + x[17 + 3 * i] * w1 + x[18 + 3 * i] * w2
+    for i in range(6):  # the integrated angles, the centre of mass
+        values[outputs[16 + i]] = x[10 + i]
+    return True
