@@ -33,6 +33,8 @@ class Gyro(NeighborSlave):
         self.parameter("jump_time", 0.0, "s",
                        "Operating time (the sum of the gyro's steps: its powered time in the mission) from which "
                        "bias_jump applies (>= 0)")
+        self.share_values()
+        self._outputs_at = self.shared_slice((("omega_meas_B", 3),))
 
     def build_model(self):
         return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"],
@@ -44,5 +46,10 @@ class Gyro(NeighborSlave):
 
     def do_step(self, current_time, step_size):
         self.model.step(step_size)
-        self._input_version += 1  # new noise sample: recompute the outputs
+        self.publish_after_step()  # the new noise sample
         return True
+
+    def publish(self):
+        # the getter's value (NeighborSlave.publish) in one write
+        self.shared[self._outputs_at] = self._measure()
+        self.mark_published()

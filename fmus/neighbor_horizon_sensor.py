@@ -28,6 +28,8 @@ class HorizonSensor(NeighborSlave):
                           depends_on=position + quaternion)
         self.output("valid", lambda: self.feedthrough(self._measure)[1], None,
                     "Nadir measurement valid (false only for a zero position)", bool, depends_on=position)
+        self.share_values()
+        self._outputs_at = self.shared_slice((("nadir_B", 3), ("valid", 1)))
 
     def build_model(self):
         return sensors.HorizonSensor(self.values["sigma"], self.values["seed"])
@@ -37,5 +39,11 @@ class HorizonSensor(NeighborSlave):
 
     def do_step(self, current_time, step_size):
         self.model.step(step_size)
-        self._input_version += 1  # new noise sample: recompute the outputs
+        self.publish_after_step()  # the new noise sample
         return True
+
+    def publish(self):
+        # the getters' values (NeighborSlave.publish) in one write
+        nadir, valid = self._measure()
+        self.shared[self._outputs_at] = (*nadir, valid)
+        self.mark_published()

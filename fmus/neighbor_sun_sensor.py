@@ -40,6 +40,8 @@ class SunSensor(NeighborSlave):
         self.parameter("fail_time", 0.0, "s",
                        "Operating time (the sum of the sensor's steps: its powered time in the mission) of the "
                        "failure when failed (>= 0)")
+        self.share_values()
+        self._outputs_at = self.shared_slice((("sun_B", 3), ("valid", 1)))
 
     def build_model(self):
         return sensors.SunSensor(self.vector("boresight_B", 3), self.values["half_fov"], self.values["sigma"],
@@ -47,9 +49,15 @@ class SunSensor(NeighborSlave):
 
     def _measure(self):
         return self.model.measure(self.vector("r_SN_N", 3), self.vector("r_BN_N", 3), self.vector("q_BN", 4),
-                                  self.values["sunlit"])
+                                  self.input_value("sunlit"))
 
     def do_step(self, current_time, step_size):
         self.model.step(step_size)
-        self._input_version += 1  # new noise sample: recompute the outputs
+        self.publish_after_step()  # the new noise sample
         return True
+
+    def publish(self):
+        # the getters' values (NeighborSlave.publish) in one write
+        sun, valid = self._measure()
+        self.shared[self._outputs_at] = (*sun, valid)
+        self.mark_published()
