@@ -1,0 +1,296 @@
+"""Values shared with the runtime (issue 27, item 1): the wrappers that call share_values() keep
+their inputs and outputs in an array the binary reads and writes without entering Python.
+
+- A wrapper's own publish (a compiled call) writes exactly what its getters define, after steps
+  and after inputs changed without a step, over every option of the model.
+- Through the binary (FMPy loading the built FMU): an output that depends on an input follows it
+  without a step; a parameter set in initialization changes the outputs; a reset gives the
+  initial outputs again in new arrays; a value reference of the wrong type is still an error; the
+  values equal the Python object's bit for bit; FMI 3.0's arrays cross the same way.
+"""
+import math
+
+import fmpy
+from fmpy.fmi3 import FMU3Slave
+import numpy as np
+import pytest
+
+import build_fmus
+from build_fmus import wrapper_scripts
+from components.attitude import thruster_control
+from fmu_helpers import instantiate
+from system_ssp import builder
+
+LEVELS = thruster_control.pair_torques()  # x, y, z pair torques (they differ in the last bit)
+LEVEL = LEVELS[0]
+SETTERS = {float: "set_real", bool: "set_boolean", int: "set_integer", str: "set_string"}
+
+
+def _slave(name, parameters):
+    """A wrapper object of FMU `name` (the class inside the FMU), initialized with `parameters`."""
+    cls = builder._import_wrapper(build_fmus.FMU_SOURCES / f"neighbor_{_snake(name)}.py")
+    slave = cls(instance_name=name, resources=str(builder.FMU_SOURCES))
+    slave.setup_experiment(0.0, 100.0)
+    slave.enter_initialization_mode()
+    _set(slave, parameters)
+    slave.exit_initialization_mode()
+    return slave
+
+
+def _snake(name):
+    return "".join("_" + c.lower() if c.isupper() else c for c in name).lstrip("_")
+
+
+def _set(slave, values):
+    vr = {var.name: r for r, var in slave.vars.items()}
+    for name, value in values.items():
+        getattr(slave, SETTERS[type(value)])([vr[name]], [value])
+
+
+def _rigid_body_inputs(rng, k):
+    v = {f"torque_B[{i}]": float(rng.choice([-1.0, 0.0, 1.0]) * LEVEL) for i in (1, 2, 3)}
+    v.update({f"wheel_torque_B[{i}]": float(rng.uniform(-1e-4, 1e-4)) for i in (1, 2, 3)})
+    v.update({f"wheel_momentum_B[{i}]": float(rng.uniform(-1e-3, 1e-3)) for i in (1, 2, 3)})
+    v.update(propellant_used=2e-4 * k, rcs_propellant=5e-5 * k)
+    return v
+
+
+def _detumble_inputs(rng, k):
+    scale = 0.2 if k < 100 else 1e-4  # tumbling, then inside the tolerance so the settle count runs
+    v = {f"omega_BN_B[{i}]": float(rng.uniform(-scale, scale)) for i in (1, 2, 3)}
+    v.update({f"omega_dot_BN_B[{i}]": float(rng.uniform(-0.01, 0.01)) for i in (1, 2, 3)})
+    v["enabled"] = bool(k % 37 != 5)
+    return v
+
+
+def _thruster_inputs(rng, k):
+    return {f"torque_cmd_B[{i}]": float(rng.choice([-1.0, 0.0, 1.0]) * LEVEL + rng.uniform(-0.6, 0.6) * LEVEL)
+            for i in (1, 2, 3)}
+
+
+def _unit(rng, n):
+    v = rng.normal(size=n)
+    return (v / np.linalg.norm(v)).tolist()
+
+
+def _gyro_inputs(rng, k):
+    return {f"omega_BN_B[{i}]": float(x) for i, x in enumerate(rng.uniform(-0.3, 0.3, 3), 1)}
+
+
+def _attitude_and_position(rng, k):
+    v = {f"q_BN[{i}]": x for i, x in enumerate(_unit(rng, 4), 1)}
+    r = [0.0, 0.0, 0.0] if k % 23 == 11 else (6.8e6 * np.array(_unit(rng, 3))).tolist()  # a zero position: invalid
+    v.update({f"r_BN_N[{i}]": x for i, x in enumerate(r, 1)})
+    return v
+
+
+def _sun_sensor_inputs(rng, k):
+    v = _attitude_and_position(rng, k)
+    v.update({f"r_SN_N[{i}]": x for i, x in enumerate((1.496e11 * np.array(_unit(rng, 3))).tolist(), 1)})
+    v["sunlit"] = bool(k % 17 != 3)
+    return v
+
+
+def _selector_inputs(rng, k):
+    active = ("detumble", "slew", "tracking", None)[k % 4]
+    v = {}
+    for name in ("detumble", "slew", "tracking"):
+        v.update({f"torque_cmd_{name}_B[{i}]": float(rng.uniform(-LEVEL, LEVEL)) for i in (1, 2, 3)})
+        v[f"{name}_enable"] = name == active
+    return v
+
+
+# FMU -> [(parameters, inputs(rng, step))]: every model option a compiled publish must follow
+SCENARIOS = {
+    "RigidBody": [
+        ({"integrator": "euler", "omega0[1]": 0.17, "omega0[2]": -0.1}, _rigid_body_inputs),
+        ({"integrator": "rk4", "q0[1]": 0.3, "q0[4]": 0.9, "omega0[3]": 0.2, "inertia_error[1]": 0.1,
+          "inertia_error[3]": -0.05, "propellant_mass_properties": True}, _rigid_body_inputs),
+        ({"integrator": "rk4", "max_substep": 0.004, "inertia_from_box": False, "inertia_B[1,1]": 0.1,
+          "inertia_B[2,2]": 0.12, "inertia_B[3,3]": 0.15, "inertia_B[1,2]": 0.002, "inertia_B[2,1]": 0.002,
+          "euler0_from_q0": False, "euler0[2]": 0.4}, _rigid_body_inputs),
+    ],
+    "DetumbleController": [
+        ({}, _detumble_inputs),
+        ({"signed_stop_test": True, "settle_time": 0.045, "omega_d[2]": 1e-4}, _detumble_inputs),
+    ],
+    "RcsThrusters": [({}, _thruster_inputs), ({"edge_a": 0.2, "thrust": 0.03, "Isp": 60.0}, _thruster_inputs)],
+    "Gyro": [({"seed": 3, "bias[2]": 1e-3}, _gyro_inputs),
+             ({"seed": 4, "sigma_sample_time": 0.1, "bias_jump[1]": 2e-3, "jump_time": 1.0}, _gyro_inputs)],
+    "HorizonSensor": [({"seed": 5, "sigma": 0.01}, _attitude_and_position)],
+    "SunSensor": [({"seed": 6}, _sun_sensor_inputs),
+                  ({"seed": 7, "boresight_B[3]": 1.0, "boresight_B[1]": 0.0, "half_fov": 1.2, "failed": True,
+                    "fail_time": 2.0}, _sun_sensor_inputs)],
+    "TorqueSelector": [({}, _selector_inputs)],
+}
+
+
+def _sharing_wrappers():
+    names = []
+    for script in wrapper_scripts():
+        cls = builder._import_wrapper(script)
+        if cls(instance_name="probe", resources=str(builder.FMU_SOURCES)).shared is not None:
+            names.append(cls.__name__)
+    return sorted(names)
+
+
+def _generic_publish(slave):
+    """The outputs as the getters define them (NeighborSlave.publish), leaving the slave as it was."""
+    base = next(klass for klass in type(slave).__mro__ if klass.__name__ == "NeighborSlave")
+    assert type(slave).publish is not base.publish  # the wrapper has its own
+    fast = slave.shared.copy()
+    base.publish(slave)
+    generic = slave.shared.copy()
+    slave.shared[:] = fast
+    return generic
+
+
+def test_every_sharing_wrapper_has_a_scenario():
+    assert _sharing_wrappers() == sorted(SCENARIOS)
+
+
+@pytest.mark.parametrize("name", sorted(SCENARIOS))
+def test_a_compiled_publish_writes_what_the_getters_define(name):
+    rng = np.random.default_rng(271)
+    for parameters, inputs in SCENARIOS[name]:
+        slave = _slave(name, parameters)
+        real_outputs = [vr for vr, var in slave.vars.items()
+                        if slave.share_codes[vr] & 15 > 1 and type(var).__name__ == "Real"]
+        for k in range(200):
+            _set(slave, inputs(rng, k))
+            if k % 9 == 4:  # inputs changed, no step: a get publishes (feedthrough outputs follow the inputs)
+                slave.get_real(real_outputs)
+                assert slave.shared.tobytes() == _generic_publish(slave).tobytes(), (name, parameters, k)
+            assert slave.do_step(k * 0.015, 0.015)
+            assert slave.share_flags[0] and slave.share_flags[1]  # the step published
+            assert slave.shared.tobytes() == _generic_publish(slave).tobytes(), (name, parameters, k)
+
+
+def _read(fmu, vr, names):
+    return fmu.getReal([vr[n] for n in names])
+
+
+def test_a_feedthrough_output_follows_its_input_without_a_step(fmu_paths, tmp_path):
+    fmu, vr = instantiate(fmu_paths["RcsThrusters"], tmp_path, "thr", initialize=True)
+    try:
+        cmd = [f"torque_cmd_B[{i}]" for i in (1, 2, 3)]
+        applied = [f"torque_B[{i}]" for i in (1, 2, 3)]
+        flags = [vr[f"thrust_flag[{i}]"] for i in (1, 2, 3)]
+        fmu.setReal([vr[n] for n in cmd], [LEVEL, -0.2 * LEVEL, -LEVEL])
+        assert _read(fmu, vr, applied) == [LEVELS[0], 0.0, -LEVELS[2]] and fmu.getInteger(flags) == [1, 0, -1]
+        fmu.setReal([vr[n] for n in cmd], [0.0, 0.9 * LEVEL, 0.0])
+        assert _read(fmu, vr, applied) == [0.0, LEVELS[1], 0.0] and fmu.getInteger(flags) == [0, 1, 0]
+        assert _read(fmu, vr, ["fire_time[2]"]) == [0.0]
+        fmu.doStep(0.0, 0.015)
+        assert _read(fmu, vr, ["fire_time[2]", "fire_time_total"]) == [0.015, 0.015]
+        with pytest.raises(Exception, match="fmi2GetReal"):  # an Integer's value reference: an error, as before
+            fmu.getReal(flags)
+        with pytest.raises(Exception, match="fmi2SetInteger"):
+            fmu.setInteger([vr[cmd[0]]], [1])
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+
+
+def test_parameters_and_reset_renew_the_shared_outputs(fmu_paths, tmp_path):
+    fmu, vr = instantiate(fmu_paths["RigidBody"], tmp_path, "body")
+    q = [f"q_BN[{i}]" for i in (1, 2, 3, 4)]
+    try:
+        fmu.enterInitializationMode()
+        assert _read(fmu, vr, q) == [0.0, 0.0, 0.0, 1.0]
+        fmu.setReal([vr["q0[1]"], vr["q0[4]"]], [1.0, 1.0])  # a parameter: the outputs are stale
+        assert _read(fmu, vr, q) == [1 / math.sqrt(2), 0.0, 0.0, 1 / math.sqrt(2)]
+        fmu.exitInitializationMode()
+        fmu.setReal([vr["torque_B[3]"]], [LEVEL])
+        for k in range(5):
+            fmu.doStep(k * 0.015, 0.015)
+        assert _read(fmu, vr, ["omega_BN_B[3]"])[0] > 0.0
+        fmu.reset()  # a new slave object's arrays: the binary must read those, not the old ones
+        fmu.setupExperiment(startTime=0.0)
+        fmu.enterInitializationMode()
+        fmu.exitInitializationMode()
+        assert _read(fmu, vr, q + ["omega_BN_B[3]", "torque_B[3]"]) == [0.0, 0.0, 0.0, 1.0, 0.0, 0.0]
+        fmu.setReal([vr["torque_B[1]"]], [LEVEL])
+        fmu.doStep(0.0, 0.015)
+        assert _read(fmu, vr, ["omega_BN_B[1]"])[0] > 0.0
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+
+
+def test_the_binary_gives_the_python_objects_bits(fmu_paths, tmp_path):
+    parameters = SCENARIOS["RigidBody"][1][0]
+    slave = _slave("RigidBody", parameters)
+    fmu, vr = instantiate(fmu_paths["RigidBody"], tmp_path, "body")
+    try:
+        fmu.enterInitializationMode()
+        for name, value in parameters.items():
+            if isinstance(value, str):
+                fmu.setString([vr[name]], [value])
+            elif isinstance(value, bool):
+                fmu.setBoolean([vr[name]], [value])
+            else:
+                fmu.setReal([vr[name]], [value])
+        fmu.exitInitializationMode()
+        outputs = [vr for vr, var in slave.vars.items() if slave.fmu_meta[var.name]["causality"] == "output"]
+        rng = np.random.default_rng(5)
+        for k in range(150):
+            inputs = _rigid_body_inputs(rng, k)
+            _set(slave, inputs)
+            fmu.setReal([vr[n] for n in inputs], list(inputs.values()))
+            slave.do_step(k * 0.015, 0.015)
+            fmu.doStep(k * 0.015, 0.015)
+            assert fmu.getReal(outputs) == slave.get_real(outputs), k
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
+
+
+def test_fmi3_arrays_cross_through_the_shared_values(fmu3_paths, fmu_paths, tmp_path):
+    """FMI 3.0 names an array by its first element's value reference: the binary expands it over
+    the shared values as the loader does, and the values are the FMI 2.0 FMU's."""
+    md = fmpy.read_model_description(str(fmu3_paths["RcsThrusters"]))
+    folder = fmpy.extract(str(fmu3_paths["RcsThrusters"]), str(tmp_path / "thr3"))
+    fmu3 = FMU3Slave(guid=md.guid, unzipDirectory=folder, modelIdentifier=md.coSimulation.modelIdentifier,
+                     instanceName="thr3")
+    fmu3.instantiate()
+    fmu2, vr2 = instantiate(fmu_paths["RcsThrusters"], tmp_path, "thr2", initialize=True)
+    vr3 = {v.name: v.valueReference for v in md.modelVariables}
+    try:
+        fmu3.enterInitializationMode(startTime=0.0)
+        fmu3.exitInitializationMode()
+        rng = np.random.default_rng(3)
+        for k in range(40):
+            cmd = _thruster_inputs(rng, k)
+            fmu3.setFloat64([vr3["torque_cmd_B"]], list(cmd.values()))
+            fmu2.setReal([vr2[n] for n in cmd], list(cmd.values()))
+            applied = fmu3.getFloat64([vr3["torque_B"]], nValues=3)  # before the step: feedthrough
+            assert applied == fmu2.getReal([vr2[f"torque_B[{i}]"] for i in (1, 2, 3)])
+            assert fmu3.getInt32([vr3["thrust_flag"]], nValues=3) == fmu2.getInteger(
+                [vr2[f"thrust_flag[{i}]"] for i in (1, 2, 3)])
+            fmu3.doStep(k * 0.015, 0.015)
+            fmu2.doStep(k * 0.015, 0.015)
+            assert fmu3.getFloat64([vr3["fire_time"], vr3["propellant_mass"]], nValues=4) == fmu2.getReal(
+                [vr2[f"fire_time[{i}]"] for i in (1, 2, 3)] + [vr2["propellant_mass"]])
+        assert fmu3.getFloat64([vr3["fire_time_total"]])[0] > 0.0
+    finally:
+        for fmu in (fmu3, fmu2):
+            fmu.terminate()
+            fmu.freeInstance()
+
+
+def test_an_output_the_inputs_cannot_give_fails_where_it_is_read(fmu_paths, tmp_path):
+    """Two controllers enabled at once: the selector's step goes on and the read of its command is
+    the error, as before its values were shared (the step publishes, the failure waits for the get)."""
+    fmu, vr = instantiate(fmu_paths["TorqueSelector"], tmp_path, "selector", initialize=True)
+    try:
+        fmu.setBoolean([vr["detumble_enable"], vr["slew_enable"]], [True, True])
+        fmu.doStep(0.0, 0.015)
+        with pytest.raises(Exception, match="fmi2GetReal"):
+            fmu.getReal([vr["torque_cmd_B[1]"]])
+        fmu.setBoolean([vr["slew_enable"]], [False])
+        fmu.setReal([vr["torque_cmd_detumble_B[2]"]], [LEVEL])
+        assert fmu.getReal([vr[f"torque_cmd_B[{i}]"] for i in (1, 2, 3)]) == [0.0, LEVEL, 0.0]
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
