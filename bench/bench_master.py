@@ -8,8 +8,10 @@ takes the same number of steps), each row measured in this run:
   runtime's batched step (neighborStepIO: set, doStep and get in one call into the FMU) and with
   the standard FMI calls only, and their ratio;
 - the floor: the same three models' wrapper objects (the classes inside the FMUs, with the same
-  parameters) called directly in a plain Python loop, set/do_step/get by value reference, no FMI
-  and no master; the master + FMI cost per FMU call over it;
+  parameters) called directly in a plain Python loop, no FMI and no master: do_step, with the
+  values moved between the arrays the models share with the runtime by numpy indexing (the
+  models' own work); the master + FMI cost per FMU call over it; and the same objects called
+  through their Python set_real/do_step/get_real by value reference;
 - the time inside the FMUs' own fmi2Set*/fmi2DoStep/fmi2Get* calls with the standard calls (each
   call timed), and the master's own overhead per step in that run;
 - libcosim (libcosimpy, its fixed-step algorithm, nothing observed) on the same .ssp in a
@@ -27,6 +29,8 @@ from pathlib import Path
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+
+import numpy as np  # noqa: E402
 
 import system_ssp  # noqa: E402
 from system_ssp.neighbor import thesis  # noqa: E402
@@ -97,11 +101,14 @@ def _wrapper_class(model_identifier):
     return builder._import_wrapper(builder.FMU_SOURCES / f"neighbor_{snake}.py")
 
 
-def floor_run(system, steps):
+def floor_run(system, steps, through_get_set=False):
     """The system's models as their wrapper objects, called directly in a plain Python loop in the
     master's order: each component's connected inputs set from the outputs read last (the same
-    Gauss-Seidel), do_step, its connected outputs read. Returns (wall seconds, FMU-call
-    equivalents per step, the final values {component.variable: value})."""
+    Gauss-Seidel), do_step, its connected outputs read. Models that share their values with the
+    runtime (NeighborSlave.share_values) get them moved between their arrays by numpy indexing
+    (their own work: do_step), unless `through_get_set`: then every model through its Python
+    set_real/get_real (what a Python host calling the objects pays). Returns (wall seconds,
+    FMU-call equivalents per step, the final values {component.variable: value})."""
     setters = {"Real": "set_real", "Integer": "set_integer", "Enumeration": "set_integer", "Boolean": "set_boolean",
                "String": "set_string"}
     slaves = []
@@ -125,16 +132,31 @@ def floor_run(system, steps):
     values = [dict(zip(outs[ci], slaves[ci].get_real(outs[ci]))) for ci in range(n)]
     order = [system.comps.index(system.by_name[name]) for name in system.default_order()]
     calls = sum(1 + bool(ins[ci]) + bool(outs[ci]) for ci in range(n))
+    shared = not through_get_set and all(slave.shared is not None for slave in slaves)
+    if shared:
+        # per component, per source: (its input indices, the source's array, the source's indices)
+        moves = [[(np.array([d for d, s, _ in ins[ci] if s == src]), slaves[src].shared,
+                   np.array([v for _, s, v in ins[ci] if s == src])) for src in sorted({s for _, s, _ in ins[ci]})]
+                 for ci in range(n)]
     t0 = time.perf_counter()
-    for k in range(steps):
-        t = k * 0.015
-        for ci in order:
-            slave = slaves[ci]
-            if ins[ci]:
-                slave.set_real([d for d, _, _ in ins[ci]], [values[src][s] for _, src, s in ins[ci]])
-            slave.do_step(t, 0.015)
-            if outs[ci]:
-                values[ci] = dict(zip(outs[ci], slave.get_real(outs[ci])))
+    if shared:
+        steps_of = [(slaves[ci].shared, moves[ci], slaves[ci].do_step) for ci in order]
+        for k in range(steps):
+            t = k * 0.015
+            for array, sources, do_step in steps_of:
+                for dst, src_array, src in sources:
+                    array[dst] = src_array[src]
+                do_step(t, 0.015)
+    else:
+        for k in range(steps):
+            t = k * 0.015
+            for ci in order:
+                slave = slaves[ci]
+                if ins[ci]:
+                    slave.set_real([d for d, _, _ in ins[ci]], [values[src][s] for _, src, s in ins[ci]])
+                slave.do_step(t, 0.015)
+                if outs[ci]:
+                    values[ci] = dict(zip(outs[ci], slave.get_real(outs[ci])))
     wall = time.perf_counter() - t0
     final = {f"{system.comps[ci].name}.{v.name}": slaves[ci].get_real([v.valueReference])[0]
              for ci in range(n) for v in system.comps[ci].md.modelVariables if v.causality == "output"
@@ -199,6 +221,7 @@ def main():
                   f"{slow / fast:.2f}x")
         one = best[("one signal recorded", True)] / n
 
+        python_get_set = min(floor_run(system, n, through_get_set=True)[0] for _ in range(args.repeat)) / n
         floor_walls = []
         for _ in range(args.repeat):
             wall, calls, final = floor_run(system, n)
@@ -207,7 +230,10 @@ def main():
         r = run_detumble(system, n, list(final))
         same = all(r.final[name] == value for name, value in final.items())
         print(f"  floor: the models called directly in Python {n * 1.0 / (floor * n):9.0f} steps/s, "
-              f"{floor * 1e6:.1f} us/step ({'the same final state' if same else 'final state DIFFERS'} as the master)")
+              f"{floor * 1e6:.1f} us/step ({'the same final state' if same else 'final state DIFFERS'} as the master; "
+              "values moved between the models' shared arrays)")
+        print(f"  the same objects through their Python set_real/get_real {1.0 / python_get_set:9.0f} steps/s, "
+              f"{python_get_set * 1e6:.1f} us/step")
         print(f"  master + FMI over the floor {(one - floor) * 1e6:9.1f} us/step, "
               f"{(one - floor) / calls * 1e6:.2f} us per FMU call ({calls} set/doStep/get calls a step), "
               f"the master's run at {one / floor:.2f}x the floor")
