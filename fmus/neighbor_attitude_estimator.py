@@ -27,11 +27,13 @@ attitudes fit it alike, as for a body at rest, or while its largest 1-sigma exce
 `attitude_valid` uses `valid_sigma_without_sun` until a Sun vector is seen again.
 """
 import math
+from operator import itemgetter
 
 import numpy as np
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import rigid_body
+from components.core.names import element_names
 from components.sensing import mekf, triad
 
 
@@ -131,14 +133,13 @@ class AttitudeEstimator(NeighborSlave):
         self.parameter("history_fix_sigma", 0.0, "rad",
                        "The history's fix is taken only once its largest 1-sigma attitude error per axis is this or "
                        "less, else tried again after 120 s more history (>= 0; 0: any)")
-        self.share_values()
-        # a step's inputs packed in mekf's U_* order (taken from the shared values), and its outputs (Y_*)
-        self._inputs_at = self.shared_indices(
-            (("nadir_B", 3), ("nadir_valid", 1), ("sun_B", 3), ("sun_valid", 1), ("r_BN_N", 3), ("r_SN_N", 3),
-             ("omega_meas_B", 3), ("torque_cmd_B", 3), ("coarse_sun_B", 3), ("coarse_sun_valid", 1),
-             ("q_true_BN", 4), ("omega_true_B", 3)))
+        # a step's inputs packed in mekf's U_* order, and its outputs (Y_*)
+        self._pick_packed = itemgetter(*element_names("nadir_B", 3), "nadir_valid", *element_names("sun_B", 3),
+                                       "sun_valid", *element_names("r_BN_N", 3), *element_names("r_SN_N", 3),
+                                       *element_names("omega_meas_B", 3), *element_names("torque_cmd_B", 3),
+                                       *element_names("coarse_sun_B", 3), "coarse_sun_valid",
+                                       *element_names("q_true_BN", 4), *element_names("omega_true_B", 3))
         self._packed, self._packed_out = np.zeros(mekf.U_SIZE), np.zeros(mekf.Y_SIZE)
-        self._outputs_at = self.shared_indices(PUBLISHED)
 
     def build_model(self):
         v = self.values
@@ -164,11 +165,10 @@ class AttitudeEstimator(NeighborSlave):
         # before the end of initialization: from the values as they stand (not kept)
         return self._compute() if self._out is None else self._out
 
-    def _valid(self, sigma=None):
+    def _valid(self):
         v = self.values
         limit = v["valid_sigma_without_sun"] if self.model.without_sun else v["valid_sigma"]
-        return v["truth_feedback"] or (self.model.filter.initialized
-                                       and max(self._sigma() if sigma is None else sigma) <= limit)
+        return v["truth_feedback"] or (self.model.filter.initialized and max(self._sigma()) <= limit)
 
     def _sigma(self):
         f = self.model.filter
@@ -201,40 +201,17 @@ class AttitudeEstimator(NeighborSlave):
         v = self.values
         if v["truth_feedback"]:
             self._refresh()
-            self.publish_after_step()
             return True
         model, u = self.model, self._packed
-        self.shared.take(self._inputs_at, out=u)
+        u[:] = self._pick_packed(v)
         # the step, the NEES against q_true_BN and the outputs, compiled between vector updates
         if model.step_packed(u, step_size, True, self._packed_out) == 0:
             self._out = self._packed_out.tolist()
         else:  # before the first fix, or a NEES the compiled code leaves to check()
             model.check(self.vector("q_true_BN", 4))
             self._refresh()
-        self.publish_after_step()
         return True
-
-    def publish(self):
-        # the getters' values (NeighborSlave.publish) in PUBLISHED's order, in one write
-        out, model = self._outputs(), self.model
-        sigma = self._sigma()
-        truth = self.values["truth_feedback"]
-        consistency, innovations = model.consistency, model.innovations
-        self.shared[self._outputs_at] = (
-            out[mekf.Y_Q:mekf.Y_RATE_DOT] + list(model.filter.bias) + sigma
-            + [truth or model.filter.initialized] + out[mekf.Y_RATE_DOT:]
-            + [self._valid(sigma), consistency.last, consistency.mean, consistency.over_fraction,
-               innovations.detections, innovations.largest, model.without_sun])
-        if self._out is not None:  # before the end of initialization the outputs follow the inputs at each get
-            self.mark_published()
 
     def _set_fmu_state(self, state):
         super()._set_fmu_state(state)
         self._refresh()
-
-
-# every output, in the order publish writes them
-PUBLISHED = (("q_est_BN", 4), ("omega_est_B", 3), ("bias_est_B", 3), ("sigma_attitude", 3), ("initialized", 1),
-             ("omega_dot_est_B", 3), ("attitude_error", 1), ("rate_error", 1), ("attitude_valid", 1), ("nees", 1),
-             ("nees_mean", 1), ("nees_over_fraction", 1), ("bias_resets", 1), ("innovation_largest", 1),
-             ("fixed_without_sun", 1))

@@ -18,7 +18,6 @@ import pytest
 import build_fmus
 from build_fmus import wrapper_scripts
 from components.attitude import thruster_control
-from components.core import rotations
 from fmu_helpers import instantiate
 from system_ssp import builder
 
@@ -101,29 +100,6 @@ def _selector_inputs(rng, k):
     return v
 
 
-def _estimator_inputs(rng, k):
-    """A slow tumble seen by noisy vector sensors (sometimes invalid) and a biased gyro."""
-    t = 0.015 * k
-    q = rotations.normalized((0.1 + 0.05 * math.sin(0.3 * t), 0.2, 0.3 * math.cos(0.2 * t), 0.9))
-    A = rotations.attitude_matrix(q)
-    r, sun = (6.8e6, 1e5 * t, 0.0), (1.0e11, 1.1e11, 0.0)
-    nadir = rotations.normalized([-x for x in r])
-    sun_dir = rotations.normalized([s - x for s, x in zip(sun, r)])
-    v = {}
-    for name, vec in (("nadir_B", nadir), ("sun_B", sun_dir), ("coarse_sun_B", sun_dir)):
-        body = [sum(A[i][j] * vec[j] for j in range(3)) + float(rng.normal(0.0, 1e-3)) for i in range(3)]
-        v.update({f"{name}[{i}]": x for i, x in enumerate(body, 1)})
-    v.update(nadir_valid=k % 7 != 0, sun_valid=k % 40 < 25, coarse_sun_valid=True)
-    v.update({f"r_BN_N[{i}]": x for i, x in enumerate(r, 1)})
-    v.update({f"r_SN_N[{i}]": x for i, x in enumerate(sun, 1)})
-    v.update({f"omega_meas_B[{i}]": 0.01 + 1e-3 * i + float(rng.normal(0.0, 5e-4)) for i in (1, 2, 3)})
-    v.update({f"torque_cmd_B[{i}]": float(rng.choice([-1.0, 0.0, 1.0]) * LEVEL) for i in (1, 2, 3)})
-    v.update({f"q_true_BN[{i}]": x for i, x in enumerate(q, 1)})
-    v.update({f"omega_true_B[{i}]": 0.01 + 1e-3 * i for i in (1, 2, 3)})
-    v.update({f"omega_dot_true_B[{i}]": 1e-4 for i in (1, 2, 3)})
-    return v
-
-
 # FMU -> [(parameters, inputs(rng, step))]: every model option a compiled publish must follow
 SCENARIOS = {
     "RigidBody": [
@@ -146,10 +122,6 @@ SCENARIOS = {
                   ({"seed": 7, "boresight_B[3]": 1.0, "boresight_B[1]": 0.0, "half_fov": 1.2, "failed": True,
                     "fail_time": 2.0}, _sun_sensor_inputs)],
     "TorqueSelector": [({}, _selector_inputs)],
-    "AttitudeEstimator": [({}, _estimator_inputs),
-                          ({"update_interval": 0.09, "use_coarse_sun": True, "fault_window": 5, "fault_limit": 2.0},
-                           _estimator_inputs),
-                          ({"truth_feedback": True}, _estimator_inputs)],
 }
 
 
