@@ -14,6 +14,10 @@ one drops the current model, and the next access of `self.model` builds a fresh 
 the parameter values through `build_model()`, which the wrapper implements. Outputs are
 getters, so an output that depends directly on inputs is recomputed from the inputs as they
 are when it is read (true direct feedthrough, as FMI co-simulation masters expect).
+
+A wrapper may share its inputs and outputs with the FMU's binary instead (`share_values`): they
+then live in one array the binary reads and writes without entering Python, and the wrapper
+publishes its outputs into it (see the section "values shared with the runtime" below).
 """
 import copy
 import math
@@ -435,6 +439,8 @@ class NeighborSlave(Fmi2Slave):
     # changed) is published first. The getters stay the outputs' definition: the generic publish
     # evaluates them, and a wrapper's faster publish must write the same values.
     def share_values(self) -> None:
+        """Keep the inputs and outputs in the shared array from now on (call it last in __init__,
+        after every declaration)."""
         n = len(self.vars)
         self.shared = np.zeros(n)
         self.share_codes = np.zeros(n, np.int32)

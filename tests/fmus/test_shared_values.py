@@ -1,8 +1,8 @@
 """Values shared with the runtime (issue 27, item 1): the wrappers that call share_values() keep
 their inputs and outputs in an array the binary reads and writes without entering Python.
 
-- A wrapper's own publish (a compiled call) writes exactly what its getters define, after steps
-  and after inputs changed without a step, over every option of the model.
+- A wrapper's own publish (a compiled call or one write) writes exactly what its getters define,
+  after steps and after inputs changed without a step, over every option of the model.
 - Through the binary (FMPy loading the built FMU): an output that depends on an input follows it
   without a step; a parameter set in initialization changes the outputs; a reset gives the
   initial outputs again in new arrays; a value reference of the wrong type is still an error; the
@@ -100,7 +100,7 @@ def _selector_inputs(rng, k):
     return v
 
 
-# FMU -> [(parameters, inputs(rng, step))]: every model option a compiled publish must follow
+# FMU -> [(parameters, inputs(rng, step))]: every model option a wrapper's publish must follow
 SCENARIOS = {
     "RigidBody": [
         ({"integrator": "euler", "omega0[1]": 0.17, "omega0[2]": -0.1}, _rigid_body_inputs),
