@@ -829,14 +829,11 @@ static Status reset_instance(void *c, const char *what) {
 }
 
 /* ---- values ----------------------------------------------------------------------------------
- * `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
- * which expands arrays; `expected` is then the host's nValues); Booleans are written as
- * `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
-/* The shared-memory path of a get or set. A value reference stands for sh_spans[vr] elements from
-   vr on (FMI 3.0: an array's elements, 0 for a value reference inside an array) or one (FMI 2.0,
-   no spans). all_shared is 1 when every element is a shared variable of this kind (a get: any
-   role; a set: an input) and they are n_values in all; 0 otherwise (the call then goes through
-   Python, which gives the same values or the error). */
+ * The shared-memory path of a get or set. A value reference stands for sh_spans[vr] elements from
+ * vr on (FMI 3.0: an array's elements, 0 for a value reference inside an array) or one (FMI 2.0,
+ * no spans). all_shared is 1 when every element is a shared variable of this kind (a get: any
+ * role; a set: an input) and they are n_values in all; 0 otherwise (the call then goes through
+ * Python, which gives the same values or the error). */
 static size_t span_of(const Instance *inst, unsigned int vr) {
     return inst->sh_spans ? (size_t)inst->sh_spans[vr] : 1;
 }
@@ -918,6 +915,9 @@ static void set_shared(Instance *inst, int kind, const unsigned int vr[], size_t
     inst->sh_flags[FRESH_FEEDTHROUGH] = 0;  /* the outputs that depend on inputs */
 }
 
+/* `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
+ * which expands arrays; `expected` is then the host's nValues), or from the shared values;
+ * Booleans are written as `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
 static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr, void *out, size_t expected,
                          int via_loader, size_t bool_size, const char *what) {
     Instance *shared = (Instance *)c;
