@@ -155,22 +155,6 @@ class RigidBody:
         self.drawn, self.center_of_mass = drawn, c
 
     # ---- dynamics --------------------------------------------------------------------
-    def angular_acceleration(self, omega, torque, wheel_torque=ZERO3, h_w=ZERO3):
-        """Eq. 17, in gyrostat form: omega_dot = I^-1 [L - wheel_torque - omega x (I omega + h_w)].
-
-        With zero wheel terms this is exactly Eq. 17 (adding or subtracting 0.0 changes no
-        non-zero float, so the thesis' numbers are reproduced bit for bit)."""
-        J, Ji = self.J, self.Jinv
-        h = (J[0][0] * omega[0] + J[0][1] * omega[1] + J[0][2] * omega[2] + h_w[0],
-             J[1][0] * omega[0] + J[1][1] * omega[1] + J[1][2] * omega[2] + h_w[1],
-             J[2][0] * omega[0] + J[2][1] * omega[1] + J[2][2] * omega[2] + h_w[2])
-        c = rotations.cross(omega, h)
-        r = (torque[0] - wheel_torque[0] - c[0], torque[1] - wheel_torque[1] - c[1],
-             torque[2] - wheel_torque[2] - c[2])
-        return (Ji[0][0] * r[0] + Ji[0][1] * r[1] + Ji[0][2] * r[2],
-                Ji[1][0] * r[0] + Ji[1][1] * r[1] + Ji[1][2] * r[2],
-                Ji[2][0] * r[0] + Ji[2][1] * r[1] + Ji[2][2] * r[2])
-
     def step(self, torque, h, wheel_torque=ZERO3, wheel_momentum=ZERO3):
         """Advance by h seconds with the body torque held constant (N.m, B frame).
 
@@ -241,7 +225,9 @@ class RigidBody:
 # the plain-Python path, so both give the same bits) ------------------------------------------
 @njit(cache=True)
 def _acceleration(w0, w1, w2, J, Ji, t, tw, h0, h1, h2):
-    """omega_dot = I^-1 [L - wheel_torque - omega x (I omega + h_w)] (RigidBody.angular_acceleration)."""
+    """Eq. 17 in gyrostat form: omega_dot = I^-1 [L - wheel_torque - omega x (I omega + h_w)]. With
+    zero wheel terms this is exactly Eq. 17 (adding or subtracting 0.0 changes no non-zero float,
+    so the thesis' numbers are reproduced bit for bit)."""
     a0 = J[0] * w0 + J[1] * w1 + J[2] * w2 + h0
     a1 = J[3] * w0 + J[4] * w1 + J[5] * w2 + h1
     a2 = J[6] * w0 + J[7] * w1 + J[8] * w2 + h2
