@@ -444,7 +444,7 @@ class NeighborSlave(Fmi2Slave):
         n = len(self.vars)
         self.shared = np.zeros(n)
         self.share_codes = np.zeros(n, np.int32)
-        self.share_flags = np.zeros(4, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH, two spare
+        self.share_flags = np.zeros(2, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH
         outputs = {cls: [] for cls in _SHARED_KINDS}
         for vr, var in self.vars.items():
             code = _SHARED_KINDS.get(type(var))
