@@ -10,20 +10,37 @@ import pytest
 
 from paths import TESTS
 
-HOST_SOURCE = TESTS / "fmus" / "c_host" / "fmu_host.c"
+HOST_SOURCES = TESTS / "fmus" / "c_host"
 
 
-@pytest.fixture(scope="session")
-def c_host(tmp_path_factory):
-    out = tmp_path_factory.mktemp("c_host") / "fmu_host"
+def compile_host(tmp_path_factory, source):
+    """A C host of tests/fmus/c_host compiled outside the checkout; it has no Python in it."""
+    out = tmp_path_factory.mktemp("c_host") / Path(source).stem
     headers = Path(fmpy.__file__).parent / "c-code"
-    cmd = ["gcc", "-std=c99", "-O1", "-Wall", "-Werror", f"-I{headers}", str(HOST_SOURCE), "-o", str(out),
+    cmd = ["gcc", "-std=c99", "-O1", "-Wall", "-Werror", f"-I{headers}", str(HOST_SOURCES / source), "-o", str(out),
            "-ldl", "-lpthread"]
     proc = subprocess.run(cmd, capture_output=True, text=True)
     assert proc.returncode == 0, proc.stderr
     libs = subprocess.run(["ldd", str(out)], capture_output=True, text=True).stdout
     assert "python" not in libs  # the host itself has no Python
     return out
+
+
+@pytest.fixture(scope="session")
+def c_host(tmp_path_factory):
+    return compile_host(tmp_path_factory, "fmu_host.c")
+
+
+@pytest.fixture(scope="session")
+def threaded_host(tmp_path_factory):
+    """tests/fmus/c_host/threaded_host.c: many instances from a pthread pool."""
+    return compile_host(tmp_path_factory, "threaded_host.c")
+
+
+@pytest.fixture(scope="session")
+def fuzz_host(tmp_path_factory):
+    """tests/fmus/c_host/fuzz_host.c: call sequences from a seed, checked against the standard."""
+    return compile_host(tmp_path_factory, "fuzz_host.c")
 
 
 @pytest.fixture(scope="session")
@@ -55,4 +72,7 @@ def fmusim(tmp_path_factory):
     simulated user machine (which hides the checkout) can run it."""
     import fmusim_host
 
-    return fmusim_host.build(tmp_path_factory.mktemp("fmusim"))
+    try:
+        return fmusim_host.build(tmp_path_factory.mktemp("fmusim"))
+    except fmusim_host.MissingPackages as exc:
+        pytest.skip(str(exc))

@@ -16,18 +16,34 @@ SOURCES = Path(__file__).with_name("fmusim")
 CLEAN_ENV = {"PATH": "/usr/bin:/bin", "HOME": os.environ.get("HOME", "/tmp")}
 
 
+class MissingPackages(RuntimeError):
+    """What this machine lacks to compile fmusim: the Debian packages, named (the tests skip)."""
+
+
+# Debian packages fmusim's compilation needs, each with the file that shows it is installed
+NEEDS = {"gcc": "/usr/bin/gcc", "libxml2-dev": "/usr/include/libxml2/libxml/parser.h",
+         "libminizip-dev": "/usr/include/minizip/unzip.h", "zlib1g-dev": "/usr/include/zlib.h"}
+
+
+def missing_packages():
+    """The Debian packages of NEEDS that this machine lacks (empty when fmusim can be compiled)."""
+    return [name for name, landmark in NEEDS.items()
+            if not (shutil.which("gcc") if name == "gcc" else Path(landmark).is_file())]
+
+
 def build(dest_dir):
     """The fmusim executable compiled from the vendored sources into `dest_dir` (kept per source
-    digest). Needs gcc, libxml2 and minizip (Debian: libxml2-dev libminizip-dev)."""
+    digest). Needs gcc, libxml2, minizip and zlib (NEEDS); MissingPackages names what is not
+    installed."""
     files = sorted(p for p in SOURCES.rglob("*") if p.suffix in (".c", ".h"))
     digest = hashlib.sha256(b"".join(p.read_bytes() for p in files)).hexdigest()[:12]
     exe = Path(dest_dir) / f"fmusim-{digest}"
     if exe.is_file():
         return exe
-    missing = [h for h in ("/usr/include/libxml2/libxml/parser.h", "/usr/include/minizip/unzip.h")
-               if not Path(h).is_file()]
-    if missing or shutil.which("gcc") is None:
-        raise RuntimeError(f"building fmusim needs gcc, libxml2-dev and libminizip-dev (missing: {missing or 'gcc'})")
+    missing = missing_packages()
+    if missing:
+        raise MissingPackages(f"fmusim cannot be compiled here: apt install {' '.join(missing)} "
+                              "(as .ci/run does)")
     exe.parent.mkdir(parents=True, exist_ok=True)
     tmp = exe.with_name(exe.name + f".{os.getpid()}.tmp")
     cmd = ["gcc", "-O1", "-w", '-DFMUSIM_VERSION="0.0.39"', f"-I{SOURCES / 'fmusim'}", f"-I{SOURCES / 'include'}",
