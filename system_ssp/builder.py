@@ -195,7 +195,7 @@ RUNTIME_C = {2: RUNTIME / "neighbor_fmi2.c", 3: RUNTIME / "neighbor_fmi3.c"}  # 
 RUNTIME_CORE = RUNTIME / "neighbor_core.c"  # what both share (included by each)
 RUNTIME_LOADER = RUNTIME / "neighbor_runtime.py"
 PLATFORMS = {  # FMI platform folder: (compiler, file suffix, extra flags)
-    "linux64": ("gcc", ".so", ["-fPIC", "-fvisibility=hidden", "-ldl"]),
+    "linux64": ("gcc", ".so", ["-fPIC", "-fvisibility=hidden", "-pthread", "-ldl"]),
     "win64": ("x86_64-w64-mingw32-gcc", ".dll", ["-static-libgcc"]),
 }
 FMI3_PLATFORMS = {"linux64": "x86_64-linux", "win64": "x86_64-windows"}  # FMI 3.0's platform tuples

@@ -39,6 +39,23 @@ static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
 #define PATH_SEP '/'
 #endif
 
+/* One lock per loaded library around starting the runtime and loading the loader: hosts may
+ * instantiate from several threads at once (libcosim's thread pool, a Python host's threads).
+ * It is taken without the GIL held (see lock_with_gil), so it never waits on Python. The Python
+ * side serializes its own import work across every FMU build (neighbor_runtime.py: _LOCK). */
+#ifdef _WIN32
+static volatile LONG runtime_lock_word = 0;
+static void runtime_lock(void) {
+    while (InterlockedCompareExchange(&runtime_lock_word, 1, 0) != 0) Sleep(0);
+}
+static void runtime_unlock(void) { InterlockedExchange(&runtime_lock_word, 0); }
+#else
+#include <pthread.h>
+static pthread_mutex_t runtime_mutex = PTHREAD_MUTEX_INITIALIZER;
+static void runtime_lock(void) { pthread_mutex_lock(&runtime_mutex); }
+static void runtime_unlock(void) { pthread_mutex_unlock(&runtime_mutex); }
+#endif
+
 /* ---- the Python C API, by pointer ---------------------------------------------------------- */
 typedef struct _object PyObject;
 typedef ptrdiff_t Py_ssize_t;
@@ -48,6 +65,7 @@ static struct {
     int (*IsInitialized)(void);
     void (*InitializeEx)(int);
     void *(*EvalSaveThread)(void);
+    void (*EvalRestoreThread)(void *);
     int (*GILStateEnsure)(void);
     void (*GILStateRelease)(int);
     PyObject *(*RunString)(const char *, int, PyObject *, PyObject *);
@@ -88,7 +106,8 @@ static struct {
 static const struct { const char *name; size_t offset; } PY_SYMBOLS[] = {
 #define S(field, name) {name, offsetof(__typeof__(py), field)}
     S(IsInitialized, "Py_IsInitialized"), S(InitializeEx, "Py_InitializeEx"),
-    S(EvalSaveThread, "PyEval_SaveThread"), S(GILStateEnsure, "PyGILState_Ensure"),
+    S(EvalSaveThread, "PyEval_SaveThread"), S(EvalRestoreThread, "PyEval_RestoreThread"),
+    S(GILStateEnsure, "PyGILState_Ensure"),
     S(GILStateRelease, "PyGILState_Release"), S(RunString, "PyRun_String"), S(DictNew, "PyDict_New"),
     S(DictSetItemString, "PyDict_SetItemString"), S(DictGetItemString, "PyDict_GetItemString"),
     S(EvalGetBuiltins, "PyEval_GetBuiltins"), S(GetAttrString, "PyObject_GetAttrString"),
@@ -361,11 +380,23 @@ static lib_handle find_python(const char *resources, char *version, size_t vsize
     return h;
 }
 
-static int start_runtime(const char *resources) {
+/* Mark an interpreter this library just started (GIL held), so that the other FMU libraries of
+   ours that find it running know it is not a host's own Python (neighbor_runtime.py reads it). */
+static void mark_started_interpreter(void) {
+    PyObject *ns = py.DictNew();
+    if (!ns) return;
+    py.DictSetItemString(ns, "__builtins__", py.EvalGetBuiltins());
+    PyObject *r = py.RunString("import sys\nsys._neighbor_cosim_started_python = True\n", PY_FILE_INPUT, ns, ns);
+    if (r) py.DecRef(r);
+    else py.ErrClear();
+    py.DecRef(ns);
+}
+
+static int start_runtime_locked(const char *resources) {
     if (runtime_ready) return 1;
     if (runtime_error[0]) return 0;  /* tried in this process before: the same answer, no retry */
     if (process_sym("Py_IsInitialized") && resolve_all(NULL) && py.IsInitialized()) {
-        runtime_ready = 1;  /* the host runs Python: use its interpreter */
+        runtime_ready = 1;  /* the host runs Python (or another FMU of ours started one): use it */
         return 1;
     }
     runtime_error[0] = '\0';
@@ -385,10 +416,36 @@ static int start_runtime(const char *resources) {
         if (whome) set_home(whome);
         py.InitializeEx(0);  /* no signal handlers: the host owns the signals */
         runtime_embedded = 1;
+        mark_started_interpreter();
         py.EvalSaveThread();  /* release the GIL: every call takes it with PyGILState_Ensure */
     }
     runtime_ready = 1;
     return 1;
+}
+
+/* Starting Python must happen once per process, whichever of our FMU libraries (each with its
+ * own statics) gets there first, and the others must wait until it has fully started: a lock the
+ * whole process shares is needed, and no library of ours can own it. POSIX: the C library's lock
+ * of stderr (flockfile: process-wide, recursive, always there; held only while Python starts).
+ * Windows: a mutex named after the process. */
+static int start_runtime(const char *resources) {
+    if (runtime_ready) return 1;
+#ifdef _WIN32
+    char name[96];
+    snprintf(name, sizeof name, "Local\\neighbor-cosim-python-start-%lu", (unsigned long)GetCurrentProcessId());
+    HANDLE mutex = CreateMutexA(NULL, FALSE, name);
+    if (mutex) WaitForSingleObject(mutex, INFINITE);
+    int ok = start_runtime_locked(resources);
+    if (mutex) {
+        ReleaseMutex(mutex);
+        CloseHandle(mutex);
+    }
+#else
+    flockfile(stderr);
+    int ok = start_runtime_locked(resources);
+    funlockfile(stderr);
+#endif
+    return ok;
 }
 
 /* ---- instances ------------------------------------------------------------------------------
@@ -433,7 +490,59 @@ typedef struct {
     int *sh_flags;
     size_t sh_n;
     PyObject *m_publish;  /* the slave's publish: writes every shared output, marks them fresh */
+    int state;            /* where the standard's state machine is (S_* below) */
+    int time_known;       /* next_time holds the communication point the next doStep must start at */
+    double next_time;     /* the start time, then the end of the last completed step */
 } Instance;
+
+/* ---- the standard's state machine ------------------------------------------------------------
+ * FMI 2.0 and 3.0 co-simulation allow each call only in some states (FMI 2.0 section 4.2.4, FMI
+ * 3.0 section 4.2.1); a call made in another state is refused with fmiError and a message naming
+ * the call and the state, and changes nothing. A lifecycle call that fails (fmiError) leaves the
+ * instance in the error state, where only gets, fmiReset, fmiSetFMUState and fmiFreeInstance are
+ * allowed; a set or get that the model refused (a bad value) leaves it where it was, since the
+ * model did not take it. Both standards' states map onto these: */
+enum {
+    S_INSTANTIATED = 1,   /* after instantiate and reset */
+    S_INITIALIZATION = 2, /* between enter and exit initialization mode */
+    S_STEPPING = 4,       /* FMI 2.0 stepComplete, FMI 3.0 Step Mode */
+    S_STEP_FAILED = 8,    /* a doStep returned fmiDiscard */
+    S_TERMINATED = 16,
+    S_ERROR = 32
+};
+#define S_ANY (S_INSTANTIATED | S_INITIALIZATION | S_STEPPING | S_STEP_FAILED | S_TERMINATED | S_ERROR)
+#define MASK_SETUP S_INSTANTIATED
+#define MASK_ENTER_INIT S_INSTANTIATED
+#define MASK_EXIT_INIT S_INITIALIZATION
+#define MASK_DO_STEP S_STEPPING
+#define MASK_TERMINATE (S_STEPPING | S_STEP_FAILED)
+#define MASK_GET (S_INITIALIZATION | S_STEPPING | S_STEP_FAILED | S_TERMINATED | S_ERROR)
+#define MASK_SET (S_INSTANTIATED | S_INITIALIZATION | S_STEPPING)
+
+static const char *state_name(int state) {
+    switch (state) {
+    case S_INSTANTIATED: return "instantiated";
+    case S_INITIALIZATION: return "initialization mode";
+    case S_STEPPING: return "step mode (initialized)";
+    case S_STEP_FAILED: return "step failed (a doStep returned Discard)";
+    case S_TERMINATED: return "terminated";
+    default: return "error (a call failed; only gets, reset, set state and free are allowed)";
+    }
+}
+
+static void log_refusal(Instance *inst, const char *text) {
+    host_log(&inst->cb, inst->name, 3 /* Error */, "logStatusError", text);
+}
+
+/* OK when `what` may be called in the instance's state (`mask`), else Error with the message. */
+static int allowed(Instance *inst, int mask, const char *what) {
+    if (inst->state & mask) return 1;
+    char text[512];
+    snprintf(text, sizeof text, "%s is not allowed in state %s (the FMI standard's call order)", what,
+             state_name(inst->state));
+    log_refusal(inst, text);
+    return 0;
+}
 
 /* Roles of shared variables and the flags (NeighborSlave's SHARED_* and FRESH_* numbers) */
 enum { SH_INPUT = 1, SH_STATE_OUTPUT = 2, SH_FEEDTHROUGH_OUTPUT = 3 };
@@ -699,7 +808,10 @@ static void release_instance(Instance *inst) {
    with the reason in the host's log. `call` names the standard's call in messages. */
 static Instance *new_instance(const char *call_name, const char *name, const char *token, const char *resources,
                               int visible, int logging_on, HostCallbacks cb) {
-    if (!start_runtime(resources)) {
+    runtime_lock();
+    int started = start_runtime(resources);
+    runtime_unlock();
+    if (!started) {
         host_log(&cb, name, ST_ERROR, "logStatusError", runtime_error);
         return NULL;
     }
@@ -708,7 +820,13 @@ static Instance *new_instance(const char *call_name, const char *name, const cha
     inst->cb = cb;
     inst->name = copy_string(name);
     inst->logging_on = logging_on ? 1 : 0;
+    inst->state = S_INSTANTIATED;
+    inst->time_known = 1;  /* the start time is 0 until a setup or an initialization says otherwise */
     int gil = py.GILStateEnsure();
+    /* the library's lock, waited for without the GIL (a thread holding the lock may need it) */
+    void *thread_state = py.EvalSaveThread();
+    runtime_lock();
+    py.EvalRestoreThread(thread_state);
     Status status = ST_OK;
     if (!loader) {
         char path[4200];
@@ -727,7 +845,11 @@ static Instance *new_instance(const char *call_name, const char *name, const cha
             fclose(f);
         }
         if (!code) {
-            host_log(&cb, name, ST_ERROR, "logStatusError", "the FMU's resources lack neighbor_runtime.py");
+            char text[4400];
+            snprintf(text, sizeof text, "the FMU's resources lack neighbor_runtime.py (no %s: is the resource "
+                     "location right?)", path);
+            host_log(&cb, name, ST_ERROR, "logStatusError", text);
+            runtime_unlock();
             py.GILStateRelease(gil);
             free(inst->name);
             free(inst);
@@ -759,6 +881,7 @@ static Instance *new_instance(const char *call_name, const char *name, const cha
             loader = ns;
         }
     }
+    runtime_unlock();  /* the loader is there (or failed): the model's import work locks in Python */
     if (loader) {
         PyObject *fn = py.DictGetItemString(loader, "instantiate");
         PyObject *args = tuple_of(6, py.UnicodeFromString(resources), py.UnicodeFromString(name),
@@ -817,6 +940,32 @@ static PyObject *setup_args(void *data) {
                     s->tol_defined ? py.FloatFromDouble(s->tol) : none_ref());
 }
 
+/* The state a lifecycle call that returned `status` leaves the instance in: `next` when it
+   succeeded, the error state when it failed (Fatal marks the instance broken in fail()). */
+static Status enter_state(Instance *inst, Status status, int next) {
+    if (status <= ST_WARNING) inst->state = next;
+    else if (status == ST_ERROR) inst->state = S_ERROR;
+    return status;
+}
+
+/* A lifecycle call (`what`, the slave's method `name`) allowed in `mask`, leading to `next`. */
+static Status lifecycle(void *c, const char *what, const char *name, PyObject *(*make_args)(void *), void *data,
+                        int mask, int next) {
+    Instance *inst = (Instance *)c;
+    if (!inst) return ST_ERROR;
+    if (inst->broken) return ST_FATAL;
+    if (!allowed(inst, mask, what)) return ST_ERROR;
+    return enter_state(inst, call_method(c, what, name, make_args, data), next);
+}
+
+/* The start time a setup or an initialization announced: where the first doStep must start. */
+static void start_time(void *c, double t) {
+    Instance *inst = (Instance *)c;
+    if (!inst || inst->state == S_ERROR) return;
+    inst->next_time = t;
+    inst->time_known = 1;
+}
+
 static Status reset_instance(void *c, const char *what) {
     ENTER(c, what)
     PyObject *fn = py.DictGetItemString(loader, "reset");
@@ -825,7 +974,9 @@ static Status reset_instance(void *c, const char *what) {
     if (res) py.DecRef(res);  /* a fresh model in the same slave object: the bound methods stay valid */
     if (res && !link_shared(inst)) status = fail(inst, what);  /* but its shared arrays are new */
     LEAVE();
-    return status;
+    inst->next_time = 0.0;  /* as after instantiation */
+    inst->time_known = 1;
+    return enter_state(inst, status, S_INSTANTIATED);
 }
 
 /* ---- values ----------------------------------------------------------------------------------
@@ -918,12 +1069,27 @@ static void set_shared(Instance *inst, int kind, const unsigned int vr[], size_t
 /* `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
  * which expands arrays; `expected` is then the host's nValues), or from the shared values;
  * Booleans are written as `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
+/* A get or set with value references or values missing where the host said there are some. */
+static int arrays_given(Instance *inst, const unsigned int vr[], size_t nvr, const void *values, size_t n_values,
+                        const char *what) {
+    if ((nvr && !vr) || (n_values && !values)) {
+        char text[256];
+        snprintf(text, sizeof text, "%s: %s is NULL for %lu entries", what, nvr && !vr ? "the value reference array"
+                 : "the value array", (unsigned long)(nvr && !vr ? nvr : n_values));
+        log_refusal(inst, text);
+        return 0;
+    }
+    return 1;
+}
+
 static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr, void *out, size_t expected,
                          int via_loader, size_t bool_size, const char *what) {
     Instance *shared = (Instance *)c;
+    if (!shared) return ST_ERROR;
+    if (shared->broken) return ST_FATAL;
+    if (!allowed(shared, MASK_GET, what) || !arrays_given(shared, vr, nvr, out, expected, what)) return ST_ERROR;
     int needs = 0;
-    if (shared && !shared->broken && (!via_loader || shared->sh_spans) &&
-        all_shared(shared, kind, vr, nvr, expected, 0, &needs))
+    if ((!via_loader || shared->sh_spans) && all_shared(shared, kind, vr, nvr, expected, 0, &needs))
         return get_shared(shared, kind, vr, nvr, out, bool_size, needs, what);
     ENTER(c, what)
     PyObject *res;
@@ -974,8 +1140,10 @@ static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr,
 static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr, const void *in, size_t n_in,
                          int via_loader, size_t bool_size, const char *what) {
     Instance *shared = (Instance *)c;
-    if (shared && !shared->broken && (!via_loader || shared->sh_spans) &&
-        all_shared(shared, kind, vr, nvr, n_in, 1, NULL)) {
+    if (!shared) return ST_ERROR;
+    if (shared->broken) return ST_FATAL;
+    if (!allowed(shared, MASK_SET, what) || !arrays_given(shared, vr, nvr, in, n_in, what)) return ST_ERROR;
+    if ((!via_loader || shared->sh_spans) && all_shared(shared, kind, vr, nvr, n_in, 1, NULL)) {
         set_shared(shared, kind, vr, nvr, in, bool_size);
         return ST_OK;
     }
@@ -1011,16 +1179,42 @@ static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr,
     return status;
 }
 
-/* ---- state ---------------------------------------------------------------------------------- */
+/* ---- state ----------------------------------------------------------------------------------
+ * An FMU state is the model's (a Python object) with where the state machine and the clock were:
+ * setting it puts the instance back there (FMI 2.0 allows it after an error). */
+typedef struct {
+    PyObject *model;
+    int state, time_known;
+    double next_time;
+} SavedState;
+
 static Status get_state(void *c, void **state, const char *what) {
     ENTER(c, what)
+    if (!state) {
+        char text[128];
+        snprintf(text, sizeof text, "%s: no place for the state given (NULL)", what);
+        log_refusal(inst, text);
+        LEAVE();
+        return ST_ERROR;
+    }
     PyObject *fn = method(inst, "_get_fmu_state");
     PyObject *res = fn ? call(inst, fn, NULL, what, &status) : NULL;
     if (!fn) status = fail(inst, what);
     if (fn) py.DecRef(fn);
     if (res) {
-        if (state && *state) py.DecRef((PyObject *)*state);  /* FMI: a given state is overwritten */
-        if (state) *state = res; else py.DecRef(res);
+        SavedState *saved = (SavedState *)*state;  /* FMI: a given state is overwritten */
+        if (!saved) saved = (SavedState *)calloc(1, sizeof(SavedState));
+        if (!saved) {
+            py.DecRef(res);
+            status = ST_ERROR;
+        } else {
+            if (saved->model) py.DecRef(saved->model);
+            saved->model = res;
+            saved->state = inst->state;
+            saved->time_known = inst->time_known;
+            saved->next_time = inst->next_time;
+            *state = saved;
+        }
     }
     LEAVE();
     return status;
@@ -1028,7 +1222,8 @@ static Status get_state(void *c, void **state, const char *what) {
 
 static Status set_state(void *c, void *state, const char *what) {
     ENTER(c, what)
-    if (!state) {
+    SavedState *saved = (SavedState *)state;
+    if (!saved || !saved->model) {
         char text[128];
         snprintf(text, sizeof text, "%s: no state given", what);
         host_log(&inst->cb, inst->name, ST_ERROR, "logStatusError", text);
@@ -1039,19 +1234,26 @@ static Status set_state(void *c, void *state, const char *what) {
     if (!fn) {
         status = fail(inst, what);
     } else {
-        py.IncRef((PyObject *)state);
-        PyObject *res = call(inst, fn, tuple_of(1, (PyObject *)state), what, &status);
+        py.IncRef(saved->model);
+        PyObject *res = call(inst, fn, tuple_of(1, saved->model), what, &status);
         if (res) py.DecRef(res);
         py.DecRef(fn);
     }
     LEAVE();
+    if (status <= ST_WARNING) {
+        inst->state = saved->state;
+        inst->time_known = saved->time_known;
+        inst->next_time = saved->next_time;
+    }
     return status;
 }
 
 static Status free_state(void *c, void **state) {
     ENTER(c, "free state")
     if (state && *state) {
-        py.DecRef((PyObject *)*state);
+        SavedState *saved = (SavedState *)*state;
+        if (saved->model) py.DecRef(saved->model);
+        free(saved);
         *state = NULL;
     }
     LEAVE();
@@ -1068,8 +1270,58 @@ static Status unsupported(void *c, const char *what) {
     return ST_ERROR;
 }
 
-/* doStep: OK, Discard when the model could not complete the step (do_step returned False). */
+/* doStep: OK, Discard when the model could not complete the step (do_step returned False);
+   refused out of the state machine's order, with a non-positive step or a communication point
+   that is not where the last step ended. */
+static Status step_model(void *c, double t, double h, const char *what);
 static Status do_step(void *c, double t, double h, const char *what) {
+    Instance *checked = (Instance *)c;
+    if (!checked) return ST_ERROR;
+    if (checked->broken) return ST_FATAL;
+    if (!allowed(checked, MASK_DO_STEP, what)) return ST_ERROR;
+    char text[512];
+    if (!(h > 0.0) || h > 1e300 || t != t || t > 1e300 || t < -1e300) {  /* NaN fails every comparison */
+        snprintf(text, sizeof text, "%s: the communication step size must be positive and finite and the "
+                 "communication point finite (got currentCommunicationPoint %.17g, communicationStepSize %.17g)",
+                 what, t, h);
+        log_refusal(checked, text);
+        return ST_ERROR;
+    }
+    if (checked->time_known) {
+        double expected = checked->next_time, scale = expected < 0 ? -expected : expected;
+        double gap = t - expected;
+        if ((gap < 0 ? -gap : gap) > 1e-10 * (scale > 1.0 ? scale : 1.0)) {
+            snprintf(text, sizeof text, "%s: currentCommunicationPoint %.17g is not where the last step ended "
+                     "(%.17g): communication points must be contiguous", what, t, expected);
+            log_refusal(checked, text);
+            return ST_ERROR;
+        }
+    }
+    Status stepped = step_model(c, t, h, what);
+    if (stepped <= ST_WARNING) {
+        checked->next_time = t + h;
+        checked->time_known = 1;
+    } else if (stepped == ST_DISCARD) {
+        checked->state = S_STEP_FAILED;
+    } else if (stepped == ST_ERROR) {
+        checked->state = S_ERROR;
+    }
+    return stepped;
+}
+
+/* system_ssp's master, for a component it suspended (nc:Schedule): the component's clock jumps to
+   `t`, where its next doStep starts (a non-standard call; other hosts never jump). */
+static Status skip_to(void *c, double t) {
+    Instance *inst = (Instance *)c;
+    if (!inst) return ST_ERROR;
+    if (inst->broken) return ST_FATAL;
+    if (!allowed(inst, MASK_DO_STEP, "neighborSkipTo")) return ST_ERROR;
+    inst->next_time = t;
+    inst->time_known = 1;
+    return ST_OK;
+}
+
+static Status step_model(void *c, double t, double h, const char *what) {
     ENTER(c, what)  /* a sharing model's step publishes its outputs (or leaves them stale) itself */
     PyObject *res = call(inst, inst->m_do_step, tuple_of(2, py.FloatFromDouble(t), py.FloatFromDouble(h)), what,
                          &status);

@@ -137,16 +137,21 @@ void fmi2FreeInstance(fmi2Component c) { free_instance((Instance *)c); }
 fmi2Status fmi2SetupExperiment(fmi2Component c, fmi2Boolean toleranceDefined, fmi2Real tolerance,
                                fmi2Real startTime, fmi2Boolean stopTimeDefined, fmi2Real stopTime) {
     Setup s = {toleranceDefined, stopTimeDefined, tolerance, startTime, stopTime};
-    return (fmi2Status)call_method(c, "fmi2SetupExperiment", "setup_experiment", setup_args, &s);
+    Status status = lifecycle(c, "fmi2SetupExperiment", "setup_experiment", setup_args, &s, MASK_SETUP,
+                              S_INSTANTIATED);
+    if (status <= ST_WARNING) start_time(c, startTime);
+    return (fmi2Status)status;
 }
 fmi2Status fmi2EnterInitializationMode(fmi2Component c) {
-    return (fmi2Status)call_method(c, "fmi2EnterInitializationMode", "enter_initialization_mode", NULL, NULL);
+    return (fmi2Status)lifecycle(c, "fmi2EnterInitializationMode", "enter_initialization_mode", NULL, NULL,
+                                 MASK_ENTER_INIT, S_INITIALIZATION);
 }
 fmi2Status fmi2ExitInitializationMode(fmi2Component c) {
-    return (fmi2Status)call_method(c, "fmi2ExitInitializationMode", "exit_initialization_mode", NULL, NULL);
+    return (fmi2Status)lifecycle(c, "fmi2ExitInitializationMode", "exit_initialization_mode", NULL, NULL,
+                                 MASK_EXIT_INIT, S_STEPPING);
 }
 fmi2Status fmi2Terminate(fmi2Component c) {
-    return (fmi2Status)call_method(c, "fmi2Terminate", "terminate", NULL, NULL);
+    return (fmi2Status)lifecycle(c, "fmi2Terminate", "terminate", NULL, NULL, MASK_TERMINATE, S_TERMINATED);
 }
 fmi2Status fmi2Reset(fmi2Component c) { return (fmi2Status)reset_instance(c, "fmi2Reset"); }
 
@@ -218,6 +223,9 @@ fmi2Status fmi2GetRealOutputDerivatives(fmi2Component c, const fmi2ValueReferenc
     (void)vr; (void)nvr; (void)order; (void)value;
     return (fmi2Status)unsupported(c, "fmi2GetRealOutputDerivatives");
 }
+
+/* system_ssp's master: a suspended component's clock jumps to t (skip_to in neighbor_core.c) */
+FMI2_Export fmi2Status neighborSkipTo(fmi2Component c, fmi2Real t) { return (fmi2Status)skip_to(c, t); }
 
 /* system_ssp's master: set, doStep and get of one component in one call (step_io above) */
 FMI2_Export fmi2Status neighborStepIO(fmi2Component c, void *io) {

@@ -40,6 +40,8 @@ static const char *SET_CALLS[] = {"fmi3SetFloat64", "fmi3SetInt32", "fmi3SetBool
 static Status no_variables_of_type(void *c, const char *what, size_t nvr) {
     Instance *inst = (Instance *)c;
     if (!inst) return ST_ERROR;
+    if (inst->broken) return ST_FATAL;
+    if (!allowed(inst, strncmp(what, "fmi3Get", 7) == 0 ? MASK_GET : MASK_SET, what)) return ST_ERROR;
     if (nvr == 0) return ST_OK;
     char text[256];
     snprintf(text, sizeof text, "%s: this FMU has no variable of that type (it declares Float64, Int32, Boolean and "
@@ -113,17 +115,27 @@ void fmi3FreeInstance(fmi3Instance instance) { free_instance((Instance *)instanc
 
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
+    Instance *inst = (Instance *)instance;
+    if (!inst) return fmi3Error;
+    if (inst->broken) return fmi3Fatal;
+    if (!allowed(inst, MASK_ENTER_INIT, "fmi3EnterInitializationMode")) return fmi3Error;
     Setup s = {toleranceDefined, stopTimeDefined, tolerance, startTime, stopTime};
     Status status = call_method(instance, "fmi3EnterInitializationMode", "setup_experiment", setup_args, &s);
-    if (status > ST_WARNING) return (fmi3Status)status;
-    Status entered = call_method(instance, "fmi3EnterInitializationMode", "enter_initialization_mode", NULL, NULL);
-    return (fmi3Status)(entered > status ? entered : status);
+    if (status <= ST_WARNING) {
+        Status entered = call_method(instance, "fmi3EnterInitializationMode", "enter_initialization_mode", NULL,
+                                     NULL);
+        if (entered > status) status = entered;
+    }
+    enter_state(inst, status, S_INITIALIZATION);
+    if (status <= ST_WARNING) start_time(instance, startTime);
+    return (fmi3Status)status;
 }
 fmi3Status fmi3ExitInitializationMode(fmi3Instance instance) {
-    return (fmi3Status)call_method(instance, "fmi3ExitInitializationMode", "exit_initialization_mode", NULL, NULL);
+    return (fmi3Status)lifecycle(instance, "fmi3ExitInitializationMode", "exit_initialization_mode", NULL, NULL,
+                                 MASK_EXIT_INIT, S_STEPPING);
 }
 fmi3Status fmi3Terminate(fmi3Instance instance) {
-    return (fmi3Status)call_method(instance, "fmi3Terminate", "terminate", NULL, NULL);
+    return (fmi3Status)lifecycle(instance, "fmi3Terminate", "terminate", NULL, NULL, MASK_TERMINATE, S_TERMINATED);
 }
 fmi3Status fmi3Reset(fmi3Instance instance) { return (fmi3Status)reset_instance(instance, "fmi3Reset"); }
 
@@ -397,4 +409,9 @@ fmi3Status fmi3GetOutputDerivatives(fmi3Instance instance, const fmi3ValueRefere
 fmi3Status fmi3ActivateModelPartition(fmi3Instance instance, fmi3ValueReference clockReference, fmi3Float64 activationTime) {
     (void)clockReference; (void)activationTime;
     return (fmi3Status)unsupported(instance, "fmi3ActivateModelPartition");
+}
+
+/* system_ssp's master: a suspended component's clock jumps to t (skip_to in neighbor_core.c) */
+FMI3_Export fmi3Status neighborSkipTo(fmi3Instance instance, fmi3Float64 t) {
+    return (fmi3Status)skip_to(instance, t);
 }

@@ -15,9 +15,15 @@ import importlib.util
 import os
 import site
 import sys
+import threading
 import traceback
 
 NONE = None
+# One lock for the import work of every FMU build of ours in this process (each build has its
+# own loader module, so the lock lives where they all see it): instantiation and reset import
+# modules and rewrite package paths, and hosts instantiate from several threads at once. Only
+# this work is serialized; steps and gets of different instances run as the GIL lets them.
+_LOCK = sys.__dict__.setdefault("_neighbor_cosim_import_lock", threading.RLock())
 # Errors after which no instance of the interpreter can be trusted: fmi2Fatal. Everything else
 # (a bad parameter or input, a model error) is fmi2Error for the instance that raised it.
 FATAL = (MemoryError, SystemError, RecursionError)
@@ -64,7 +70,10 @@ def _package(resources, name):
             del sys.modules[name]
             raise
         return package
-    for module_name, module in list(sys.modules.items()):
+    # a snapshot taken in one C call: iterating sys.modules itself (or building a list of its
+    # items, which can start a garbage collection that lets another thread import) fails when
+    # another thread imports meanwhile
+    for module_name, module in sys.modules.copy().items():
         if module_name == name or module_name.startswith(name + "."):
             path = getattr(module, "__path__", None)
             if path is not None:
@@ -75,12 +84,20 @@ def _package(resources, name):
 
 def instantiate(resources, instance_name, guid, visible, embedded, logging_on):
     """The model's slave object for one FMU instance."""
+    with _LOCK:
+        return _instantiate(resources, instance_name, guid, visible, embedded, logging_on)
+
+
+def _instantiate(resources, instance_name, guid, visible, embedded, logging_on):
+    if not os.path.isdir(resources):
+        raise ValueError(f"the resource location {resources!r} is not a folder: the host gave a wrong "
+                         "fmuResourceLocation (FMI 2.0) or resourcePath (FMI 3.0)")
     cfg = _config(resources)
     built_guid = cfg.get("guid", [""])[0]
     if guid != built_guid:
         raise ValueError(f"fmuGUID {guid!r} is not this FMU's GUID {built_guid!r}: the model description "
                          "and the binary come from different builds")
-    if embedded:
+    if embedded or getattr(sys, "_neighbor_cosim_started_python", False):  # a Python one of our FMUs started
         _make_packages_importable(cfg)
     version = sys.version.split()[0]
     try:
@@ -192,7 +209,8 @@ def shared_memory(slave):
 def reset(slave):
     """fmi2Reset/fmi3Reset: the slave as instantiation left it (the binary keeps its log queue)."""
     queue = slave.log_queue
-    slave.__init__(**slave._neighbor_init)
+    with _LOCK:
+        slave.__init__(**slave._neighbor_init)
     if hasattr(slave, "_neighbor_time"):
         slave._neighbor_time = None
     queue.extend(slave.log_queue)
