@@ -237,8 +237,9 @@ class ScheduledAlgorithm:
       fixed-step multiples); until the master reaches t_c it is not stepped again;
     - not active in the mode: suspended, not stepped, outputs held, inputs not set. When it
       becomes active again its clock jumps to the current time: its next doStep starts there,
-      and the suspended span is skipped, not integrated (FMI 2.0 does not require contiguous
-      communication points; every component must declare canHandleVariableCommunicationStepSize).
+      and the suspended span is skipped, not integrated (our runtime's FMUs, which refuse a doStep
+      that does not start where the last one ended, are told so: InstanceTable.resume; every
+      component must declare canHandleVariableCommunicationStepSize).
     After the steps, direct-feedthrough components whose outputs the schedule or a stop condition
     watches, or that feed a component stepping before them, get their inputs again and their
     outputs are read (so conditions, stop signals and the next steps see values at t + h); the
@@ -380,6 +381,7 @@ class ScheduledAlgorithm:
         for ci in mode.order:
             if suspended[ci]:
                 tc[ci] = t  # back from suspension: the clock jumps to now
+                table.resume(ci, t)
                 suspended[ci] = False
         T = loop.T
         T.ev_buf[:] = self.ev_values
@@ -422,6 +424,7 @@ class ScheduledAlgorithm:
         for ci in order:
             if suspended[ci]:
                 tc[ci] = t  # back from suspension: the clock jumps to now
+                table.resume(ci, t)
                 suspended[ci] = False
             t_c = tc[ci]
             if t_c > t + tol:

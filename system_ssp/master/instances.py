@@ -307,6 +307,17 @@ def _step_io_function(inst):
     return fn
 
 
+def _skip_function(inst):
+    """The runtime's `neighborSkipTo(component, t)` of an instance's library (FMI 2.0 or 3.0), or
+    None (another tool's FMU, which takes a jump of its communication point as it is)."""
+    dll = getattr(inst.fmu.slave if inst.fmi3 else inst.fmu, "dll", None)
+    fn = getattr(dll, "neighborSkipTo", None)
+    if fn is not None:
+        fn.argtypes = [ctypes.c_void_p, ctypes.c_double]
+        fn.restype = ctypes.c_int
+    return fn
+
+
 def _slot_blocks(slots):
     """([(component, [variables], first position)], total): each component's connected outputs of
     one type as one block of the type's shared buffer, in component order; fills `slots`
@@ -575,6 +586,17 @@ class InstanceTable:
         self.steppers = [self._stepper(ci) for ci in range(n)]
         # components whose connected outputs change when their inputs are set
         self.has_ft = [bool(sysm.graph.feedthrough_outputs[ci]) and bool(self.gets[ci]) for ci in range(n)]
+
+    def resume(self, ci, t):
+        """Component ci, suspended by a schedule, goes on at `t`: our runtime's FMUs, which refuse a
+        doStep that does not start where the last one ended (the FMI standard's order), are told
+        that their clock jumps there."""
+        inst = self.instances[ci]
+        fn = _skip_function(inst)
+        if fn is not None:
+            s = fn(inst.fmu.component, t)
+            if s > 1:
+                raise StepFailed(ci, "neighborSkipTo", s)
 
     def _do_step(self, ci):
         """do_step(t, dt) of component ci: fmi2DoStep only."""
