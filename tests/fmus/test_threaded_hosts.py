@@ -10,7 +10,6 @@ single-threaded run of the same jobs bit for bit.
 from concurrent.futures import ThreadPoolExecutor
 import math
 import os
-from pathlib import Path
 import subprocess
 import sys
 import zipfile
