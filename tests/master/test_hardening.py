@@ -155,9 +155,10 @@ def test_limit_variable_that_is_not_a_number_is_refused(ssp_paths, capsys, monke
     assert "NEIGHBOR_COSIM_MAX_ARCHIVE_BYTES='lots': expected a positive whole number" in line
 
 
-def test_readme_lists_the_limits_and_how_to_raise_them():
-    readme = (REPO / "README.md").read_text()
-    assert markdown_table() in readme, "README's Errors section: paste system_ssp.limits.markdown_table()"
+def test_docs_list_the_limits_and_how_to_raise_them():
+    reference = (REPO / "docs" / "commands.md").read_text()
+    assert markdown_table() in reference, "docs/commands.md, Errors: paste system_ssp.limits.markdown_table()"
+    assert "docs/commands.md" in (REPO / "README.md").read_text()  # and the README links to it
 
 
 # ---- archives: damaged, hostile, oversized ---------------------------------------------------
