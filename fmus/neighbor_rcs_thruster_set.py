@@ -29,9 +29,12 @@ takeover). `impulse_B` is the running total of the force that the propulsion's n
 not carry (the RCS net force, the axial thrusters' force error and misalignment in the burn): the
 orbit takes its mean over each of its steps.
 """
+import math
+
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import mass_properties, rigid_body, thruster_monitor, thruster_set
+from components.core import checks
 from components.mission.neighbor import SPACECRAFT
 
 # declared after the outputs that depend on them (appended in later releases)
@@ -127,6 +130,12 @@ class RcsThrusterSet(NeighborSlave):
 
     def build_model(self):
         v = self.values
+        # the detection's and the mass properties' values, refused even while those options are off
+        # (a negative mass was taken silently and failed only once the option was switched on)
+        for name, unit in (("mass", "kg"), ("edge_b", "m"), ("gyro_sample_time", "s"), ("detection_window", "s")):
+            checks.positive(name, v[name], unit)
+        if not (math.isfinite(v["gyro_sigma"]) and v["gyro_sigma"] >= 0.0):
+            raise ValueError(f"gyro_sigma = {v['gyro_sigma']!r} rad/s must be a finite number >= 0")
         model = thruster_set.ThrusterSet(
             v["thrust"], v["edge_a"], v["edge_c"], v["Isp"], v["g0"], v["min_on_time"], self.vector("force_error", N),
             list(zip(self.vector("misalignment_1", N), self.vector("misalignment_2", N))), v["off_pulsing"],

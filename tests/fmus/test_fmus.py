@@ -297,3 +297,23 @@ def test_every_real_parameter_of_every_fmu_refuses_nan_and_inf(fmu_paths, tmp_pa
             fmu.terminate()
             fmu.freeInstance()
     assert tried > 300, tried
+
+
+@pytest.mark.parametrize("name, bad", [("mass", -12.0), ("edge_b", -0.1), ("gyro_sigma", -5.5e-4),
+                                       ("gyro_sample_time", -0.1), ("gyro_sample_time", 0.0)])
+def test_rcs_thruster_set_refuses_values_no_detection_can_use(fmu_paths, tmp_path, capsys, name, bad):
+    """Issue 54: a negative mass, box edge, gyro noise or sample time was taken silently while the
+    fault detection was off (and failed only once it was on). Refused at initialization, naming
+    the parameter, whatever the options."""
+    from fmpy.fmi1 import FMICallException
+
+    fmu, refs = instantiate(fmu_paths["RcsThrusterSet"], tmp_path, "thrusters")
+    vr = refs[name]
+    try:
+        fmu.enterInitializationMode()
+        fmu.setReal([vr], [bad])
+        with pytest.raises(FMICallException):
+            fmu.exitInitializationMode()
+        assert f"{name} = {bad!r}" in capsys.readouterr().out
+    finally:
+        fmu.freeInstance()
