@@ -3,7 +3,7 @@ reader uses, so that a damaged, hostile or oversized archive is refused in one l
 and the member, before anything is written outside the target folder.
 
 Refused: a file that is not a zip archive; members whose names are absolute, climb out (`..`),
-carry a drive or a backslash (`C:x`, `resources\\x`: Windows paths a Linux unzip would take
+carry a drive, a colon or a backslash (`C:x`, `resources/C:x`, `resources\\x`: Windows paths a Linux unzip would take
 literally), are symbolic links or repeat another; members that fail their CRC-32 or use a
 compression zipfile cannot read; more members, more unpacked bytes or a higher compression
 ratio than system_ssp.limits allows (a zip bomb)."""
@@ -30,8 +30,10 @@ def _bad_name(name: str) -> str:
         return "an empty name or a NUL character"
     if "\\" in name:
         return "a backslash (a Windows path separator)"
-    if _DRIVE.match(name) or ":" in name.split("/", 1)[0]:
-        return "a drive or a colon in its first part"
+    if _DRIVE.match(name):
+        return "a drive"
+    if ":" in name:  # Windows: a drive (C:x) or, in a later part, a file's alternate data stream
+        return "a colon (a drive, or a Windows alternate data stream)"
     path = PurePosixPath(name)
     if path.is_absolute():
         return "an absolute path"

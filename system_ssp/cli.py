@@ -18,7 +18,7 @@ import traceback
 
 import fmpy
 
-from . import __version__
+from . import __version__, archive
 from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, convert, flatten, plot, release, replace
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
@@ -214,6 +214,7 @@ def _run_or_info(argv):
     with tempfile.TemporaryDirectory(prefix="neighbor_one_fmu_") as tmp:
         path = args.path
         if args.command == "run" and suffix == ".fmu":  # the FMU alone, as a system of one
+            archive.extract(args.path, Path(tmp) / "checked", args.path)  # refused naming the user's file
             path = str(single_fmu_system(path, tmp))
             md = fmpy.read_model_description(args.path)
             refusal = unsupported_fmu(md)

@@ -216,6 +216,18 @@ def test_ssp_member_names_of_other_systems_or_outside_the_archive_are_refused(ss
     assert f"archive member {name!r} has {says}" in line
 
 
+@pytest.mark.parametrize("name, says", [("C:x", "a drive"), ("resources/C:x", "a colon")])
+def test_fmu_run_alone_with_a_windows_member_name_is_refused_naming_the_fmu(fmu_paths, tmp_path, capsys, name,
+                                                                            says):
+    """Issue 54: an FMU with a member 'resources/C:x' (a drive-relative path or an alternate data
+    stream on Windows) ran; a refusal named the temporary system, not the user's file."""
+    fmu = _repack(fmu_paths["SunEphemeris"], tmp_path / "w.fmu",
+                  lambda n, d: [(n, d, zipfile.ZIP_DEFLATED)] + ([(name, b"x", zipfile.ZIP_STORED)]
+                                                                 if n == "modelDescription.xml" else []))
+    line = refused(capsys, "run", fmu, "--stop-time", "0.1", "--step-size", "0.1")
+    assert f"{fmu}: archive member {name!r} has {says}" in line
+
+
 def test_ssp_symlink_member_is_refused(ssp_paths, tmp_path, capsys):
     ssp = _repack(ssp_paths["detumble"], tmp_path / "l.ssp", lambda n, d: [(n, d, zipfile.ZIP_DEFLATED)])
     with zipfile.ZipFile(ssp, "a") as z:
