@@ -8,6 +8,7 @@ file and line, component or variable); 3 an unexpected error; 130 interrupted by
 143 by SIGTERM, 129 by SIGHUP. A run that fails or is interrupted writes what it had recorded to
 <output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
 """
+import errno
 import json
 import os
 from pathlib import Path
@@ -172,15 +173,37 @@ def main(argv=None):
     except BrokenPipeError:  # the reader went away (| head): not an error of ours
         sys.stdout = open(os.devnull, "w")
         return 0
-    except Exception as exc:  # unexpected: one line, the traceback only with --log-level debug
-        if debug:
-            traceback.print_exc()
-        print(f"error: unexpected {type(exc).__name__}: {one_line(exc)} (--log-level debug shows where)",
+    except OSError as exc:
+        if exc.errno != errno.ENAMETOOLONG:
+            return _unexpected(exc, debug)
+        # a name longer than the file system takes: bad input, wherever the first look at it was
+        name = str(exc.filename or "")
+        shown = name if len(name) <= 80 else f"{name[:60]}... ({len(name):,} characters)"
+        print(f"error: {shown}: the file name is longer than the file system takes (a part of at most "
+              f"{_path_limit('PC_NAME_MAX', 255)} bytes, a path of at most {_path_limit('PC_PATH_MAX', 4096)})",
               file=sys.stderr)
-        return 3
+        return 2
+    except Exception as exc:  # unexpected: one line, the traceback only with --log-level debug
+        return _unexpected(exc, debug)
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+
+
+def _path_limit(name, default):
+    try:
+        return os.pathconf("/", name)
+    except (AttributeError, OSError, ValueError):  # no pathconf (Windows)
+        return default
+
+
+def _unexpected(exc, debug):
+    """Exit 3 for an error no check foresaw: one line, the traceback only with --log-level debug."""
+    if debug:
+        traceback.print_exc()
+    print(f"error: unexpected {type(exc).__name__}: {one_line(exc)} (--log-level debug shows where)",
+          file=sys.stderr)
+    return 3
 
 
 def one_line(message: object) -> str:

@@ -522,3 +522,10 @@ def test_nan_start_value_of_an_fmu_parameter_is_refused_before_the_run(ssp_paths
     # the master refuses it (the FMU would too: tests/fmus/test_fmus.py sweeps every parameter)
     line = refused(capsys, "run", ssp_paths["detumble"], "--stop-time", "0.1", "--set", "dynamics.omega0[1]=nan")
     assert "dynamics.omega0[1]: nan is not a valid value: expected a finite Real number" in line
+
+
+@pytest.mark.parametrize("command", ["run", "info"])
+def test_a_file_name_longer_than_the_file_system_takes_is_bad_input(capsys, command):
+    """Issue 54: a 10 kB system name gave 'unexpected OSError: [Errno 36] File name too long' (exit 3)."""
+    line = refused(capsys, command, "a" * 10000 + ".ssp")
+    assert "(10,004 characters): the file name is longer than the file system takes" in line
