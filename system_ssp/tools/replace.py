@@ -165,6 +165,9 @@ def replace_component(source, component, new_fmu, out, drop_unmatched=False):
     out = check_output_place(out, "--out", (".ssp",))
     new = FmuInterface.read(new_fmu)
     with tempfile.TemporaryDirectory(prefix="neighbor_replace_") as tmp:
+        # every member of the new FMU checked (names, CRC, sizes) before the system is touched, so
+        # that a damaged FMU is named, not the temporary system it would be packed into
+        archive.extract(new_fmu, Path(tmp) / "new_fmu", str(new_fmu))
         root = Path(tmp) / "system"
         ssd = _unpack(source, root)
         report = _replace_in_folder(root, ssd, component, new, drop_unmatched, source)

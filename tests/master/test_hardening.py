@@ -205,6 +205,18 @@ def test_fmu_with_a_damaged_member_is_refused_naming_the_component(ssp_paths, tm
     assert "component 'dynamics'" in line and f"archive member '{member}' is damaged" in line
 
 
+def test_replace_with_a_damaged_fmu_names_the_fmu(fmu_paths, ssp_paths, tmp_path, capsys):
+    """Issue 54: the refusal named the temporary system the FMU was packed into, not the FMU."""
+    fmu = _repack(fmu_paths["RigidBody"], tmp_path / "new.fmu", lambda n, d: [(n, d, zipfile.ZIP_STORED)])
+    with zipfile.ZipFile(fmu) as z:
+        member = next(n for n in z.namelist() if n.endswith(".py") and "resources/" in n)
+    _damage_crc(fmu, member)
+    out = tmp_path / "r.ssp"
+    line = refused(capsys, "replace", ssp_paths["detumble"], "dynamics", fmu, "--out", out)
+    assert f"{fmu}: archive member '{member}' is damaged" in line
+    assert not out.exists()
+
+
 @pytest.mark.parametrize("name, says", [("resources\\x", "a backslash"), ("C:x", "a drive"),
                                         ("/etc/x", "an absolute path"), ("a/../../x", "'..'")])
 def test_ssp_member_names_of_other_systems_or_outside_the_archive_are_refused(ssp_paths, tmp_path, capsys, name,
