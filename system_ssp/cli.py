@@ -217,6 +217,8 @@ def _say_partial(exc):
     if exc.partial_file is not None:
         rows = f"{len(r.data)} rows to t = {r.stop_time:g} s " if r is not None else ""
         print(f"partial results ({rows}recorded before it stopped): {exc.partial_file}", file=sys.stderr)
+    elif exc.partial_note:
+        print(f"partial results: {exc.partial_note}", file=sys.stderr)
 
 
 def _run_or_info(argv):

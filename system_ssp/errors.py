@@ -14,9 +14,11 @@ class _Stopped(SSPError):
     result:       a Result with the rows recorded so far (`result.partial` is True), or None when
                   the run stopped before its first row (instantiation, initialization).
     partial_file: where those rows were written (System.run with an output file), or None.
+    partial_note: why they could not be written there, or None.
     """
     result = None
     partial_file = None
+    partial_note = None
 
 
 class SimulationError(_Stopped):

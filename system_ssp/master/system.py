@@ -138,8 +138,11 @@ class System:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
                 if output_file is not None:
-                    err.partial_file = partial_path(output_file)
-                    write_result(err.result.data, err.partial_file, err.result.units)
+                    try:
+                        write_result(err.result.data, partial_path(output_file), err.result.units)
+                        err.partial_file = partial_path(output_file)
+                    except SSPError as write_error:  # the run's own failure stays the message
+                        err.partial_note = f"its rows could not be kept: {write_error}"
             raise
         result.wall_time = time.perf_counter() - wall0
         LOG.info("%s: %s after %d steps, %.3f s wall", self.desc.display, result.stop_reason, result.steps,

@@ -96,6 +96,30 @@ def test_failed_run_keeps_its_rows(fmus, tmp_path):
     assert json.loads((tmp_path / "res.partial.units.json").read_text()) == {"time": "s", "integ.x": None}
 
 
+def test_partial_results_place_is_checked_before_the_run(fmus, tmp_path):
+    """Issue 54: a folder where x.partial.csv goes was found only when the run failed, and its
+    refusal replaced the run's own failure (which component failed). Now refused before any step."""
+    ssd = loop_system(tmp_path, fmus)
+    (tmp_path / "res.partial.csv").mkdir()
+    with pytest.raises(SSPError, match=r"partial-results file .*res\.partial\.csv: is a folder"):
+        system_ssp.simulate(ssd, step_size=0.1, stop_time=1.0, outputs=["integ.x"], output_file=tmp_path / "res.csv")
+
+
+def test_a_partial_place_that_fails_late_keeps_the_runs_own_failure(fmus, tmp_path, monkeypatch):
+    """The partial place turned into a folder during the run (after the check): the error is still
+    the component's failure, and says the rows could not be kept."""
+    import system_ssp.master.system as system_module
+
+    ssd = loop_system(tmp_path, fmus)
+    monkeypatch.setattr(system_module, "check_output_file", lambda path: path)  # as if it changed after
+    (tmp_path / "res.partial.csv").mkdir()
+    with pytest.raises(SimulationError, match=r"component 'integ'.*fixture failure at t=0.5 s") as err:
+        system_ssp.simulate(ssd, step_size=0.1, stop_time=1.0, outputs=["integ.x"], output_file=tmp_path / "res.csv",
+                            parameters={"integ.fail_at": 0.5})
+    assert err.value.partial_file is None
+    assert "its rows could not be kept" in err.value.partial_note and "res.partial.csv" in err.value.partial_note
+
+
 # ---- Ctrl-C and SIGTERM (defect 2) ------------------------------------------------------------
 def _cli_env(tmpdir):
     return dict(os.environ, PYTHONPATH=str(REPO) + os.pathsep + os.environ.get("PYTHONPATH", ""), TMPDIR=str(tmpdir))
