@@ -314,8 +314,8 @@ def main(argv=None):
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
-    resolve_system(str(Path(args.ssp_dir) / "detumble.ssp"))  # built first if it is a missing default
     # the places the results go, checked before the two-minute run (they used to fail after it)
+    # and before a first build of the systems (minutes on a fresh install)
     if args.markdown:
         check_output_file(args.markdown, "--markdown", (".md", ".markdown"))
         if Path(args.markdown).is_file():
@@ -325,6 +325,7 @@ def main(argv=None):
                 raise SSPError(f"--markdown {args.markdown}: cannot read it as UTF-8 text ({exc})") from None
     if args.json:
         check_output_file(args.json, "--json", (".json",))
+    resolve_system(str(Path(args.ssp_dir) / "detumble.ssp"))  # built first if it is a missing default
     ours = compute(args.ssp_dir, progress)
     print(table(ours), end="")
     if args.markdown:
