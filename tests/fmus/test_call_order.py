@@ -111,6 +111,17 @@ def _fmi3_out_of_order(path, tmp_path):
     case("fmi3GetFloat64 of an unknown value reference", initialized, lambda: fmu.getFloat64([99999999]))
     if outputs:
         case("fmi3GetFloat64 before initialization", lambda: None, lambda: fmu.getFloat64(outputs))
+    for label, token, where in (("a wrong instantiation token", "{not-this-fmu}", folder),
+                                ("a wrong resource path", md.guid, folder / "missing")):
+        wrong = FMU3Slave(guid=token, unzipDirectory=str(folder), modelIdentifier=md.coSimulation.modelIdentifier,
+                          instanceName="wrong")
+        wrong.unzipDirectory = str(where)  # the library loaded; the resource path it is given is wrong
+        try:
+            wrong.instantiate()
+            answers[f"fmi3InstantiateCoSimulation with {label}"] = "accepted"
+            wrong.freeInstance()
+        except Exception:
+            answers[f"fmi3InstantiateCoSimulation with {label}"] = "status 3"
     fmu.reset()  # and the legal sequence after all that
     initialized()
     for k in range(3):
