@@ -9,6 +9,7 @@ location: fmiError (or NULL) with a message naming the call and the state, never
 - FMI 3.0: the out-of-order calls through FMPy on every FMU.
 The legal sequences of every shipped system run unchanged (the rest of the suite)."""
 from concurrent.futures import ThreadPoolExecutor
+import math
 import os
 import subprocess
 import zipfile
@@ -111,6 +112,11 @@ def _fmi3_out_of_order(path, tmp_path):
     case("fmi3GetFloat64 of an unknown value reference", initialized, lambda: fmu.getFloat64([99999999]))
     if outputs:
         case("fmi3GetFloat64 before initialization", lambda: None, lambda: fmu.getFloat64(outputs))
+    arrays = [v for v in md.modelVariables if v.causality == "output" and v.type == "Float64" and v.dimensions]
+    if arrays:  # fewer values than the array's elements: a too-short array for the host's buffer
+        size = math.prod(int(d.start) for d in arrays[0].dimensions)
+        case("fmi3GetFloat64 with nValues below the array's size", initialized,
+             lambda: fmu.getFloat64([arrays[0].valueReference], size - 1))
     for label, token, where in (("a wrong instantiation token", "{not-this-fmu}", folder),
                                 ("a wrong resource path", md.guid, folder / "missing")):
         wrong = FMU3Slave(guid=token, unzipDirectory=str(folder), modelIdentifier=md.coSimulation.modelIdentifier,
