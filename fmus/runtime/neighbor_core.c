@@ -41,7 +41,7 @@ static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
 
 /* One lock per loaded library around starting the runtime and loading the loader: hosts may
  * instantiate from several threads at once (libcosim's thread pool, a Python host's threads).
- * It is taken without the GIL held (see lock_with_gil), so it never waits on Python. The Python
+ * new_instance waits for it with the GIL released, so it never waits on Python. The Python
  * side serializes its own import work across every FMU build (neighbor_runtime.py: _LOCK). */
 #ifdef _WIN32
 static volatile LONG runtime_lock_word = 0;
@@ -491,8 +491,8 @@ typedef struct {
     size_t sh_n;
     PyObject *m_publish;  /* the slave's publish: writes every shared output, marks them fresh */
     int state;            /* where the standard's state machine is (S_* below) */
-    int time_known;       /* next_time holds the communication point the next doStep must start at */
-    double next_time;     /* the start time, then the end of the last completed step */
+    double next_time;     /* where the next doStep must start: the start time (0 until a setup or
+                             an initialization says otherwise), then the end of the last step */
 } Instance;
 
 /* ---- the standard's state machine ------------------------------------------------------------
@@ -510,7 +510,6 @@ enum {
     S_TERMINATED = 16,
     S_ERROR = 32
 };
-#define S_ANY (S_INSTANTIATED | S_INITIALIZATION | S_STEPPING | S_STEP_FAILED | S_TERMINATED | S_ERROR)
 #define MASK_SETUP S_INSTANTIATED
 #define MASK_ENTER_INIT S_INSTANTIATED
 #define MASK_EXIT_INIT S_INITIALIZATION
@@ -821,7 +820,6 @@ static Instance *new_instance(const char *call_name, const char *name, const cha
     inst->name = copy_string(name);
     inst->logging_on = logging_on ? 1 : 0;
     inst->state = S_INSTANTIATED;
-    inst->time_known = 1;  /* the start time is 0 until a setup or an initialization says otherwise */
     int gil = py.GILStateEnsure();
     /* the library's lock, waited for without the GIL (a thread holding the lock may need it) */
     void *thread_state = py.EvalSaveThread();
@@ -963,7 +961,6 @@ static void start_time(void *c, double t) {
     Instance *inst = (Instance *)c;
     if (!inst || inst->state == S_ERROR) return;
     inst->next_time = t;
-    inst->time_known = 1;
 }
 
 static Status reset_instance(void *c, const char *what) {
@@ -975,7 +972,6 @@ static Status reset_instance(void *c, const char *what) {
     if (res && !link_shared(inst)) status = fail(inst, what);  /* but its shared arrays are new */
     LEAVE();
     inst->next_time = 0.0;  /* as after instantiation */
-    inst->time_known = 1;
     return enter_state(inst, status, S_INSTANTIATED);
 }
 
@@ -1184,7 +1180,7 @@ static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr,
  * setting it puts the instance back there (FMI 2.0 allows it after an error). */
 typedef struct {
     PyObject *model;
-    int state, time_known;
+    int state;
     double next_time;
 } SavedState;
 
@@ -1211,7 +1207,6 @@ static Status get_state(void *c, void **state, const char *what) {
             if (saved->model) py.DecRef(saved->model);
             saved->model = res;
             saved->state = inst->state;
-            saved->time_known = inst->time_known;
             saved->next_time = inst->next_time;
             *state = saved;
         }
@@ -1242,7 +1237,6 @@ static Status set_state(void *c, void *state, const char *what) {
     LEAVE();
     if (status <= ST_WARNING) {
         inst->state = saved->state;
-        inst->time_known = saved->time_known;
         inst->next_time = saved->next_time;
     }
     return status;
@@ -1287,20 +1281,17 @@ static Status do_step(void *c, double t, double h, const char *what) {
         log_refusal(checked, text);
         return ST_ERROR;
     }
-    if (checked->time_known) {
-        double expected = checked->next_time, scale = expected < 0 ? -expected : expected;
-        double gap = t - expected;
-        if ((gap < 0 ? -gap : gap) > 1e-10 * (scale > 1.0 ? scale : 1.0)) {
-            snprintf(text, sizeof text, "%s: currentCommunicationPoint %.17g is not where the last step ended "
-                     "(%.17g): communication points must be contiguous", what, t, expected);
-            log_refusal(checked, text);
-            return ST_ERROR;
-        }
+    double expected = checked->next_time, scale = expected < 0 ? -expected : expected;
+    double gap = t - expected;
+    if ((gap < 0 ? -gap : gap) > 1e-10 * (scale > 1.0 ? scale : 1.0)) {  /* round-off of t + h sums */
+        snprintf(text, sizeof text, "%s: currentCommunicationPoint %.17g is not where the last step ended "
+                 "(%.17g): communication points must be contiguous", what, t, expected);
+        log_refusal(checked, text);
+        return ST_ERROR;
     }
     Status stepped = step_model(c, t, h, what);
     if (stepped <= ST_WARNING) {
         checked->next_time = t + h;
-        checked->time_known = 1;
     } else if (stepped == ST_DISCARD) {
         checked->state = S_STEP_FAILED;
     } else if (stepped == ST_ERROR) {
@@ -1317,7 +1308,6 @@ static Status skip_to(void *c, double t) {
     if (inst->broken) return ST_FATAL;
     if (!allowed(inst, MASK_DO_STEP, "neighborSkipTo")) return ST_ERROR;
     inst->next_time = t;
-    inst->time_known = 1;
     return ST_OK;
 }
 
