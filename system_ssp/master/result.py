@@ -101,13 +101,13 @@ def check_output_file(path: PathLike, what: str = "output file", formats: Sequen
     if Path(path).suffix == "" and formats == FORMATS:
         formats = ()  # no suffix: CSV
     checked = check_output_place(path, what, formats)
-    if formats == FORMATS and checked.suffix.lower() != ".parquet" and not is_stream(checked):
-        check_output_place(units_path(checked), f"{what}'s units file")
     if formats == FORMATS and not is_stream(checked):
-        # where a run that fails or is stopped keeps its rows: refused now, not after the failure
+        # the partial-results place too (where a run that fails or is stopped keeps its rows):
+        # refused now, not after the failure
         partial = check_output_place(partial_path(checked), f"{what}'s partial-results file (the rows of a run "
                                      "that stops early)", formats)
-        if partial.suffix.lower() != ".parquet":
+        if checked.suffix.lower() != ".parquet":
+            check_output_place(units_path(checked), f"{what}'s units file")
             check_output_place(units_path(partial), f"{what}'s partial-results units file")
     return checked
 

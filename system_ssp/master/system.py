@@ -138,9 +138,10 @@ class System:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
                 if output_file is not None:
+                    partial = partial_path(output_file)
                     try:
-                        write_result(err.result.data, partial_path(output_file), err.result.units)
-                        err.partial_file = partial_path(output_file)
+                        write_result(err.result.data, partial, err.result.units)
+                        err.partial_file = partial
                     except SSPError as write_error:  # the run's own failure stays the message
                         err.partial_note = f"its rows could not be kept: {write_error}"
             raise
