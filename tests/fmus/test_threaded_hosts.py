@@ -1,9 +1,10 @@
 """Every FMU in hosts that call from several threads at once (issue 54): libcosim steps FMUs on a
 thread pool and any host may instantiate from worker threads. Each FMU is listed twice (the same
-file instantiated twice at once); 8 threads instantiate, initialize, step, read every Real
+file instantiated twice at once); 8 threads instantiate, initialize, set, step, read every Real
 output, terminate and free them, in a fresh process each time; the values must equal a
 single-threaded run of the same jobs bit for bit.
 
+Each FMU's first scalar Real input (where it has one) is set before every step.
 - a C host with pthreads and no Python in it (tests/fmus/c_host/threaded_host.c), FMI 2.0;
 - FMPy in a Python process (ctypes releases the GIL around each call), FMI 2.0 and FMI 3.0.
 """
@@ -29,6 +30,16 @@ def _real_outputs(path):
     return md, [v.valueReference for v in md.modelVariables if v.causality == "output" and v.type == "Real"][:64]
 
 
+def _real_input(md, real="Real"):
+    """(value reference, value) of the FMU's first Real input with a start value, set to that value
+    before every step (any other value may not be one the model takes: a unit quaternion's
+    element, a direction cosine), or None."""
+    for v in md.modelVariables:
+        if v.causality == "input" and v.type == real and v.start is not None and not v.dimensions:
+            return v.valueReference, float(v.start)
+    return None
+
+
 @pytest.fixture(scope="module")
 def extracted(fmu_paths, tmp_path_factory):
     """{name: (folder, model identifier, guid, [Real output value references])}, FMI 2.0."""
@@ -39,7 +50,7 @@ def extracted(fmu_paths, tmp_path_factory):
         with zipfile.ZipFile(path) as z:
             z.extractall(folder)
         md, vrs = _real_outputs(path)
-        out[name] = (folder, md.coSimulation.modelIdentifier, md.guid, vrs)
+        out[name] = (folder, md.coSimulation.modelIdentifier, md.guid, vrs, _real_input(md))
     return out
 
 
@@ -54,8 +65,8 @@ def _parallel(commands):
 
 def test_c_host_threads_give_the_single_threaded_values(threaded_host, extracted, tmp_path):
     jobs = tmp_path / "jobs.txt"
-    lines = [f"{folder} {model} {guid} {','.join(map(str, vrs)) or '-'}"
-             for folder, model, guid, vrs in extracted.values()]
+    lines = [f"{folder} {model} {guid} {','.join(map(str, vrs)) or '-'}" + (f" {inp[0]} {inp[1]!r}" if inp else "")
+             for folder, model, guid, vrs, inp in extracted.values()]
     jobs.write_text("".join(line + "\n" + line + "\n" for line in lines))  # every FMU twice
     base = [str(threaded_host), str(jobs), "--steps", str(STEPS), "--step", str(STEP)]
     reference = _parallel([base + ["--threads", "1"]])[0]
@@ -78,13 +89,14 @@ from fmpy.fmi3 import FMU3Slave
 jobs, threads, steps, h = json.loads(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3]), float(sys.argv[4])
 
 def run(k):
-    folder, model, guid, vrs, version, size = jobs[k]
+    folder, model, guid, vrs, version, size, inp = jobs[k]
     if version == 3:
         fmu = FMU3Slave(guid=guid, unzipDirectory=folder, modelIdentifier=model, instanceName=f"job{k}")
         fmu.instantiate()
         fmu.enterInitializationMode(startTime=0.0)
         fmu.exitInitializationMode()
         get = lambda vrs: fmu.getFloat64(vrs, size)
+        put = fmu.setFloat64
     else:
         fmu = FMU2Slave(guid=guid, unzipDirectory=folder, modelIdentifier=model, instanceName=f"job{k}")
         fmu.instantiate()
@@ -92,8 +104,11 @@ def run(k):
         fmu.enterInitializationMode()
         fmu.exitInitializationMode()
         get = fmu.getReal
+        put = fmu.setReal
     values = []
     for i in range(steps):
+        if inp:
+            put([inp[0]], [inp[1]])
         fmu.doStep(i * h, h)
         values.append([float(x).hex() for x in get(vrs)] if vrs else [])
     fmu.terminate()
@@ -110,8 +125,8 @@ def fmpy_jobs(extracted, fmu3_paths, tmp_path_factory):
     """Every FMU twice as FMI 2.0 and twice as FMI 3.0 (its output variables as FMI 3.0 declares them)."""
     root = tmp_path_factory.mktemp("threaded3")
     jobs = []
-    for name, (folder, model, guid, vrs) in extracted.items():
-        jobs += [[str(folder), model, guid, vrs, 2, len(vrs)]] * 2
+    for name, (folder, model, guid, vrs, inp) in extracted.items():
+        jobs += [[str(folder), model, guid, vrs, 2, len(vrs), inp]] * 2
         path = fmu3_paths[name]
         folder3 = root / name
         with zipfile.ZipFile(path) as z:
@@ -120,7 +135,7 @@ def fmpy_jobs(extracted, fmu3_paths, tmp_path_factory):
         outputs3 = [v for v in md3.modelVariables if v.causality == "output" and v.type == "Float64"][:64]
         size = sum(math.prod(int(d.start) for d in v.dimensions) for v in outputs3)  # arrays' elements
         jobs += [[str(folder3), md3.coSimulation.modelIdentifier, md3.instantiationToken,
-                  [v.valueReference for v in outputs3], 3, size]] * 2
+                  [v.valueReference for v in outputs3], 3, size, _real_input(md3, "Float64")]] * 2
     return jobs
 
 

@@ -7,7 +7,8 @@
  * --threads 8.
  *
  *   threaded_host JOBFILE [--threads N (8)] [--steps N (3)] [--step H (0.015)]
- *   JOBFILE: one job a line, "DIR MODEL_ID GUID VR,VR,..." (VR list may be "-": no outputs)
+ *   JOBFILE: one job a line, "DIR MODEL_ID GUID VR,VR,... [IN_VR IN_VALUE]" (VR list may be "-":
+ *   no outputs; IN_VR: a Real input set to IN_VALUE before every step)
  * Output: "JOB <k> <name> <value> <value> ..." (%.17g, every output after every step), a
  * "FAIL <k> <call> <status>" line for a call that did not return fmi2OK, "LOG <k> <status>
  * <message>" for messages of status warning and worse. Exit 0 when every call returned fmi2OK. */
@@ -29,6 +30,9 @@ typedef struct {
     char dir[1024], model[256], guid[256];
     unsigned vr[MAX_OUT];
     int n_vr;
+    unsigned in_vr;
+    double in_value;
+    int has_input;
     char *text; /* what the job prints, written by its thread */
     size_t used;
     int failures;
@@ -76,7 +80,8 @@ static void run_job(int k) {
     void *lib = dlopen(path, RTLD_NOW | RTLD_LOCAL);
     if (!lib) { out(job, "FAIL %d dlopen %s\n", k, dlerror()); job->failures++; return; }
     LOAD(fmi2Instantiate) LOAD(fmi2SetupExperiment) LOAD(fmi2EnterInitializationMode)
-    LOAD(fmi2ExitInitializationMode) LOAD(fmi2DoStep) LOAD(fmi2GetReal) LOAD(fmi2Terminate) LOAD(fmi2FreeInstance)
+    LOAD(fmi2ExitInitializationMode) LOAD(fmi2DoStep) LOAD(fmi2GetReal) LOAD(fmi2SetReal) LOAD(fmi2Terminate)
+    LOAD(fmi2FreeInstance)
     fmi2CallbackFunctions cb = {logger, calloc, free, NULL, job};
     snprintf(uri, sizeof uri, "file://%s/resources", job->dir);
     snprintf(name, sizeof name, "job%d", k);
@@ -88,6 +93,7 @@ static void run_job(int k) {
     out(job, "JOB %d %s", k, job->model);
     double values[MAX_OUT];
     for (int i = 0; i < steps; i++) {
+        if (job->has_input) CHECK(fmi2SetReal(c, &job->in_vr, 1, &job->in_value));
         CHECK(fmi2DoStep(c, i * h, h, fmi2True));
         if (job->n_vr) {
             CHECK(fmi2GetReal(c, job->vr, (size_t)job->n_vr, values));
@@ -125,7 +131,10 @@ int main(int argc, char **argv) {
     char line[8192], vrs[4096];
     while (n_jobs < MAX_JOBS && fgets(line, sizeof line, f)) {
         Job *job = &jobs[n_jobs];
-        if (sscanf(line, "%1023s %255s %255s %4095s", job->dir, job->model, job->guid, vrs) != 4) continue;
+        int fields = sscanf(line, "%1023s %255s %255s %4095s %u %lf", job->dir, job->model, job->guid, vrs,
+                            &job->in_vr, &job->in_value);
+        if (fields != 4 && fields != 6) continue;
+        job->has_input = fields == 6;
         if (strcmp(vrs, "-") != 0)
             for (char *p = strtok(vrs, ","); p && job->n_vr < MAX_OUT; p = strtok(NULL, ","))
                 job->vr[job->n_vr++] = (unsigned)strtoul(p, NULL, 10);
