@@ -221,7 +221,9 @@ def compile_runtime(out_dir=None, fmi_version=2):
                     raise BuildError(f"the FMU runtime needs a C compiler: {cc} not found")
                 continue
             out_dir.mkdir(parents=True, exist_ok=True)
-            tmp = target.with_name(target.name + ".tmp")
+            # a name of this process's own: two processes (pytest-xdist's workers, two commands) may
+            # compile the same runtime at once, and each replaces the target whole
+            tmp = target.with_name(f"{target.name}.{os.getpid()}.tmp")
             cmd = [cc, "-std=c99", "-O2", "-Wall", "-Wextra", "-Werror", "-shared", f"-I{headers}", str(source),
                    "-o", str(tmp), *flags]
             proc = subprocess.run(cmd, capture_output=True, text=True)

@@ -317,3 +317,20 @@ def test_rcs_thruster_set_refuses_values_no_detection_can_use(fmu_paths, tmp_pat
         assert f"{name} = {bad!r}" in capsys.readouterr().out
     finally:
         fmu.freeInstance()
+
+
+def test_processes_compiling_the_runtime_at_once_all_get_it(tmp_path):
+    """Issue 54: two pytest-xdist workers of a fresh clone compiled the runtime into the same
+    build/runtime/<digest>/ with one temporary name, and one failed ('No such file or directory:
+    neighbor_fmi2.so.tmp'). Each process now compiles to a name of its own and replaces the target
+    whole."""
+    import subprocess
+    import sys
+
+    code = "import sys; from system_ssp import builder; print(builder.compile_runtime(sys.argv[1], 2)['linux64'])"
+    procs = [subprocess.Popen([sys.executable, "-c", code, str(tmp_path)], stdout=subprocess.PIPE,
+                              stderr=subprocess.PIPE, text=True) for _ in range(4)]
+    results = [p.communicate(timeout=300) + (p.returncode,) for p in procs]
+    assert all(rc == 0 for _, _, rc in results), [err[-500:] for _, err, _ in results]
+    assert (tmp_path / "neighbor_fmi2.so").is_file()
+    assert not list(tmp_path.glob("*.tmp"))
