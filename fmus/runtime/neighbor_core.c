@@ -39,8 +39,9 @@ static void *process_sym(const char *name) { return dlsym(RTLD_DEFAULT, name); }
 #define PATH_SEP '/'
 #endif
 
-/* One lock per loaded library around starting the runtime and loading the loader: hosts may
- * instantiate from several threads at once (libcosim's thread pool, a Python host's threads).
+/* One lock per loaded library around loading its loader: hosts may instantiate from several
+ * threads at once (libcosim's thread pool, a Python host's threads; starting Python has a lock of
+ * the whole process, see start_runtime).
  * new_instance waits for it with the GIL released, so it never waits on Python. The Python
  * side serializes its own import work across every FMU build (neighbor_runtime.py: _LOCK). */
 #ifdef _WIN32
@@ -427,9 +428,9 @@ static int start_runtime_locked(const char *resources) {
  * own statics) gets there first, and the others must wait until it has fully started: a lock the
  * whole process shares is needed, and no library of ours can own it. POSIX: the C library's lock
  * of stderr (flockfile: process-wide, recursive, always there; held only while Python starts).
- * Windows: a mutex named after the process. */
+ * Windows: a mutex named after the process. Taken by every instantiation (cheap), so that the
+ * runtime's statics a thread reads were written under the lock. */
 static int start_runtime(const char *resources) {
-    if (runtime_ready) return 1;
 #ifdef _WIN32
     char name[96];
     snprintf(name, sizeof name, "Local\\neighbor-cosim-python-start-%lu", (unsigned long)GetCurrentProcessId());
@@ -533,14 +534,17 @@ static void log_refusal(Instance *inst, const char *text) {
     host_log(&inst->cb, inst->name, 3 /* Error */, "logStatusError", text);
 }
 
-/* OK when `what` may be called in the instance's state (`mask`), else Error with the message. */
-static int allowed(Instance *inst, int mask, const char *what) {
-    if (inst->state & mask) return 1;
+/* ST_OK when `what` may be called on `inst` now (its state is in `mask`); else the status the call
+   returns: Error (no instance, or the state's refusal logged), Fatal after a fatal error. */
+static Status admit(Instance *inst, int mask, const char *what) {
+    if (!inst) return ST_ERROR;
+    if (inst->broken) return ST_FATAL;
+    if (inst->state & mask) return ST_OK;
     char text[512];
     snprintf(text, sizeof text, "%s is not allowed in state %s (the FMI standard's call order)", what,
              state_name(inst->state));
     log_refusal(inst, text);
-    return 0;
+    return ST_ERROR;
 }
 
 /* Roles of shared variables and the flags (NeighborSlave's SHARED_* and FRESH_* numbers) */
@@ -807,10 +811,7 @@ static void release_instance(Instance *inst) {
    with the reason in the host's log. `call` names the standard's call in messages. */
 static Instance *new_instance(const char *call_name, const char *name, const char *token, const char *resources,
                               int visible, int logging_on, HostCallbacks cb) {
-    runtime_lock();
-    int started = start_runtime(resources);
-    runtime_unlock();
-    if (!started) {
+    if (!start_runtime(resources)) {
         host_log(&cb, name, ST_ERROR, "logStatusError", runtime_error);
         return NULL;
     }
@@ -949,18 +950,14 @@ static Status enter_state(Instance *inst, Status status, int next) {
 /* A lifecycle call (`what`, the slave's method `name`) allowed in `mask`, leading to `next`. */
 static Status lifecycle(void *c, const char *what, const char *name, PyObject *(*make_args)(void *), void *data,
                         int mask, int next) {
-    Instance *inst = (Instance *)c;
-    if (!inst) return ST_ERROR;
-    if (inst->broken) return ST_FATAL;
-    if (!allowed(inst, mask, what)) return ST_ERROR;
-    return enter_state(inst, call_method(c, what, name, make_args, data), next);
+    Status refused = admit((Instance *)c, mask, what);
+    if (refused) return refused;
+    return enter_state((Instance *)c, call_method(c, what, name, make_args, data), next);
 }
 
 /* The start time a setup or an initialization announced: where the first doStep must start. */
 static void start_time(void *c, double t) {
-    Instance *inst = (Instance *)c;
-    if (!inst || inst->state == S_ERROR) return;
-    inst->next_time = t;
+    ((Instance *)c)->next_time = t;
 }
 
 static Status reset_instance(void *c, const char *what) {
@@ -1062,9 +1059,6 @@ static void set_shared(Instance *inst, int kind, const unsigned int vr[], size_t
     inst->sh_flags[FRESH_FEEDTHROUGH] = 0;  /* the outputs that depend on inputs */
 }
 
-/* `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
- * which expands arrays; `expected` is then the host's nValues), or from the shared values;
- * Booleans are written as `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
 /* A get or set with value references or values missing where the host said there are some. */
 static int arrays_given(Instance *inst, const unsigned int vr[], size_t nvr, const void *values, size_t n_values,
                         const char *what) {
@@ -1078,12 +1072,15 @@ static int arrays_given(Instance *inst, const unsigned int vr[], size_t nvr, con
     return 1;
 }
 
+/* `get` fills out[0 .. expected) from the model's list of values (for FMI 3.0 through the loader,
+ * which expands arrays; `expected` is then the host's nValues), or from the shared values;
+ * Booleans are written as `bool_size`-byte integers (FMI 2.0: int, FMI 3.0: bool). */
 static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr, void *out, size_t expected,
                          int via_loader, size_t bool_size, const char *what) {
     Instance *shared = (Instance *)c;
-    if (!shared) return ST_ERROR;
-    if (shared->broken) return ST_FATAL;
-    if (!allowed(shared, MASK_GET, what) || !arrays_given(shared, vr, nvr, out, expected, what)) return ST_ERROR;
+    Status refused = admit(shared, MASK_GET, what);
+    if (refused) return refused;
+    if (!arrays_given(shared, vr, nvr, out, expected, what)) return ST_ERROR;
     int needs = 0;
     if ((!via_loader || shared->sh_spans) && all_shared(shared, kind, vr, nvr, expected, 0, &needs))
         return get_shared(shared, kind, vr, nvr, out, bool_size, needs, what);
@@ -1136,9 +1133,9 @@ static Status get_values(void *c, int kind, const unsigned int vr[], size_t nvr,
 static Status set_values(void *c, int kind, const unsigned int vr[], size_t nvr, const void *in, size_t n_in,
                          int via_loader, size_t bool_size, const char *what) {
     Instance *shared = (Instance *)c;
-    if (!shared) return ST_ERROR;
-    if (shared->broken) return ST_FATAL;
-    if (!allowed(shared, MASK_SET, what) || !arrays_given(shared, vr, nvr, in, n_in, what)) return ST_ERROR;
+    Status refused = admit(shared, MASK_SET, what);
+    if (refused) return refused;
+    if (!arrays_given(shared, vr, nvr, in, n_in, what)) return ST_ERROR;
     if ((!via_loader || shared->sh_spans) && all_shared(shared, kind, vr, nvr, n_in, 1, NULL)) {
         set_shared(shared, kind, vr, nvr, in, bool_size);
         return ST_OK;
@@ -1270,9 +1267,8 @@ static Status unsupported(void *c, const char *what) {
 static Status step_model(void *c, double t, double h, const char *what);
 static Status do_step(void *c, double t, double h, const char *what) {
     Instance *checked = (Instance *)c;
-    if (!checked) return ST_ERROR;
-    if (checked->broken) return ST_FATAL;
-    if (!allowed(checked, MASK_DO_STEP, what)) return ST_ERROR;
+    Status refused = admit(checked, MASK_DO_STEP, what);
+    if (refused) return refused;
     char text[512];
     if (!(h > 0.0) || h > 1e300 || t != t || t > 1e300 || t < -1e300) {  /* NaN fails every comparison */
         snprintf(text, sizeof text, "%s: the communication step size must be positive and finite and the "
@@ -1303,11 +1299,9 @@ static Status do_step(void *c, double t, double h, const char *what) {
 /* system_ssp's master, for a component it suspended (nc:Schedule): the component's clock jumps to
    `t`, where its next doStep starts (a non-standard call; other hosts never jump). */
 static Status skip_to(void *c, double t) {
-    Instance *inst = (Instance *)c;
-    if (!inst) return ST_ERROR;
-    if (inst->broken) return ST_FATAL;
-    if (!allowed(inst, MASK_DO_STEP, "neighborSkipTo")) return ST_ERROR;
-    inst->next_time = t;
+    Status refused = admit((Instance *)c, MASK_DO_STEP, "neighborSkipTo");
+    if (refused) return refused;
+    ((Instance *)c)->next_time = t;
     return ST_OK;
 }
 

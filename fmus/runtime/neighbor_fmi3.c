@@ -39,9 +39,8 @@ static const char *SET_CALLS[] = {"fmi3SetFloat64", "fmi3SetInt32", "fmi3SetBool
 
 static Status no_variables_of_type(void *c, const char *what, size_t nvr) {
     Instance *inst = (Instance *)c;
-    if (!inst) return ST_ERROR;
-    if (inst->broken) return ST_FATAL;
-    if (!allowed(inst, strncmp(what, "fmi3Get", 7) == 0 ? MASK_GET : MASK_SET, what)) return ST_ERROR;
+    Status refused = admit(inst, strncmp(what, "fmi3Get", 7) == 0 ? MASK_GET : MASK_SET, what);
+    if (refused) return refused;
     if (nvr == 0) return ST_OK;
     char text[256];
     snprintf(text, sizeof text, "%s: this FMU has no variable of that type (it declares Float64, Int32, Boolean and "
@@ -116,9 +115,8 @@ void fmi3FreeInstance(fmi3Instance instance) { free_instance((Instance *)instanc
 fmi3Status fmi3EnterInitializationMode(fmi3Instance instance, fmi3Boolean toleranceDefined, fmi3Float64 tolerance,
                                        fmi3Float64 startTime, fmi3Boolean stopTimeDefined, fmi3Float64 stopTime) {
     Instance *inst = (Instance *)instance;
-    if (!inst) return fmi3Error;
-    if (inst->broken) return fmi3Fatal;
-    if (!allowed(inst, MASK_ENTER_INIT, "fmi3EnterInitializationMode")) return fmi3Error;
+    Status refused = admit(inst, MASK_ENTER_INIT, "fmi3EnterInitializationMode");
+    if (refused) return (fmi3Status)refused;
     Setup s = {toleranceDefined, stopTimeDefined, tolerance, startTime, stopTime};
     Status status = call_method(instance, "fmi3EnterInitializationMode", "setup_experiment", setup_args, &s);
     if (status <= ST_WARNING) {
