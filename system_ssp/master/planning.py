@@ -81,6 +81,11 @@ def _stops(system, stop_when):
 
 
 def _recorded(system, outputs):
+    if outputs is None and system.desc.master.record:  # nc:Record: what the system says to record
+        try:
+            return _recorded(system, system.desc.master.record)
+        except SSPError as exc:
+            raise SSPError(f"{system.desc.master.record_origin}: nc:Record: {exc}") from None
     if outputs is None:
         return [(c.index, v.name) for c in system.comps for v in c.md.modelVariables
                 if v.causality in ("input", "output") and v.type in RECORDABLE]

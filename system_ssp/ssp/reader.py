@@ -143,6 +143,8 @@ class MasterSettings:
     step_multiples: dict = field(default_factory=dict)
     stop_conditions: list = field(default_factory=list)
     schedule: Optional[Schedule] = None
+    record: Optional[list] = None  # nc:Record: the signals a run records unless told otherwise
+    record_origin: str = ""
     origin: str = ""
 
 
@@ -517,9 +519,12 @@ def parse_master_annotation(el, namer, settings):
                 settings.stop_conditions.append(f"{comp}.{conn}")
             elif child.tag == _q("nc", "Schedule"):
                 settings.schedule = _parse_schedule(child, namer)
+            elif child.tag == _q("nc", "Record"):
+                settings.record = (child.text or "").split()
+                settings.record_origin = corigin
             else:
                 raise SSPError(f"{corigin}: unknown element {child.tag} in nc:Master "
-                               "(expected nc:Order, nc:StepMultiple, nc:StopCondition, nc:Schedule)")
+                               "(expected nc:Order, nc:StepMultiple, nc:StopCondition, nc:Schedule, nc:Record)")
 
 
 def parse_osp_annotation(el, namer, settings):

@@ -10,7 +10,7 @@ atomically. The output is byte-for-byte reproducible, which `python -m system_ss
 """
 from pathlib import Path
 import shutil
-from xml.sax.saxutils import quoteattr
+from xml.sax.saxutils import escape, quoteattr
 
 from fmpy import read_model_description
 
@@ -71,11 +71,12 @@ class SystemWriter:
         self.fmu_dir = Path(fmu_dir)
         self.written = []
         self._fmus = {}
+        self.fmu_files = {}  # FMUs outside fmu_dir: resource name -> path (system specs)
 
     def fmu_variables(self, fmu_name):
         """(model variables, {unit name: BaseUnit}) of build/fmus/<fmu_name>.fmu."""
         if fmu_name not in self._fmus:
-            path = self.fmu_dir / f"{fmu_name}.fmu"
+            path = self.fmu_files.get(fmu_name, self.fmu_dir / f"{fmu_name}.fmu")
             if not path.is_file():
                 raise GeneratorError(f"{path} not found: build the FMUs first (python build_fmus.py)")
             md = read_model_description(str(path))
@@ -99,7 +100,10 @@ class SystemWriter:
     def ssd(self, name, spec):
         """Write <name>.ssd from a spec: components as (instance, FMU model identifier, [parameter
         files in parameters/, without .ssv]), connections as (source, output, destination, input,
-        n) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar, optional
+        n[, transform]) with n > 0 for structured names out[1]..out[n] or n = 0 for a scalar (transform:
+        {"factor", "offset", "linear", "suppress"}, an ssc:LinearTransformation and/or
+        suppressUnitConversion), optional "algorithm" (default gauss-seidel), "record" (the
+        signals recorded by default, nc:Record),
         "parameters" (system parameters, see _system_parameters_xml) and "parameter_bindings", "stop"
         Boolean outputs, "order", "stop_time", "step_size", and "schedule": a schedule.Schedule
         for an nc:Schedule (the type the reader returns). libcosim applies only a component's
@@ -135,14 +139,25 @@ class SystemWriter:
             out.append("      </ssd:Component>")
         out.append("    </ssd:Elements>")
         out.append("    <ssd:Connections>")
-        for src, sname, dst, dname, n in spec["connections"]:
+        for src, sname, dst, dname, n, *transform in spec["connections"]:
             pairs = [(f"{sname}[{i}]", f"{dname}[{i}]") for i in range(1, n + 1)] if n else [(sname, dname)]
             for a, b in pairs:
                 va, vb = comp_vars[src].get(a), comp_vars[dst].get(b)
                 if va is None or vb is None or va.causality != "output" or vb.causality != "input":
                     raise GeneratorError(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
-                out.append(f'      <ssd:Connection startElement="{src}" startConnector="{a}" '
-                           f'endElement="{dst}" endConnector="{b}"/>')
+                head = (f'      <ssd:Connection startElement="{src}" startConnector={quoteattr(a)} '
+                        f'endElement="{dst}" endConnector={quoteattr(b)}')
+                tr = transform[0] if transform else None
+                if not tr:
+                    out.append(head + "/>")
+                    continue
+                if tr.get("suppress"):
+                    head += ' suppressUnitConversion="true"'
+                if not tr.get("linear"):
+                    out.append(head + "/>")
+                    continue
+                out += [head + ">", f'        <ssc:LinearTransformation factor="{float(tr["factor"])!r}" '
+                        f'offset="{float(tr["offset"])!r}"/>', "      </ssd:Connection>"]
         for pname, (_, targets) in spec.get("parameters", {}).items():
             for comp, var in targets:
                 out.append(f'      <ssd:Connection startConnector={quoteattr(pname)} endElement="{comp}" '
@@ -154,11 +169,14 @@ class SystemWriter:
                 raise GeneratorError(f"{name}: stop signal {comp}.{var} must be a Boolean output")
         out += ["    <ssd:Annotations>",
                 f'      <ssc:Annotation type="{ANNOTATION_TYPE}">',
-                f'        <nc:Master xmlns:nc="{NS_NC}" stepSize="{dt!r}" algorithm="gauss-seidel">',
+                f'        <nc:Master xmlns:nc="{NS_NC}" stepSize="{dt!r}" '
+                f'algorithm="{spec.get("algorithm", "gauss-seidel")}">',
                 *([f'          <nc:Order>{" ".join(spec["order"])}</nc:Order>'] if spec.get("order") else [])]
         out += [f'          <nc:StopCondition component="{c}" connector="{v}"/>' for c, v in spec.get("stop", [])]
         if spec.get("schedule"):
             out += _schedule_xml(name, spec["schedule"], comp_vars)
+        if spec.get("record"):
+            out.append(f'          <nc:Record>{escape(" ".join(spec["record"]))}</nc:Record>')
         out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
         out.append("  <ssd:Units>")
         for uname in sorted(all_units):

@@ -1,5 +1,7 @@
 """The system generators: one module per family of systems, each with `generate(writer)`, which
-writes its .ssd files and parameter sets through a `system_ssp.ssp.writer.SystemWriter`.
+writes its parameter sets (the values derived from the mission definition) through a
+`system_ssp.ssp.writer.SystemWriter` and then each of its systems from its spec,
+system_ssp/systems/specs/<name>.toml (`from_spec.write_system`).
 
 The written files are committed (system_ssp/systems/); `python -m system_ssp.systems --check`
 regenerates them into a temporary folder and fails on any difference, so the committed systems

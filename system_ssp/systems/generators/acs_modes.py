@@ -51,6 +51,7 @@ from components.environment import sun
 from components.mission.neighbor import SPACECRAFT as BASELINE
 
 from ...ssp.writer import vec
+from .from_spec import write_system
 
 MASS, EDGES = BASELINE.mass, {"edge_a": BASELINE.edge_a, "edge_b": BASELINE.edge_b, "edge_c": BASELINE.edge_c}
 J = rigid_body.box_inertia(MASS, EDGES["edge_a"], EDGES["edge_b"], EDGES["edge_c"])
@@ -74,58 +75,6 @@ SHORTENED = {**{f"modes.{k}": v for k, v in SHORT_DELAYS.items()},
              "paddles.deployment_time": 20.0, "optical.acquisition_time": 10.0, "optical.loss_time": 7.0}
 SHORT_STEP, SHORT_STOP = 5.0, 18000.0
 GROUND = {**SHORTENED, "signals.command_start": 12000.0, "signals.command_end": 12030.0}
-
-SYSTEM = {
-    "description": "ACS of the mode specification: mode manager, per-mode control laws, torque coils, Y momentum "
-                   "wheel, paddles, "
-                   "optical tracker, on a rigid body in a circular orbit with Sun, shadow and geomagnetic field",
-    "components": [("orbit", "CircularOrbit", ["acs_modes_orbit"]),
-                   ("sun", "SunEphemeris", []),
-                   ("shadow", "EarthShadow", []),
-                   ("sunline", "SunlineEphemeris", ["acs_modes_sunline"]),
-                   ("field", "MagneticField", []),
-                   ("signals", "AcsSignals", ["acs_modes_signals"]),
-                   ("modes", "AcsModeManager", []),
-                   ("control", "AcsControl", ["acs_modes_control"]),
-                   ("coils", "TorqueCoils", []),
-                   ("wheel", "MomentumWheel", []),
-                   ("paddles", "Paddles", []),
-                   ("optical", "OpticalTracker", []),
-                   ("dynamics", "RigidBody", ["acs_modes_initial_state", "acs_modes_spacecraft"])],
-    "connections": [
-        ("orbit", "r_BN_N", "shadow", "r_BN_N", 3), ("sun", "r_SN_N", "shadow", "r_SN_N", 3),
-        ("orbit", "r_BN_N", "sunline", "r_BN_N", 3), ("sun", "r_SN_N", "sunline", "r_SN_N", 3),
-        ("dynamics", "q_BN", "sunline", "q_BN", 4),
-        ("orbit", "r_BN_N", "field", "r_BN_N", 3), ("dynamics", "q_BN", "field", "q_BN", 4),
-        ("dynamics", "H_B", "signals", "H_B", 3), ("wheel", "wheel_momentum_B", "signals", "wheel_momentum_B", 3),
-        ("dynamics", "omega_BN_B", "signals", "omega_BN_B", 3),
-        ("sunline", "sun_heading_B", "signals", "sun_heading_B", 3),
-        ("shadow", "orbit_day", "optical", "orbit_day", 0), ("signals", "body_rate", "optical", "body_rate", 0),
-        ("paddles", "paddles_deployed", "optical", "paddles_deployed", 0),
-        *[("signals", n, "modes", n, 0) for n in ("xz_momentum_error", "momentum_error", "sin_sun_elevation",
-                                                  "sin_sun_azimuth", "body_rate", "ground_command")],
-        ("wheel", "wheel_rate", "modes", "wheel_rate", 0), ("shadow", "orbit_day", "modes", "orbit_day", 0),
-        ("paddles", "paddles_deployed", "modes", "paddles_deployed", 0),
-        ("optical", "tracking", "modes", "optical_tracking", 0),
-        ("modes", "paddle_deploy", "paddles", "deploy", 0),
-        ("modes", "mode", "control", "mode", 0), ("modes", "coils_enabled", "control", "coils_enabled", 0),
-        ("modes", "wheel_enabled", "control", "wheel_enabled", 0),
-        ("modes", "time_in_mode", "control", "time_in_mode", 0),
-        ("dynamics", "omega_BN_B", "control", "omega_BN_B", 3), ("field", "B_B", "control", "B_B", 3),
-        ("sunline", "sun_heading_B", "control", "sun_heading_B", 3),
-        ("wheel", "wheel_rate", "control", "wheel_rate", 0),
-        ("control", "dipole_cmd_B", "coils", "dipole_cmd_B", 3), ("field", "B_B", "coils", "B_B", 3),
-        ("modes", "coils_enabled", "coils", "enabled", 0),
-        ("control", "wheel_torque_cmd", "wheel", "torque_cmd", 0), ("modes", "wheel_enabled", "wheel", "enabled", 0),
-        ("coils", "torque_B", "dynamics", "torque_B", 3),
-        ("wheel", "wheel_torque_B", "dynamics", "wheel_torque_B", 3),
-        ("wheel", "wheel_momentum_B", "dynamics", "wheel_momentum_B", 3),
-    ],
-    "order": ["field", "sunline", "shadow", "signals", "optical", "modes", "paddles", "control", "coils", "wheel",
-              "dynamics", "orbit", "sun"],
-    "stop_time": math.ceil(6 * PERIOD / STEP) * STEP,
-    "step_size": STEP,
-}
 
 
 def sun_facing():
@@ -154,4 +103,4 @@ def generate(writer):
     writer.ssv("acs_modes_sun_facing",
                "Scenario: orbit plane facing the Sun at the epoch (no eclipse) for the specification's 6000 s RMD",
                sun_facing())
-    writer.ssd("acs_modes", SYSTEM)
+    write_system(writer, "acs_modes")

@@ -25,6 +25,7 @@ Parameter files (parameters/, one per concern):
 import math
 
 from ...ssp.writer import vec
+from .from_spec import write_system
 
 
 STEP = 0.02
@@ -44,18 +45,6 @@ SCENARIOS = {
 }
 
 DCM = [(i, j) for i in (1, 2, 3) for j in (1, 2, 3)]
-SYSTEM = {
-    "description": "Spherical air-bearing testbed without IMU (the air-bearing note): rigid body, quaternion to DCM, "
-                   "kinematics node (rate from the DCM stream, pitch/roll limited to tau)",
-    "components": [("dynamics", "RigidBody", ["air_bearing_initial_state", "air_bearing_testbed"]),
-                   ("to_dcm", "AttitudeToDcm", []),
-                   ("kinematics", "AirBearingKinematics", ["air_bearing_kinematics"])],
-    "connections": [("dynamics", "q_BN", "to_dcm", "q_BN", 4)]
-                   + [("to_dcm", f"dcm_BN[{i},{j}]", "kinematics", f"dcm_BN[{i},{j}]", 0) for i, j in DCM],
-    "order": ["to_dcm", "kinematics", "dynamics"],
-    "stop_time": 20.0,
-    "step_size": STEP,
-}
 
 
 def generate(writer):
@@ -69,4 +58,4 @@ def generate(writer):
                KINEMATICS)
     for name, (description, values) in SCENARIOS.items():
         writer.ssv(name, description, {f"dynamics.{k}": v for k, v in values.items()})
-    writer.ssd("air_bearing", SYSTEM)
+    write_system(writer, "air_bearing")

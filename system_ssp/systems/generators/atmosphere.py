@@ -10,26 +10,16 @@ where another atmosphere FMU is swapped in (`neighbor-cosim replace`).
 import math
 
 from components.core import time_utils
-from components.core.constants import DAY
+from .from_spec import write_system
 
 NAME = "atmosphere"
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0}
 DENSITY = {"epoch": time_utils.DEFAULT_EPOCH, "density_model": "jacchia_roberts", "space_weather_file": "",
            "use_constant_space_weather": False}
 
-SYSTEM = {
-    "description": "Atmospheric density along a circular 420 km orbit: CircularOrbit position into the Atmosphere "
-                   "FMU (Jacchia-Roberts, bundled CSSI space weather)",
-    "components": [("orbit", "CircularOrbit", [f"{NAME}_orbit"]), ("atmosphere", "Atmosphere", [f"{NAME}_density"])],
-    "connections": [("orbit", "r_BN_N", "atmosphere", "r_BN_N", 3)],
-    "order": ["orbit", "atmosphere"],
-    "stop_time": DAY,
-    "step_size": 60.0,
-}
-
 
 def generate(writer):
     writer.ssv(f"{NAME}_orbit", "Circular 420 km orbit at 51.6 deg (the de-orbit study's start)", ORBIT)
     writer.ssv(f"{NAME}_density", "Jacchia-Roberts with the bundled CSSI space weather from 2023-01-01 (the de-orbit "
                "study's settings)", DENSITY)
-    writer.ssd(NAME, SYSTEM)
+    write_system(writer, NAME)

@@ -27,6 +27,7 @@ from components.core import constants, rotations
 from components.sensing import triad
 
 from ...ssp.writer import vec
+from .from_spec import write_system
 
 NAME = "attitude_determination"
 AU = 1.495978707e11  # m
@@ -84,36 +85,10 @@ SCENARIOS = {
                  **{f"gyro.bias[{i}]": b for i, b in enumerate([1e-3, -1e-3, 1e-3], 1)}}),
 }
 
-SYSTEM = {
-    "description": ("NEIGHBOR attitude determination (thesis 3.3.1): horizon and sun sensors, TRIAD, gyro "
-                    "propagation, GPS, on a slowly tumbling host"),
-    "components": [("dynamics", "RigidBody", [f"{NAME}_initial_state", "spacecraft"]),
-                   ("horizon", "HorizonSensor", [f"{NAME}_horizon"]),
-                   ("sun_sensor", "SunSensor", [f"{NAME}_sun_sensor"]),
-                   ("gyro", "Gyro", [f"{NAME}_gyro"]),
-                   ("gps", "GpsReceiver", [f"{NAME}_gps"]),
-                   ("ad", "AttitudeDetermination", [f"{NAME}_ad"])],
-    "connections": [("dynamics", "q_BN", "horizon", "q_BN", 4),
-                    ("dynamics", "q_BN", "sun_sensor", "q_BN", 4),
-                    ("dynamics", "omega_BN_B", "gyro", "omega_BN_B", 3),
-                    ("horizon", "nadir_B", "ad", "nadir_B", 3),
-                    ("horizon", "valid", "ad", "nadir_valid", 0),
-                    ("sun_sensor", "sun_B", "ad", "sun_B", 3),
-                    ("sun_sensor", "valid", "ad", "sun_valid", 0),
-                    ("gyro", "omega_meas_B", "ad", "omega_meas_B", 3),
-                    ("gps", "r_meas_N", "ad", "r_BN_N", 3)],
-    # `ad` first: it steps from t with the measurements of t (the sensors' outputs refreshed
-    # after the previous step), then the truth and the sensors advance; after the step the
-    # master refreshes the feedthrough outputs, so ad's outputs at t + h use t + h measurements.
-    "order": ["ad", "dynamics", "horizon", "sun_sensor", "gyro", "gps"],
-    "step_size": STEP,
-    "stop_time": 60.0,
-}
-
 
 def generate(writer):
     for concern, (description, values) in FILES.items():
         writer.ssv(f"{NAME}_{concern}", description, values)
     for scenario, (description, values) in SCENARIOS.items():
         writer.ssv(f"{NAME}_{scenario}", description, values)
-    writer.ssd(NAME, SYSTEM)
+    write_system(writer, NAME)

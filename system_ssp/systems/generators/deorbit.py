@@ -29,12 +29,12 @@ Scenario files (names component.variable), one per thesis case, with and without
   scenario's target perigee (350, 350, 300 km). Without the burn, burn_enable stays false
   (the host alone, 12 kg).
 """
-from components.mission.neighbor import (DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBIT as HOST_ORBIT, ORBIT_FMUS, SCENARIOS,
+from components.mission.neighbor import (DEFAULT_SCENARIO, DEORBIT_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS,
                                          SPACECRAFT, scenario_set)
 from components.orbit import propulsion
-from components.core.constants import DAY, R_EQ, YEAR
+from components.core.constants import R_EQ
 
-from ...ssp.schedule import Schedule, ScheduleMode, When
+from .from_spec import write_system
 
 KM = 1000.0
 BASE = SCENARIOS[DEFAULT_SCENARIO]  # the component-level files start from it
@@ -42,9 +42,6 @@ ORBIT = {"epoch": HOST_ORBIT.deorbit_epoch, "sma0": R_EQ + BASE.altitude_km * KM
          "inc0": HOST_ORBIT.inclination, "raan0": 0.0, "argp0": 0.0, "ta0": 0.0, "Cd": SPACECRAFT.Cd,
          "area": SPACECRAFT.drag_area, "reentry_altitude": HOST_ORBIT.reentry_altitude_km * KM,
          "density_model": HOST_ORBIT.density_model, "space_weather_file": "", "use_constant_space_weather": False}
-BURN_STEP = 0.5  # s, thesis Section 3.2
-COAST_STEP = {"cowell": 3600.0, "averaged": DAY}
-STOP_TIME = 150.0 * YEAR  # longer than the 97-year case
 
 
 def scenario(name, burn):
@@ -52,24 +49,6 @@ def scenario(name, burn):
     if burn:
         params["propulsion.propellant_budget"] = propulsion.mission_scenario(name)["propellant"]
     return params
-
-
-def system(orbit_fmu, coast_step):
-    return {
-        "description": f"NEIGHBOR de-orbit: {orbit_fmu} orbit, main de-orbit thrusters (retrograde burn to the "
-                       "propellant budget); stops at re-entry (250 km)",
-        "components": [("propulsion", "Propulsion", ["deorbit_propulsion"]),
-                       ("orbit", orbit_fmu, ["deorbit_orbit"])],
-        "connections": [("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
-                        ("propulsion", "mass", "orbit", "mass", 0)],
-        "order": ["propulsion", "orbit"],
-        "stop": [("orbit", "reentered")],
-        "stop_time": STOP_TIME,
-        "step_size": coast_step,
-        "schedule": Schedule(modes=(
-            ScheduleMode("burn", BURN_STEP, record_every=60, conditions=(When("propulsion", "burning", (1,)),)),
-            ScheduleMode("coast", coast_step))),
-    }
 
 
 def generate(writer):
@@ -100,4 +79,4 @@ def generate(writer):
         for burn in (True, False):
             writer.ssv_copy(scenario_set(cowell, name, burn), scenario_set(averaged, name, burn))
     for orbit, name in DEORBIT_SYSTEMS.items():
-        writer.ssd(name, system(ORBIT_FMUS[orbit], COAST_STEP[orbit]))
+        write_system(writer, name)

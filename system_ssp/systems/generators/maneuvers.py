@@ -22,6 +22,7 @@ from components.core import rotations
 from components.mission.neighbor import SPACECRAFT
 
 from ...ssp.writer import GeneratorError, vec
+from .from_spec import write_system
 
 DT = 0.015  # thesis time step (s)
 DETUMBLE_LIMIT = 20.0  # s, the Appendix D loop limit
@@ -125,38 +126,8 @@ def thesis_cases():
     return cases
 
 
-SYSTEMS = {
-    "detumble": {
-        "description": "NEIGHBOR detumble maneuver: PD rate controller, RCS thruster pairs, rigid body",
-        "components": [("detumble", "DetumbleController", ["detumble_gains"]),
-                       ("thrusters", "RcsThrusters", ["thrusters"]),
-                       ("dynamics", "RigidBody", ["detumble_initial_state", "spacecraft"])],
-        "connections": [("dynamics", "omega_BN_B", "detumble", "omega_BN_B", 3),
-                        ("dynamics", "omega_dot_BN_B", "detumble", "omega_dot_BN_B", 3),
-                        ("detumble", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
-                        ("thrusters", "torque_B", "dynamics", "torque_B", 3)],
-        "default_case": "detumble_case1",
-        "stop": [("detumble", "done")],
-        "order": ["detumble", "thrusters", "dynamics"],
-        "stop_time": DETUMBLE_LIMIT,
-        "step_size": DT,
-    },
-    "slew": {
-        "description": "NEIGHBOR slew maneuver: quaternion PD controller, RCS thruster pairs, rigid body",
-        "components": [("slew", "SlewController", ["slew_gains"]),
-                       ("thrusters", "RcsThrusters", ["thrusters"]),
-                       ("dynamics", "RigidBody", ["slew_initial_state", "spacecraft"])],
-        "connections": [("dynamics", "q_BN", "slew", "q_BN", 4),
-                        ("dynamics", "omega_BN_B", "slew", "omega_BN_B", 3),
-                        ("slew", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
-                        ("thrusters", "torque_B", "dynamics", "torque_B", 3)],
-        "default_case": "slew_case1",
-        "stop": [("slew", "done")],
-        "order": ["slew", "thrusters", "dynamics"],
-        "stop_time": 1500.0,  # the Appendix G loop limit
-        "step_size": DT,
-    },
-}
+# The systems and the thesis case each one binds by default (specs/<name>.toml describe them)
+DEFAULT_CASES = {"detumble": "detumble_case1", "slew": "slew_case1"}
 
 CONCERNS = {"spacecraft": ("Host spacecraft mass and box edges (thesis Appendix A)", BODY),
             "thrusters": ("RCS thruster force, lever-arm edges, Isp and g0 (Appendix A, Eq. 16, 74)", THRUSTERS),
@@ -175,8 +146,7 @@ def generate(writer):
     cases = thesis_cases()
     for case, spec in cases.items():
         writer.ssv(case, spec["description"], case_parameters(case))
-    for name, spec in SYSTEMS.items():
-        initial = cases[spec["default_case"]]["dynamics"]
-        writer.ssv(f"{name}_initial_state",
-                   f"Default initial state of {name}: {cases[spec['default_case']]['description']}", initial)
-        writer.ssd(name, spec)
+    for name, case in DEFAULT_CASES.items():
+        writer.ssv(f"{name}_initial_state", f"Default initial state of {name}: {cases[case]['description']}",
+                   cases[case]["dynamics"])
+        write_system(writer, name)

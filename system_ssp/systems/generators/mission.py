@@ -74,15 +74,12 @@ from components.attitude import rigid_body, thruster_control
 from components.environment import atmosphere
 from components.orbit import averaged, propulsion
 from components.core import time_utils
-from components.core.constants import DAY, R_EQ, YEAR
-from components.mission.modes import DeorbitPhase as Phase, MissionMode as Mode
-from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, ORBIT_FMUS,
-                                         SCENARIOS, SPACECRAFT, scenario_set)
-from components.mission.power_bus import LOAD_NAMES
+from components.core.constants import DAY, R_EQ
+from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS, SPACECRAFT, scenario_set)
 
-from ...ssp.schedule import Schedule, ScheduleMode, When
 from ...ssp.writer import vec
 from . import attitude_determination as ad
+from .from_spec import write_system
 
 KM = 1000.0
 IDLE_DAYS = 1825.0  # 5 years (Appendix I: 1855 days of idle + grace)
@@ -92,74 +89,10 @@ MISSION_EPOCH = (time_utils.parse_epoch(DEORBIT_EPOCH)
                  - dt.timedelta(days=IDLE_DAYS + GRACE_DAYS)).strftime("%Y-%m-%dT%H:%M:%SZ")
 W0_TAKEOVER = [math.radians(10.0)] * 3  # Eq. 7
 
-# During the 15 ms attitude phases the slow components (orbit, ground station, host, power, data)
-# step every 33rd step (0.495 s, about the thesis' 0.5 s burn step), ahead with inputs held.
-SLOW_EVERY = 33
-# Waiting for a contact: 240 s steps while the station's near_contact is false (a contact cannot
-# begin within 448 s of that, components/mission/ground_station.py), 5-10 s steps while it is true.
-FAR_STEP = 240.0
-
-# The components, in SSD order: instance -> (FMU, parameter files, schedule roles). The roles
-# decide where each is stepped (the nc:Schedule below is derived from them):
-#   idle     idle and grace period (6 h steps)          bus      awaiting, contact, determination
-#   monitor  monitoring (after the burn)                decay    battery empty, until re-entry
-#   slow     every SLOW_EVERY-th step of the 15 ms maneuvers; slow_burn: so in the burn only
-#   sense    the attitude knowledge (sense_slow: every SLOW_EVERY-th maneuver step, sense_vector:
-#            every SENSOR_EVERY-th), truth: also with truth feedback
-#   a phase (detumble, slew, burn): the controller of that maneuver only; every other component
-#   steps in all three maneuvers.
-# Adding a component to the mission is one row here plus its connections in `system()`.
-ORBIT = "orbit fidelity"  # Orbit (Cowell) or OrbitAveraged, per system
-COMPONENTS = {
-    "host": ("HostSpacecraft", ["mission_host"], {"idle", "bus", "slow"}),
-    "mission": ("MissionManager", ["mission_manager"], {"idle", "bus", "monitor", "decay", "slow_burn"}),
-    "orbit": (ORBIT, ["mission_orbit"], {"idle", "bus", "monitor", "decay", "slow"}),
-    "ground": ("GroundStation", ["mission_ground"], {"bus", "monitor", "slow"}),
-    "propulsion": ("Propulsion", ["mission_propulsion"], {"bus", "slow_burn"}),
-    "dynamics": ("RigidBody", ["mission_takeover", "spacecraft"], set()),
-    "guidance": ("BurnGuidance", [], {"slow"}),
-    "detumble": ("DetumbleController", ["detumble_gains", "mission_detumble"], {"detumble"}),
-    "slew": ("SlewController", ["slew_gains", "mission_slew"], {"slew"}),
-    "tracking": ("TrackingController", ["mission_tracking"], {"burn"}),
-    "selector": ("TorqueSelector", [], set()),
-    "thrusters": ("RcsThrusterSet", ["thrusters", "mission_thrusters"], set()),
-    "power": ("Power", ["mission_power"], {"idle", "bus", "monitor", "slow"}),
-    "data": ("DataStorage", ["mission_data"], {"bus", "monitor", "slow"}),
-    # attitude knowledge: ephemeris, shadow, sensors and the estimator (truth feedback: the estimator only)
-    "sun": ("SunEphemeris", ["mission_sun"], {"sense", "sense_slow"}),
-    "shadow": ("EarthShadow", [], {"sense", "sense_slow"}),
-    "gps": ("GpsReceiver", ["mission_gps"], {"sense", "sense_slow"}),
-    "horizon": ("HorizonSensor", ["mission_horizon"], {"sense", "sense_vector"}),
-    "sun_sensor": ("SunSensor", ["mission_sun_sensor"], {"sense", "sense_vector"}),
-    "coarse_sun": ("SunSensor", ["mission_coarse_sun"], {"sense", "sense_vector"}),
-    "gyro": ("Gyro", ["mission_gyro"], {"sense"}),
-    "estimator": ("AttitudeEstimator", ["mission_estimator"], {"sense", "truth"}),
-}
-MANEUVERS = ("detumble", "slew", "burn")
-# Gauss-Seidel order. The mission manager decides at a step's start from its inputs there;
-# components stepped after it see that decision for the step (the controllers, the burn). Power
-# and data integrate the loads and recording over the step, so they step before it and see the
-# states held at the step's start; a timed event the manager reaches at the step's end (a
-# wake-up) applies from then on, not to the step before. The rest follow the feedthrough edges
-# (propulsion -> orbit, orbit -> ground, controllers -> selector -> thrusters -> dynamics).
-# The sensors and the estimator come last: they read the rigid body at the step's end, so the
-# estimate (or, with truth feedback, the true state) the controllers read at the next step's
-# start is the state at that time, as if they read the rigid body itself.
-ORDER = ["power", "data", "mission", "host", "propulsion", "orbit", "guidance", "ground", "detumble", "slew",
-         "tracking", "selector", "thrusters", "dynamics", "sun", "shadow", "gps", "horizon", "sun_sensor", "coarse_sun",
-         "gyro", "estimator"]
-# The estimator takes one vector sample per sensor every UPDATE_INTERVAL (0.09 s), each with its
-# own noise, and uses a sample the step it arrives or never. In the 15 ms maneuvers the gyro and
-# the estimator step every step, the vector sensors (horizon, fine and coarse Sun: "sense_vector")
-# every SENSOR_EVERY-th step, i.e. exactly at the estimator's rate: a sensor samples the rigid
-# body at the end of the step it is stepped in, the estimator stepping after it uses that sample
-# in the same step (its interval has just elapsed), and between two samples the sensor's output
-# is held (a refresh for a recorded row recomputes it from the current geometry; the estimator
-# drops it, its interval not elapsed). Stepped every 7th step, a rate the interval does not
-# divide, the sensors had made the estimator overconfident (held samples used up to 6 steps
-# late, 1.5 deg at 17 deg/s; the attitude NEES in the detumble reached 250-700, issue 28). Every
-# step cost 26 s of a mission for samples the estimator dropped (issue 27). Determination runs
-# at the gyro's 0.1 s, every sample used.
+# The system itself (components, connections, order and the nc:Schedule with its reasons) is
+# specs/neighbor_mission.toml; what follows are the values of its parameter files.
+# The estimator takes one vector sample per sensor every UPDATE_INTERVAL (0.09 s); the spec steps
+# the vector sensors every 6th 15 ms step, exactly at that rate (its comments say why).
 UPDATE_INTERVAL = 0.09
 # The estimator's fault detection watches the mean normalized innovation squared over this many
 # vector updates (components.sensing.mekf.InnovationMonitor: 1e-6 false alarms per window at 3.64)
@@ -168,11 +101,8 @@ FAULT_WINDOW = 100
 # eclipse is over and the Sun seen by then; the nominal fix takes about 25 min) no Sun sensor is
 # left: the detumble runs on rates, then the mission manager's safe state.
 DETERMINATION_TIMEOUT = 6000.0
-MANEUVER_STEP = 0.015
-SENSOR_EVERY = round(UPDATE_INTERVAL / MANEUVER_STEP)
-assert abs(SENSOR_EVERY * MANEUVER_STEP - UPDATE_INTERVAL) < 1e-12
-DETERMINATION_STEP = 0.1
-DETERMINATION_EVERY = 10
+MANEUVER_STEP = 0.015  # the attitude loop's step (specs/neighbor_mission.toml)
+
 
 
 # Flight tolerances sized from the impulse bit: the rate change of one 15 ms firing (the attitude
@@ -224,63 +154,12 @@ GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynam
 
 
 # The spacecraft's physical values, each given once (system parameters of the SSD, in
-# parameters/mission_spacecraft.ssv) and handed by parameter connections to every component that
-# uses it: `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
+# parameters/mission_spacecraft.ssv; the spec's [system_parameters] say which components take them): `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
 # propulsion's initial mass together.
-SPACECRAFT_PARAMETERS = {
-    "spacecraft_mass": ("Host spacecraft total mass at takeover, kg (Table 2: 12 kg)", SPACECRAFT.mass,
-                        [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0"),
-                         ("thrusters", "mass")]),
-    "spacecraft_edge_a": ("Box edge a along body y, m (Appendix A: 0.1 m); also the x thruster pairs' spacing",
-                          SPACECRAFT.edge_a, [("dynamics", "edge_a"), ("tracking", "edge_a"), ("estimator", "edge_a"),
-                                ("thrusters", "edge_a")]),
-    "spacecraft_edge_b": ("Box edge b along body z, m (Appendix A: 0.2 m)", SPACECRAFT.edge_b,
-                          [("dynamics", "edge_b"), ("tracking", "edge_b"), ("estimator", "edge_b"),
-                           ("thrusters", "edge_b")]),
-    "spacecraft_edge_c": ("Box edge c along body x, m (Appendix A: 0.3 m); also the y and z thruster pairs' arms",
-                          SPACECRAFT.edge_c, [("dynamics", "edge_c"), ("tracking", "edge_c"), ("estimator", "edge_c"),
-                                ("thrusters", "edge_c")]),
-    "spacecraft_Cd": ("Drag coefficient (Table 2: 2.2)", SPACECRAFT.Cd, [("orbit", "Cd")]),
-    "spacecraft_drag_area": ("Drag area facing the flow, m2 (Table 2: 0.02 m2)", SPACECRAFT.drag_area,
-                             [("orbit", "area")]),
-    "rcs_thrust": ("Force of one RCS thruster, N (Appendix A: 25 mN)", SPACECRAFT.rcs_thrust,
-                   [("thrusters", "thrust")]),
-}
-
-
-def having(role):
-    """The components with a schedule role, in SSD order."""
-    return tuple(c for c, (_, _, roles) in COMPONENTS.items() if role in roles)
-
-
-def maneuver_active(phase, truth=False):
-    """Every component but the other maneuvers' controllers, in Gauss-Seidel order; with truth
-    feedback no sensors (the estimator passes the rigid body's state through)."""
-    others = {c for c, (_, _, roles) in COMPONENTS.items() if roles & set(MANEUVERS) - {phase}}
-    if truth:
-        others |= set(having("sense")) - set(having("truth"))
-    return tuple(c for c in ORDER if c not in others)
-
-
-def maneuver_every(phase, truth=False):
-    slow = having("slow") + (having("slow_burn") if phase == "burn" else ())
-    every = {c: SLOW_EVERY for c in slow}
-    if not truth:
-        every.update({c: SLOW_EVERY for c in having("sense_slow")})
-        every.update({c: SENSOR_EVERY for c in having("sense_vector")})
-    return every
-
-
-def determination_active():
-    """Estimation: the bus, the tumbling rigid body, the sensors and the estimator."""
-    return tuple(c for c in ORDER if c in set(having("bus")) | set(having("sense")) | {"dynamics"})
-
-
-def determination_every():
-    """In the 0.1 s determination steps the bus (but the manager, whose timers land exactly), the
-    ephemeris, the shadow and the GPS step every second."""
-    slow = (set(having("bus")) - {"mission"}) | set(having("sense_slow"))
-    return {c: DETERMINATION_EVERY for c in determination_active() if c in slow}
+SPACECRAFT_VALUES = {"spacecraft_mass": SPACECRAFT.mass, "spacecraft_edge_a": SPACECRAFT.edge_a,
+                     "spacecraft_edge_b": SPACECRAFT.edge_b, "spacecraft_edge_c": SPACECRAFT.edge_c,
+                     "spacecraft_Cd": SPACECRAFT.Cd, "spacecraft_drag_area": SPACECRAFT.drag_area,
+                     "rcs_thrust": SPACECRAFT.rcs_thrust}
 
 
 def deployment_altitude(target_km, density=HOST_ORBIT.density_model):
@@ -304,139 +183,6 @@ def deployment_altitude(target_km, density=HOST_ORBIT.density_model):
         if hi - lo < 0.01:
             break
     return 0.5 * (lo + hi)
-
-
-TRUTH = When("estimator", "truth_feedback", (1,))
-
-
-def in_mode(mode, **also):
-    """Conditions: the mission in `mode` and each further output of the manager at its value."""
-    return (When("mission", "mode", (mode,)),) + tuple(When("mission", k, (v,)) for k, v in also.items())
-
-
-def maneuver_modes():
-    """The 15 ms attitude phases, each twice: with truth feedback (no sensors) and with estimation."""
-    modes = []
-    for name, phase in (("detumble", Phase.DETUMBLE), ("slew", Phase.SLEW), ("burn", Phase.BURN)):
-        when = in_mode(Mode.DEORBIT, phase=phase)
-        modes.append(ScheduleMode(f"{name}_truth", MANEUVER_STEP, maneuver_active(name, truth=True), 20,
-                                  when + (TRUTH,), maneuver_every(name, truth=True)))
-        modes.append(ScheduleMode(name, MANEUVER_STEP, maneuver_active(name), 20, when, maneuver_every(name)))
-    return modes
-
-
-def system(orbit_fmu):
-    comps = [(name, orbit_fmu if fmu == ORBIT else fmu, files) for name, (fmu, files, _) in COMPONENTS.items()]
-    conns = [("host", "heartbeat", "mission", "heartbeat", 0),
-             ("ground", "visible", "mission", "ground_contact", 0),
-             ("ground", "ground_command", "mission", "ground_command", 0),
-             ("detumble", "done", "mission", "detumble_done", 0),
-             ("slew", "done", "mission", "slew_done", 0),
-             ("propulsion", "budget_spent", "mission", "budget_spent", 0),
-             ("power", "state_of_charge", "mission", "state_of_charge", 0),
-             ("orbit", "reentered", "mission", "reentered", 0),
-             ("orbit", "r_BN_N", "ground", "r_BN_N", 3),
-             ("mission", "burn_enable", "propulsion", "burn_enable", 0),
-             ("propulsion", "F_thrust_B", "orbit", "F_thrust_B", 3),
-             ("propulsion", "mass", "orbit", "mass", 0),
-             ("dynamics", "q_BN", "orbit", "q_BN", 4),
-             ("orbit", "r_BN_N", "guidance", "r_BN_N", 3),
-             ("orbit", "v_BN_N", "guidance", "v_BN_N", 3),
-             ("guidance", "q_target_BN", "slew", "q_target_BN", 4),
-             ("guidance", "omega_target_B", "slew", "omega_target_B", 3),
-             ("guidance", "q_target_BN", "tracking", "q_target_BN", 4),
-             ("guidance", "omega_target_B", "tracking", "omega_target_B", 3),
-             ("estimator", "omega_est_B", "detumble", "omega_BN_B", 3),
-             ("estimator", "omega_dot_est_B", "detumble", "omega_dot_BN_B", 3),
-             ("estimator", "q_est_BN", "slew", "q_BN", 4),
-             ("estimator", "omega_est_B", "slew", "omega_BN_B", 3),
-             ("estimator", "q_est_BN", "tracking", "q_BN", 4),
-             ("estimator", "omega_est_B", "tracking", "omega_BN_B", 3),
-             ("estimator", "sigma_attitude", "tracking", "sigma_attitude_B", 3),
-             ("mission", "detumble_enable", "detumble", "enabled", 0),
-             ("mission", "slew_enable", "slew", "enabled", 0),
-             ("mission", "tracking_enable", "tracking", "enabled", 0),
-             ("mission", "detumble_enable", "selector", "detumble_enable", 0),
-             ("mission", "slew_enable", "selector", "slew_enable", 0),
-             ("mission", "tracking_enable", "selector", "tracking_enable", 0),
-             ("detumble", "torque_cmd_B", "selector", "torque_cmd_detumble_B", 3),
-             ("slew", "torque_cmd_B", "selector", "torque_cmd_slew_B", 3),
-             ("tracking", "torque_cmd_B", "selector", "torque_cmd_tracking_B", 3),
-             ("selector", "torque_cmd_B", "thrusters", "torque_cmd_B", 3),
-             ("thrusters", "propellant_mass", "propulsion", "rcs_propellant", 0),
-             ("propulsion", "burning", "thrusters", "axial_firing", 0),
-             ("thrusters", "axial_off_time", "propulsion", "axial_off_time", 0),
-             ("thrusters", "torque_B", "dynamics", "torque_B", 3),
-             # mass properties that follow the tank, the thrusters' force on the orbit (issue 28)
-             ("propulsion", "propellant_used", "dynamics", "propellant_used", 0),
-             ("thrusters", "propellant_mass", "dynamics", "rcs_propellant", 0),
-             ("propulsion", "propellant_used", "thrusters", "propellant_used", 0),
-             ("thrusters", "impulse_B", "orbit", "impulse_B", 3),
-             ("mission", "data_recording", "data", "data_recording", 0),
-             ("mission", "downlink_enable", "data", "downlink_enable", 0),
-             ("ground", "visible", "data", "ground_contact", 0),
-             # attitude knowledge
-             ("orbit", "r_BN_N", "shadow", "r_BN_N", 3),
-             ("sun", "r_SN_N", "shadow", "r_SN_N", 3),
-             ("orbit", "r_BN_N", "gps", "r_BN_N", 3),
-             ("orbit", "r_BN_N", "horizon", "r_BN_N", 3),
-             ("dynamics", "q_BN", "horizon", "q_BN", 4),
-             ("sun", "r_SN_N", "sun_sensor", "r_SN_N", 3),
-             ("orbit", "r_BN_N", "sun_sensor", "r_BN_N", 3),
-             ("dynamics", "q_BN", "sun_sensor", "q_BN", 4),
-             ("shadow", "orbit_day", "sun_sensor", "sunlit", 0),
-             ("sun", "r_SN_N", "coarse_sun", "r_SN_N", 3),
-             ("orbit", "r_BN_N", "coarse_sun", "r_BN_N", 3),
-             ("dynamics", "q_BN", "coarse_sun", "q_BN", 4),
-             ("shadow", "orbit_day", "coarse_sun", "sunlit", 0),
-             ("coarse_sun", "sun_B", "estimator", "coarse_sun_B", 3),
-             ("coarse_sun", "valid", "estimator", "coarse_sun_valid", 0),
-             ("dynamics", "omega_BN_B", "gyro", "omega_BN_B", 3),
-             ("gyro", "omega_meas_B", "thrusters", "omega_meas_B", 3),
-             ("horizon", "nadir_B", "estimator", "nadir_B", 3),
-             ("horizon", "valid", "estimator", "nadir_valid", 0),
-             ("sun_sensor", "sun_B", "estimator", "sun_B", 3),
-             ("sun_sensor", "valid", "estimator", "sun_valid", 0),
-             ("gyro", "omega_meas_B", "estimator", "omega_meas_B", 3),
-             ("gps", "r_meas_N", "estimator", "r_BN_N", 3),
-             ("sun", "r_SN_N", "estimator", "r_SN_N", 3),
-             ("selector", "torque_cmd_B", "estimator", "torque_cmd_B", 3),
-             ("dynamics", "q_BN", "estimator", "q_true_BN", 4),
-             ("dynamics", "omega_BN_B", "estimator", "omega_true_B", 3),
-             ("dynamics", "omega_dot_BN_B", "estimator", "omega_dot_true_B", 3),
-             ("estimator", "attitude_valid", "mission", "attitude_valid", 0)]
-    conns += [("mission", name, "power", name, 0) for name in LOAD_NAMES]
-    return {
-        "description": f"NEIGHBOR mission from deployment to re-entry ({orbit_fmu} orbit): operating modes, "
-                       "heartbeat, ground contact, de-orbit attitude control and burn, power, data. Correct at the "
-                       "fixed 15 ms step; years of coasting need the mode-dependent steps of the "
-                       "org.neighbor-cosim.master annotation (nc:Schedule)",
-        "components": comps,
-        "connections": conns,
-        "parameters": {name: (about, targets) for name, (about, _, targets) in SPACECRAFT_PARAMETERS.items()},
-        "parameter_bindings": ["mission_spacecraft"],
-        "stop": [("orbit", "reentered")],
-        "order": ORDER,
-        "stop_time": 40.0 * YEAR,
-        # The fixed step a master without our nc:Schedule runs at (and `--no-schedule`): the 15 ms of
-        # the attitude loop, which every phase is correct at. The schedule only saves the steps.
-        "step_size": MANEUVER_STEP,
-        "schedule": Schedule(modes=(
-            *maneuver_modes(),
-            ScheduleMode("determination_truth", 1.0, having("bus"), 10, in_mode(Mode.DEORBIT) + (TRUTH,)),
-            ScheduleMode("determination", DETERMINATION_STEP, determination_active(), 10, in_mode(Mode.DEORBIT),
-                         determination_every()),
-            ScheduleMode("contact", 1.0, having("bus"), 10, in_mode(Mode.CONTACT)),
-            ScheduleMode("awaiting_near", 5.0, having("bus"), 12,
-                         in_mode(Mode.AWAITING) + (When("ground", "near_contact", (1,)),)),
-            ScheduleMode("awaiting", FAR_STEP, having("bus"), 1, in_mode(Mode.AWAITING)),
-            ScheduleMode("monitoring_near", 10.0, having("monitor"), 6,
-                         in_mode(Mode.MONITORING) + (When("ground", "near_contact", (1,)),)),
-            ScheduleMode("monitoring", FAR_STEP, having("monitor"), 1, in_mode(Mode.MONITORING)),
-            ScheduleMode("decay", DAY, having("decay"), 1, in_mode(Mode.END)),
-            ScheduleMode("idle", 6 * 3600.0, having("idle"), 4)),
-            events=(("mission", "next_event_time"), ("host", "next_event_time"))),
-    }
 
 
 def generate(writer):
@@ -495,7 +241,7 @@ def generate(writer):
     writer.ssv("mission_spacecraft",
                "The spacecraft's physical values, each once: system parameters handed to every component that uses "
                "them (the system's parameter connections)",
-               {name: value for name, (_, value, _) in SPACECRAFT_PARAMETERS.items()})
+               SPACECRAFT_VALUES)
     writer.ssv(GNC_SETS["thesis"],
                "The thesis' guidance and control (its published numbers): thrust along -v whatever the attitude, "
                "identity slew target, tracking at the Eq. 67 rate latched at the burn start, single-sample stop "
@@ -540,7 +286,7 @@ def generate(writer):
                    f"{MISSION_EPOCH}, at {h0:g} km when the de-orbit starts ({DEORBIT_EPOCH})",
                    {"orbit.sma0": R_EQ + takeover_altitudes[name] * KM,
                    "propulsion.propellant_budget": budget[name]})
-    for orbit, name in MISSION_SYSTEMS.items():
-        writer.ssd(name, system(ORBIT_FMUS[orbit]))
+    for name in MISSION_SYSTEMS.values():
+        write_system(writer, name)
     for name in SCENARIOS:
         writer.ssv_copy(scenario_set(cowell, name), scenario_set(averaged, name))

@@ -27,6 +27,7 @@ from components.attitude import sun_avoidance as sa
 from components.mission.neighbor import SPACECRAFT
 
 from ...ssp.writer import vec
+from .from_spec import write_system
 
 NAME = "sun_avoidance_slew"
 BORESIGHT = (0.0, 0.0, 1.0)
@@ -71,32 +72,6 @@ TRACKER = {**vec("Kp", list(rt.DEFAULT_KP)), **vec("Kd", list(rt.DEFAULT_KD)), *
            "quantize": False, "angle_tol": math.radians(0.1), "rate_tol": math.radians(0.01)}
 INITIAL = {**vec("q0", list(Q0)), **vec("omega0", [0.0] * 3), "integrator": "rk4"}
 
-SYSTEM = {
-    "description": "Sun-avoidance slew: SAS guidance, reference-tracking PD + feed-forward controller, rigid body "
-                   "(ideal continuous torque)",
-    "components": [("guidance", "SunAvoidanceGuidance", [f"{NAME}_guidance"]),
-                   ("tracker", "ReferenceTrackingController", [f"{NAME}_tracker"]),
-                   ("dynamics", "RigidBody", [f"{NAME}_initial_state", "spacecraft"])],
-    "connections": [("guidance", "q_ref_BN", "tracker", "q_ref_BN", 4),
-                    ("guidance", "omega_ref_BN_B", "tracker", "omega_ref_BN_B", 3),
-                    ("guidance", "torque_ff_B", "tracker", "torque_ff_B", 3),
-                    ("guidance", "done", "tracker", "guidance_done", 0),
-                    ("dynamics", "q_BN", "tracker", "q_BN", 4),
-                    ("dynamics", "omega_BN_B", "tracker", "omega_BN_B", 3),
-                    ("tracker", "torque_cmd_B", "dynamics", "torque_B", 3),
-                    ("dynamics", "q_BN", "guidance", "q_BN", 4)],  # checked against guidance.q0 at the start
-    # The initial attitude, given once: the guidance plans from it and the rigid body starts there
-    # (two separate values once let the flown boresight pass 0.85 deg from the Sun).
-    "parameters": {f"initial_attitude[{i}]": (f"Initial attitude q_BN, scalar last (component {i})",
-                                              [("guidance", f"q0[{i}]"), ("dynamics", f"q0[{i}]")])
-                   for i in (1, 2, 3, 4)},
-    "parameter_bindings": [f"{NAME}_initial_attitude"],
-    "stop": [("tracker", "done")],
-    "order": ["tracker", "dynamics", "guidance"],
-    "stop_time": 600.0,
-    "step_size": 0.05,
-}
-
 
 def scenario(sun):
     g = {f"guidance.{k}": v for k, v in vec("sun_N", sun).items()}
@@ -121,4 +96,4 @@ def generate(writer):
                "Sun opposite the direct path's midpoint: single eigenaxis slew", scenario(sun_far()))
     writer.ssv(f"{NAME}_initial_attitude", "Initial attitude q_BN of the guidance and the rigid body, given once",
                vec("initial_attitude", list(Q0)))
-    writer.ssd(NAME, SYSTEM)
+    write_system(writer, NAME)

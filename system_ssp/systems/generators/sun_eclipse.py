@@ -21,6 +21,7 @@ from components.orbit import circular
 from components.core import constants
 from components.environment import eclipse, sun
 from components.core import time_utils
+from .from_spec import write_system
 
 EPOCH = time_utils.DEFAULT_EPOCH
 ORBIT = {"altitude": 420e3, "inclination": math.radians(51.6), "raan": 0.0, "arg_latitude0": 0.0,
@@ -43,20 +44,6 @@ def dawn_dusk():
             "orbit.raan": (ra + math.pi / 2) % (2 * math.pi), "orbit.arg_latitude0": 0.0}
 
 
-SYSTEM = {
-    "description": "Circular orbit, Sun ephemeris and conical Earth shadow: sunlit fraction, umbra, penumbra, "
-                   "orbit day",
-    "components": [("orbit", "CircularOrbit", ["sun_eclipse_orbit"]),
-                   ("sun", "SunEphemeris", ["sun_eclipse_epoch"]),
-                   ("shadow", "EarthShadow", ["sun_eclipse_shadow"])],
-    "connections": [("orbit", "r_BN_N", "shadow", "r_BN_N", 3),
-                    ("sun", "r_SN_N", "shadow", "r_SN_N", 3)],
-    "order": ["orbit", "sun", "shadow"],
-    "stop_time": math.ceil(2 * PERIOD / STEP) * STEP,  # two orbits: 11160 s
-    "step_size": STEP,
-}
-
-
 def generate(writer):
     writer.ssv("sun_eclipse_orbit",
                "Circular orbit of the sun_eclipse system: 420 km, 51.6 deg, RAAN 0, u0 0 (SI units)", ORBIT)
@@ -67,4 +54,4 @@ def generate(writer):
     writer.ssv("sun_eclipse_dawn_dusk",
                "Scenario: 700 km Sun-synchronous dawn-dusk orbit facing the Sun at the epoch (no eclipse)",
                dawn_dusk())
-    writer.ssd("sun_eclipse", SYSTEM)
+    write_system(writer, "sun_eclipse")

@@ -20,6 +20,7 @@ Parameter files (system_ssp/systems/parameters/):
 from components.core import rotations
 
 from ...ssp.writer import vec
+from .from_spec import write_system
 
 AU = 149597870700.0  # m
 # Sun about 1 au away, off every axis; spacecraft in a low Earth orbit position.
@@ -36,16 +37,6 @@ SCENARIOS = {
                        {**vec("dynamics.omega0", [SPIN_X, 0.0, 0.0])}),
 }
 
-SYSTEM = {
-    "description": "Sunline from ephemeris: a spinning rigid body's attitude quaternion feeds the Sun heading in B",
-    "components": [("dynamics", "RigidBody", ["sunline_initial_state", "spacecraft"]),
-                   ("sunline", "SunlineEphemeris", ["sunline_ephemeris"])],
-    "connections": [("dynamics", "q_BN", "sunline", "q_BN", 4)],
-    "order": ["dynamics", "sunline"],
-    "stop_time": 20.0,
-    "step_size": 0.1,
-}
-
 
 def generate(writer):
     writer.ssv("sunline_ephemeris",
@@ -55,4 +46,4 @@ def generate(writer):
                "spin 0.1 rad/s about body z", INITIAL_STATE)
     for name, (description, values) in SCENARIOS.items():
         writer.ssv(name, description, values)
-    writer.ssd("sunline", SYSTEM)
+    write_system(writer, "sunline")

@@ -1,0 +1,630 @@
+"""A system spec (TOML): the components of a system, their parameter values and files, the
+connections (by identical names, or spelled out with optional transformations), the master's
+settings and what is recorded; `compose` turns it into an SSP 1.0 system that `write_ssp` packs
+with its FMUs and parameter sets, loaded by the master before it is kept.
+
+    [system]
+    name = "my_detumble"
+    description = "Our rigid body and thrusters with our own controller"
+
+    [master]
+    step_size = 0.015
+    stop_time = 20.0
+    stop_when = ["controller.done"]
+
+    [components.dynamics]
+    fmu = "RigidBody"                          # a shipped FMU by name, or a path to any .fmu
+    parameter_files = ["spacecraft"]           # a shipped parameter set by name, or a path to an .ssv
+    parameters = { omega0 = [0.17, 0.17, 0.17], integrator = "rk4" }
+
+    [connections]
+    auto = true                                # an output feeds the inputs of the same name
+    exclude = ["dynamics.omega_dot_BN_B"]      # names (fnmatch patterns) never wired by name
+    links = ["controller.torque_cmd_B -> thrusters.torque_cmd_B",
+             { from = "a.angle_deg", to = "b.angle", factor = 0.0174533 }]
+
+docs/compose.md describes every key. Errors name the spec, its line, the key and what is
+allowed (with close matches), before anything is written.
+"""
+from dataclasses import dataclass, field
+import fnmatch
+import math
+from pathlib import Path
+import re
+import sys
+from typing import Any, Dict, List, Optional, Tuple
+
+from fmpy import read_model_description
+
+from ..errors import SSPError
+from ..limits import read_text_input
+from ..master.names import near
+from .schedule import Schedule, ScheduleMode, When
+from .toml_lines import KeyLines
+
+if sys.version_info >= (3, 11):
+    import tomllib
+else:  # pragma: no cover - Python 3.10 and older
+    import tomli as tomllib
+
+TOP_KEYS = {"extends", "system", "master", "components", "system_parameters", "connections"}
+SYSTEM_KEYS = {"name", "description", "ssp_version", "parameter_files"}
+MASTER_KEYS = {"step_size", "stop_time", "algorithm", "order", "stop_when", "record", "schedule"}
+SCHEDULE_KEYS = {"mode", "events"}
+MODE_KEYS = {"name", "step_size", "active", "record_every", "every", "when"}
+COMPONENT_KEYS = {"fmu", "parameter_files", "parameters"}
+SYSTEM_PARAMETER_KEYS = {"description", "value", "to"}
+CONNECTION_KEYS = {"auto", "exclude", "links"}
+LINK_KEYS = {"from", "to", "factor", "offset", "suppress_unit_conversion"}
+ALGORITHMS = ("gauss-seidel", "jacobi")
+SSP_VERSIONS = ("1.0", "2.0")
+NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
+# a component's name; dots for the components of a nested system as the master names them (outer.inner)
+COMPONENT_NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*(\.[A-Za-z_][A-Za-z0-9_]*)*$")
+STARTABLE = ("parameter", "input")  # what a spec may give a value
+
+
+@dataclass
+class ComponentSpec:
+    name: str
+    fmu: str  # as the spec gives it
+    fmu_path: Path
+    parameter_files: List[Tuple[str, Path]]  # (stem in the SSP's parameters/, file)
+    parameters: Dict[str, Any]  # variable name (vectors expanded) -> value
+    line: Optional[int]
+    variables: Dict[str, Any] = field(default_factory=dict)  # name -> fmpy ScalarVariable
+    units: Dict[str, Any] = field(default_factory=dict)  # unit name -> BaseUnit
+    model_identifier: str = ""
+
+
+@dataclass
+class LinkSpec:
+    src: str
+    src_var: str
+    dst: str
+    dst_var: str
+    factor: Optional[float] = None
+    offset: Optional[float] = None
+    suppress: bool = False
+    how: str = "link"  # "link" (spelled out) or "name" (wired by identical names)
+
+
+@dataclass
+class Composition:
+    """What a spec composes to: the SystemWriter spec dict, the files the .ssp holds besides the
+    SSD, and the report of what was wired by name and what stays unconnected."""
+    name: str
+    spec_path: Path
+    components: Dict[str, ComponentSpec]
+    links: List[LinkSpec]
+    writer_spec: Dict[str, Any]
+    ssv_files: Dict[str, Any]  # parameters/<stem>.ssv -> source Path, or (description, {name: value})
+    ssp_version: str
+    unconnected: List[Tuple[str, str, Any, str]]  # (component, variable, start, unit)
+    unused: List[Tuple[str, str]]  # outputs that feed nothing
+
+    def report(self) -> str:
+        by_name = [lk for lk in self.links if lk.how == "name"]
+        out = [f"{self.name}: {len(self.components)} components, {len(self.links)} connections "
+               f"({len(by_name)} by identical names)"]
+        if by_name:
+            out.append("wired by name:")
+            out += [f"  {a} -> {b}" for a, b in _grouped([(f"{lk.src}.{lk.src_var}", f"{lk.dst}.{lk.dst_var}")
+                                                           for lk in by_name])]
+        if self.unconnected:
+            out.append(f"inputs left unconnected ({len(self.unconnected)}), at their start values:")
+            for comp, var, start, unit in self.unconnected:
+                shown = "no start value" if start is None else f"{start}" + (f" {unit}" if unit else "")
+                out.append(f"  {comp}.{var} = {shown}")
+        if self.unused:
+            out.append(f"outputs that feed nothing ({len(self.unused)}):")
+            out += [f"  {a}" for a, _ in _grouped([(f"{c}.{v}", "") for c, v in self.unused])]
+        return "\n".join(out)
+
+
+def _grouped(pairs):
+    """[(a[1], b[1]), (a[2], b[2]), ...] -> [(a[1..n], b[1..n])]: a vector on one line (b may
+    be "" throughout)."""
+    index = re.compile(r"^(.*)\[(\d+)\]$")
+    groups: List[list] = []  # [a base, first, last, b base, b first] or [a, None, None, b, None]
+    for a, b in pairs:
+        ma, mb = index.match(a), index.match(b)
+        g = groups[-1] if groups else None
+        if g and ma and g[1] is not None and g[0] == ma.group(1) and g[2] + 1 == int(ma.group(2)) \
+                and ((not b and not g[3]) or (mb and g[3] == mb.group(1))):
+            g[2] += 1
+            continue
+        if ma and (mb or not b):
+            groups.append([ma.group(1), int(ma.group(2)), int(ma.group(2)), mb.group(1) if mb else "",
+                           int(mb.group(2)) if mb else 0])
+        else:
+            groups.append([a, None, None, b, None])
+    out = []
+    for a, first, last, b, bfirst in groups:
+        if first is None:
+            out.append((a, b))
+        elif first == last:
+            out.append((f"{a}[{first}]", f"{b}[{bfirst}]" if b else ""))
+        else:
+            out.append((f"{a}[{first}..{last}]", f"{b}[{bfirst}..{bfirst + last - first}]" if b else ""))
+    return out
+
+
+class SpecReader:
+    """Reads one spec file (and the one it extends) and says where a key is."""
+
+    def __init__(self, path: Path):
+        self.path = Path(path)
+        self.doc, self.lines = self._read(self.path, ())
+
+    def _read(self, path, seen):
+        text = read_text_input(path, str(path), "the system spec", "a system spec is TOML, which is UTF-8: save it "
+                               "as UTF-8")
+        try:
+            doc = tomllib.loads(text)
+        except tomllib.TOMLDecodeError as exc:
+            line = re.search(r"line (\d+)", str(exc))
+            raise SSPError(f"{path}{':' + line.group(1) if line else ''}: not valid TOML: {exc}") from None
+        lines = KeyLines(text)
+        base = doc.pop("extends", None)
+        if base is None:
+            return doc, lines
+        where = f"{path}:{lines.line('extends')}"
+        if not isinstance(base, str) or not base.endswith(".toml"):
+            raise SSPError(f"{where}: extends = {base!r}: expected the path of another system spec (.toml)")
+        base_path = (path.parent / base) if not Path(base).is_absolute() else Path(base)
+        if not base_path.is_file():
+            raise SSPError(f"{where}: extends = {base!r}: no such file ({base_path})")
+        if base_path.resolve() in seen or base_path.resolve() == path.resolve():
+            raise SSPError(f"{where}: extends = {base!r}: the specs extend each other in a cycle")
+        base_doc, _ = self._read(base_path, seen + (path.resolve(),))
+        return _merged(base_doc, doc), lines
+
+    def where(self, *key: str) -> str:
+        line = self.lines.line(*key)
+        return f"{self.path}:{line}" if line else str(self.path)
+
+    def fail(self, key: Tuple[str, ...], message: str) -> SSPError:
+        return SSPError(f"{self.where(*key)}: {'.'.join(key)}: {message}")
+
+    def table(self, key: Tuple[str, ...], value: Any, allowed: set) -> Dict[str, Any]:
+        if not isinstance(value, dict):
+            raise self.fail(key, f"expected a table (keys: {', '.join(sorted(allowed))})")
+        for k in value:
+            if k not in allowed:
+                raise SSPError(f"{self.where(*key, k)}: {'.'.join(key + (k,))}: unknown key{near(k, allowed)}; "
+                               f"allowed: {', '.join(sorted(allowed))}")
+        return value
+
+    def strings(self, key: Tuple[str, ...], value: Any) -> List[str]:
+        if not isinstance(value, list) or not all(isinstance(v, str) and v for v in value):
+            raise self.fail(key, f"{value!r}: expected a list of strings")
+        return list(value)
+
+    def number(self, key: Tuple[str, ...], value: Any, positive: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value) \
+                or (positive and value <= 0):
+            raise self.fail(key, f"{value!r}: expected a finite number{' > 0' if positive else ''}")
+        return float(value)
+
+
+def _merged(base, over):
+    """`over`'s tables over `base`'s, key by key (values and lists replaced)."""
+    out = dict(base)
+    for k, v in over.items():
+        out[k] = _merged(out[k], v) if isinstance(v, dict) and isinstance(out.get(k), dict) else v
+    return out
+
+
+def shipped_fmu_names(fmu_dir: Path) -> List[str]:
+    return sorted(p.stem for p in Path(fmu_dir).glob("*.fmu"))
+
+
+def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
+    """Read and check the spec at `spec_path`. Shipped FMUs are `fmu_dir/<name>.fmu`, shipped
+    parameter sets `parameters_dir/<name>.ssv`. SSPError (file:line: key: what is allowed) on
+    anything the system could not be written from."""
+    r = SpecReader(Path(spec_path))
+    doc = r.doc
+    for k in doc:
+        if k not in TOP_KEYS:
+            raise SSPError(f"{r.where(k)}: unknown table or key {k!r}{near(k, TOP_KEYS)}; allowed: "
+                           f"{', '.join(sorted(TOP_KEYS))}")
+    system = r.table(("system",), doc.get("system"), SYSTEM_KEYS)
+    name = system.get("name")
+    if not isinstance(name, str) or not NAME.match(name):
+        raise r.fail(("system", "name"), f"{name!r}: expected a name of letters, digits and _ (not starting with a "
+                     "digit)")
+    description = system.get("description", "")
+    if not isinstance(description, str):
+        raise r.fail(("system", "description"), "expected a string")
+    version = system.get("ssp_version", "1.0")
+    if version not in SSP_VERSIONS:
+        raise r.fail(("system", "ssp_version"), f"{version!r}: expected one of {', '.join(SSP_VERSIONS)}")
+    ssv_files: Dict[str, Any] = {}
+    base = Path(spec_path).parent
+
+    def parameter_file(key, entry):
+        if entry.endswith(".ssv"):
+            path = Path(entry) if Path(entry).is_absolute() else base / entry
+            if not path.is_file():
+                raise r.fail(key, f"{entry!r}: no such file ({path})")
+            stem = path.stem
+        else:
+            path = parameters_dir / f"{entry}.ssv"
+            if not path.is_file():
+                known = sorted(p.stem for p in parameters_dir.glob("*.ssv"))
+                raise r.fail(key, f"{entry!r}: no shipped parameter set of that name{near(entry, known)}; give a "
+                             "path to an .ssv file (ending in .ssv) or a shipped set's name")
+            stem = entry
+        previous = ssv_files.get(stem)
+        if previous is not None and Path(previous).resolve() != path.resolve():
+            raise r.fail(key, f"{entry!r}: another parameter file of the spec has the name {stem}.ssv ({previous})")
+        ssv_files[stem] = path
+        return stem, path
+
+    components: Dict[str, ComponentSpec] = {}
+    comps_doc = doc.get("components")
+    if not isinstance(comps_doc, dict) or not comps_doc:
+        raise SSPError(f"{r.where('components')}: a system spec needs [components.<name>] tables (fmu = ...)")
+    shipped = shipped_fmu_names(fmu_dir)
+    for cname, c in comps_doc.items():
+        key = ("components", cname)
+        if not COMPONENT_NAME.match(cname):
+            raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit)")
+        c = r.table(key, c, COMPONENT_KEYS)
+        fmu = c.get("fmu")
+        if not isinstance(fmu, str) or not fmu:
+            raise r.fail(key + ("fmu",), f"{fmu!r}: expected a shipped FMU's name ({', '.join(shipped)}) or the path "
+                         "of an .fmu file")
+        if fmu.lower().endswith(".fmu"):
+            path = Path(fmu) if Path(fmu).is_absolute() else base / fmu
+            if not path.is_file():
+                raise r.fail(key + ("fmu",), f"{fmu!r}: no such file ({path})")
+        else:
+            if fmu not in shipped:
+                raise r.fail(key + ("fmu",), f"{fmu!r}: no shipped FMU of that name{near(fmu, shipped)}; give a path "
+                             "ending in .fmu for any other FMU")
+            path = fmu_dir / f"{fmu}.fmu"
+        files = [parameter_file(key + ("parameter_files",), e)
+                 for e in r.strings(key + ("parameter_files",), c.get("parameter_files", []))]
+        comp = ComponentSpec(name=cname, fmu=fmu, fmu_path=path, parameter_files=files, parameters={},
+                             line=r.lines.line(*key))
+        _read_fmu(r, key, comp)
+        values = c.get("parameters", {})
+        if not isinstance(values, dict):
+            raise r.fail(key + ("parameters",), "expected a table of variable = value")
+        for var, value in values.items():
+            comp.parameters.update(_start_values(r, key + ("parameters", var), comp, var, value))
+        components[cname] = comp
+    resources = _resource_names(components)
+
+    def endpoint(key, text, causality):
+        """'comp.var' -> (component, [variable names]) (a vector name gives its elements)."""
+        if not isinstance(text, str) or "." not in text:
+            raise r.fail(key, f"{text!r}: expected 'component.variable'")
+        cname, var = text.split(".", 1)
+        for known in sorted(components, key=len, reverse=True):  # the longest name wins (a.b.x: a.b's x)
+            if text.startswith(known + "."):
+                cname, var = known, text[len(known) + 1:]
+                break
+        if cname not in components:
+            raise r.fail(key, f"{text!r}: unknown component {cname!r}{near(cname, components)} (components: "
+                         f"{', '.join(components)})")
+        comp = components[cname]
+        names = _elements(comp, var)
+        if not names:
+            candidates = [v.name for v in comp.variables.values() if v.causality in causality]
+            raise r.fail(key, f"{text!r}: {comp.fmu} has no {' or '.join(causality)} {var!r}{near(var, candidates)}")
+        bad = [n for n in names if comp.variables[n].causality not in causality]
+        if bad:
+            raise r.fail(key, f"{text!r}: {cname}.{bad[0]} is {comp.variables[bad[0]].causality}, expected "
+                         f"{' or '.join(causality)}")
+        return cname, names
+
+    # ---- system parameters: one value handed to parameters of several components -------------
+    sys_params: Dict[str, Tuple[str, List[Tuple[str, str]]]] = {}
+    sys_values: Dict[str, Any] = {}
+    for pname, p in (doc.get("system_parameters") or {}).items():
+        key = ("system_parameters", pname)
+        p = r.table(key, p, SYSTEM_PARAMETER_KEYS)
+        targets = []
+        for k, t in enumerate(r.strings(key + ("to",), p.get("to", []))):
+            cname, names = endpoint(key + ("to",), t, ("parameter",))
+            targets += [(cname, n) for n in names]
+        if not targets:
+            raise r.fail(key + ("to",), "expected the parameters it sets: to = [\"component.parameter\", ...]")
+        sys_params[pname] = (str(p.get("description", pname)), targets)
+        if "value" in p:
+            sys_values[pname] = p["value"]
+    system_files = [parameter_file(("system", "parameter_files"), e)[0]
+                    for e in r.strings(("system", "parameter_files"), system.get("parameter_files", []))]
+
+    # ---- connections -------------------------------------------------------------------------
+    conn_doc = r.table(("connections",), doc.get("connections", {}), CONNECTION_KEYS)
+    auto = conn_doc.get("auto", True)
+    if not isinstance(auto, bool):
+        raise r.fail(("connections", "auto"), f"{auto!r}: expected true or false")
+    exclude = r.strings(("connections", "exclude"), conn_doc.get("exclude", []))
+    links: List[LinkSpec] = []
+    fed: Dict[Tuple[str, str], str] = {}
+    raw_links = conn_doc.get("links", [])
+    if not isinstance(raw_links, list):
+        raise r.fail(("connections", "links"), "expected a list of \"a.x -> b.y\" strings or { from, to } tables")
+    for k, item in enumerate(raw_links):
+        key = ("connections", "links")
+        if isinstance(item, str):
+            a, arrow, b = item.partition("->")
+            if not arrow:
+                raise r.fail(key, f"{item!r}: expected \"component.output -> component.input\"")
+            item = {"from": a.strip(), "to": b.strip()}
+        if not isinstance(item, dict):
+            raise r.fail(key, f"{item!r}: expected \"a.x -> b.y\" or {{ from = \"a.x\", to = \"b.y\" }}")
+        for kk in item:
+            if kk not in LINK_KEYS:
+                raise r.fail(key, f"unknown key {kk!r} in a link{near(kk, LINK_KEYS)}; allowed: "
+                             f"{', '.join(sorted(LINK_KEYS))}")
+        where = key + (f"[{k + 1}]",)
+        src, outs = endpoint(where, item.get("from"), ("output",))
+        dst, ins = endpoint(where, item.get("to"), ("input",))
+        if len(outs) != len(ins):
+            raise r.fail(where, f"{item['from']} has {len(outs)} element(s), {item['to']} {len(ins)}")
+        factor = r.number(where + ("factor",), item["factor"]) if "factor" in item else None
+        offset = r.number(where + ("offset",), item["offset"]) if "offset" in item else None
+        suppress = item.get("suppress_unit_conversion", False)
+        if not isinstance(suppress, bool):
+            raise r.fail(where + ("suppress_unit_conversion",), "expected true or false")
+        for o, i in zip(outs, ins):
+            _check_types(r, where, components, src, o, dst, i, factor is not None or offset is not None)
+            if (dst, i) in fed:
+                raise r.fail(where, f"{dst}.{i} is already fed by {fed[(dst, i)]}: an input takes one connection")
+            fed[(dst, i)] = f"{src}.{o}"
+            links.append(LinkSpec(src, o, dst, i, factor, offset, suppress))
+    targets = {t for _, ts in sys_params.values() for t in ts}
+
+    def excluded(cname, var):
+        base_name = var.split("[", 1)[0]
+        return any(fnmatch.fnmatchcase(f"{cname}.{var}", pat) or fnmatch.fnmatchcase(f"{cname}.{base_name}", pat)
+                   for pat in exclude)
+
+    if auto:
+        outputs: Dict[str, List[Tuple[str, Any]]] = {}
+        for cname, comp in components.items():
+            for v in comp.variables.values():
+                if v.causality == "output" and not excluded(cname, v.name):
+                    outputs.setdefault(v.name, []).append((cname, v))
+        for cname, comp in components.items():
+            for v in comp.variables.values():
+                if v.causality != "input" or (cname, v.name) in fed or excluded(cname, v.name):
+                    continue
+                sources = [(s, sv) for s, sv in outputs.get(v.name, []) if s != cname and sv.type == v.type]
+                if len(sources) > 1:
+                    raise SSPError(f"{r.where('connections')}: {cname}.{v.name}: several outputs of that name could "
+                                   f"feed it ({', '.join(f'{s}.{v.name}' for s, _ in sources)}); link one in "
+                                   "connections.links or exclude the others in connections.exclude")
+                if sources:
+                    src = sources[0][0]
+                    fed[(cname, v.name)] = f"{src}.{v.name}"
+                    links.append(LinkSpec(src, v.name, cname, v.name, how="name"))
+
+    # ---- master ------------------------------------------------------------------------------
+    m = r.table(("master",), doc.get("master"), MASTER_KEYS)
+    for need in ("step_size", "stop_time"):
+        if need not in m:
+            raise SSPError(f"{r.where('master')}: [master] needs {need} (seconds)")
+    step = r.number(("master", "step_size"), m["step_size"], positive=True)
+    stop = r.number(("master", "stop_time"), m["stop_time"], positive=True)
+    algorithm = m.get("algorithm", "gauss-seidel")
+    if algorithm not in ALGORITHMS:
+        raise r.fail(("master", "algorithm"), f"{algorithm!r}: expected one of {', '.join(ALGORITHMS)}"
+                     f"{near(str(algorithm), ALGORITHMS)}")
+    order = r.strings(("master", "order"), m.get("order", []))
+    for c in order:
+        if c not in components:
+            raise r.fail(("master", "order"), f"{c!r}: unknown component{near(c, components)}")
+    missing = [c for c in components if c not in order]
+    if order and missing:
+        raise r.fail(("master", "order"), f"leaves out {', '.join(missing)}: the order lists every component once")
+    stop_when = []
+    for s in r.strings(("master", "stop_when"), m.get("stop_when", [])):
+        cname, names = endpoint(("master", "stop_when"), s, ("output",))
+        if components[cname].variables[names[0]].type != "Boolean":
+            raise r.fail(("master", "stop_when"), f"{s!r}: a stop condition is a Boolean output")
+        stop_when.append((cname, names[0]))
+    record = []
+    for s in r.strings(("master", "record"), m.get("record", [])):
+        cname, names = endpoint(("master", "record"), s, ("output", "input", "parameter", "local"))
+        record += [f"{cname}.{n}" for n in names]
+    schedule = _schedule(r, m.get("schedule"), components, endpoint) if "schedule" in m else None
+
+    # ---- what the writer needs ---------------------------------------------------------------
+    for cname, comp in components.items():
+        if comp.parameters:
+            stem = f"{name}.{cname}"
+            ssv_files[stem] = (f"{cname}'s parameters from {Path(spec_path).name}", comp.parameters)
+            comp.parameter_files.append((stem, Path(stem + ".ssv")))
+    if sys_values:
+        unknown = sorted(set(sys_values) - set(sys_params))
+        if unknown:
+            raise r.fail(("system_parameters", unknown[0]), "has a value but no targets")
+        typed = {}
+        for pname, value in sys_values.items():
+            comp_name, var = sys_params[pname][1][0]
+            typed[pname] = _typed(r, ("system_parameters", pname, "value"), components[comp_name].variables[var],
+                                  value)
+        ssv_files[name] = (f"{name}'s system parameters from {Path(spec_path).name}", typed)
+        system_files = system_files + [name]
+    writer_spec = {
+        "description": description,
+        "components": [(c.name, resources[c.name], [stem for stem, _ in c.parameter_files])
+                       for c in components.values()],
+        "connections": [(lk.src, lk.src_var, lk.dst, lk.dst_var, 0) + ((_transform(lk),) if _transform(lk) else ())
+                        for lk in links],
+        "stop_time": stop,
+        "step_size": step,
+    }
+    if algorithm != "gauss-seidel":
+        writer_spec["algorithm"] = algorithm
+    if sys_params:
+        writer_spec["parameters"] = sys_params
+    if system_files:
+        writer_spec["parameter_bindings"] = system_files
+    if stop_when:
+        writer_spec["stop"] = stop_when
+    if order:
+        writer_spec["order"] = order
+    if schedule is not None:
+        writer_spec["schedule"] = schedule
+    if record:
+        writer_spec["record"] = record
+    unconnected = []
+    for cname, comp in components.items():
+        given = {n for n in comp.parameters}
+        for v in comp.variables.values():
+            if v.causality == "input" and (cname, v.name) not in fed and (cname, v.name) not in targets:
+                unconnected.append((cname, v.name, comp.parameters.get(v.name, v.start) if v.name in given else v.start,
+                                    getattr(v, "unit", None) or ""))
+    used = {(lk.src, lk.src_var) for lk in links}
+    unused = [(cname, v.name) for cname, comp in components.items() for v in comp.variables.values()
+              if v.causality == "output" and (cname, v.name) not in used]
+    return Composition(name=name, spec_path=Path(spec_path), components=components, links=links,
+                       writer_spec=writer_spec, ssv_files=ssv_files, ssp_version=version, unconnected=unconnected,
+                       unused=unused)
+
+
+def _read_fmu(r, key, comp):
+    try:
+        md = read_model_description(str(comp.fmu_path), validate=False)
+    except Exception as exc:  # fmpy raises several kinds for a file that is not an FMU
+        raise r.fail(key + ("fmu",), f"{comp.fmu_path}: not an FMU that can be read ({exc})") from None
+    if md.coSimulation is None:
+        raise r.fail(key + ("fmu",), f"{comp.fmu_path}: has no co-simulation interface (model exchange only)")
+    comp.model_identifier = md.coSimulation.modelIdentifier
+    comp.variables = {v.name: v for v in md.modelVariables}
+    comp.units = {u.name: u.baseUnit for u in md.unitDefinitions}
+
+
+def _elements(comp, var):
+    """The variable names `var` stands for: itself, or its elements var[1], var[2], ..."""
+    if var in comp.variables:
+        return [var]
+    names = []
+    while f"{var}[{len(names) + 1}]" in comp.variables:
+        names.append(f"{var}[{len(names) + 1}]")
+    return names
+
+
+def _typed(r, key, v, value):
+    """`value` in the type of FMU variable `v` (an int for a Real becomes a float)."""
+    t = v.type
+    ok = {"Real": lambda x: isinstance(x, (int, float)) and not isinstance(x, bool),
+          "Integer": lambda x: isinstance(x, int) and not isinstance(x, bool),
+          "Enumeration": lambda x: isinstance(x, int) and not isinstance(x, bool),
+          "Boolean": lambda x: isinstance(x, bool),
+          "String": lambda x: isinstance(x, str)}.get(t)
+    if ok is None or not ok(value):
+        raise r.fail(key, f"{value!r}: {v.name} is {t}, expected a value of that type")
+    return float(value) if t == "Real" else value
+
+
+def _start_values(r, key, comp, var, value):
+    names = _elements(comp, var)
+    if not names:
+        candidates = [v.name.split("[", 1)[0] for v in comp.variables.values() if v.causality in STARTABLE]
+        raise r.fail(key, f"{comp.fmu} has no parameter or input {var!r}{near(var, sorted(set(candidates)))}")
+    values = value if isinstance(value, list) else [value]
+    if len(names) != len(values) or (len(names) > 1 and not isinstance(value, list)):
+        raise r.fail(key, f"{var} has {len(names)} element(s), the spec gives {len(values)}")
+    out = {}
+    for n, x in zip(names, values):
+        v = comp.variables[n]
+        if v.causality not in STARTABLE or v.variability == "constant":
+            raise r.fail(key, f"{n} is {v.variability} {v.causality}: only parameters and inputs take a value")
+        out[n] = _typed(r, key, v, x)
+    return out
+
+
+def _check_types(r, key, components, src, o, dst, i, transformed):
+    a, b = components[src].variables[o], components[dst].variables[i]
+    if a.type != b.type and {a.type, b.type} != {"Integer", "Enumeration"}:
+        raise r.fail(key, f"{src}.{o} is {a.type}, {dst}.{i} is {b.type}: a connection joins one type")
+    if transformed and a.type != "Real":
+        raise r.fail(key, f"{src}.{o} is {a.type}: factor and offset apply to Real connections")
+
+
+def _transform(lk):
+    if lk.factor is None and lk.offset is None and not lk.suppress:
+        return None
+    return {"factor": 1.0 if lk.factor is None else lk.factor, "offset": 0.0 if lk.offset is None else lk.offset,
+            "suppress": lk.suppress, "linear": lk.factor is not None or lk.offset is not None}
+
+
+def _resource_names(components):
+    """resources/<name>.fmu for each component: a shipped FMU's own name, another FMU's model
+    identifier (made unique when two different files share one)."""
+    taken: Dict[str, Path] = {}
+    out = {}
+    for cname, comp in components.items():
+        base = comp.model_identifier if comp.fmu.lower().endswith(".fmu") else comp.fmu
+        base = re.sub(r"[^A-Za-z0-9_]", "_", base) or "fmu"
+        stem, k = base, 1
+        while stem in taken and taken[stem].resolve() != comp.fmu_path.resolve():
+            k += 1
+            stem = f"{base}_{k}"
+        taken[stem] = comp.fmu_path
+        out[cname] = stem
+    return out
+
+
+def _schedule(r, s, components, endpoint):
+    key = ("master", "schedule")
+    s = r.table(key, s, SCHEDULE_KEYS)
+    modes_doc = s.get("mode")
+    if not isinstance(modes_doc, list) or not modes_doc:
+        raise r.fail(key, "expected [[master.schedule.mode]] tables (name, step_size, when, ...)")
+    modes = []
+    for k, md in enumerate(modes_doc):
+        mkey = key + ("mode", str(k))
+        md = r.table(mkey, md, MODE_KEYS)
+        name = md.get("name")
+        if not isinstance(name, str) or not name:
+            raise r.fail(mkey + ("name",), "a mode needs a name")
+        step = r.number(mkey + ("step_size",), md.get("step_size"), positive=True)
+        active = md.get("active")
+        if active is not None:
+            active = tuple(r.strings(mkey + ("active",), active))
+            for c in active:
+                if c not in components:
+                    raise r.fail(mkey + ("active",), f"{c!r}: unknown component{near(c, components)}")
+        every_doc = md.get("every", {})
+        if not isinstance(every_doc, dict):
+            raise r.fail(mkey + ("every",), "expected a table component = k")
+        every = {}
+        for c, n in every_doc.items():
+            if c not in components:
+                raise r.fail(mkey + ("every",), f"{c!r}: unknown component{near(c, components)}")
+            if isinstance(n, bool) or not isinstance(n, int) or n < 1:
+                raise r.fail(mkey + ("every", c), f"{n!r}: expected an integer >= 1")
+            every[c] = n
+        record_every = md.get("record_every", 1)
+        if isinstance(record_every, bool) or not isinstance(record_every, int) or record_every < 1:
+            raise r.fail(mkey + ("record_every",), f"{record_every!r}: expected an integer >= 1")
+        when_doc = md.get("when", {})
+        if not isinstance(when_doc, dict):
+            raise r.fail(mkey + ("when",), "expected a table \"component.signal\" = [values]")
+        conditions = []
+        for signal, values in when_doc.items():
+            cname, names = endpoint(mkey + ("when",), signal, ("output", "parameter", "input", "local"))
+            values = values if isinstance(values, list) else [values]
+            if not values or not all(isinstance(x, (int, bool)) for x in values):
+                raise r.fail(mkey + ("when", signal), f"{values!r}: expected integers or true/false")
+            conditions.append(When(cname, names[0], tuple(int(x) for x in values)))
+        if not conditions and k != len(modes_doc) - 1:
+            raise r.fail(mkey + ("when",), f"mode {name!r} has no condition, so it always matches: only the last "
+                         "mode may have none")
+        modes.append(ScheduleMode(name, step, active, record_every, tuple(conditions), every))
+    events = []
+    for e in r.strings(key + ("events",), s.get("events", [])):
+        cname, names = endpoint(key + ("events",), e, ("output",))
+        events.append((cname, names[0]))
+    return Schedule(modes=tuple(modes), events=tuple(events))
