@@ -184,8 +184,12 @@ class SpecReader:
         line = self.lines.line(*key)
         return f"{self.path}:{line}" if line else str(self.path)
 
+    at_line: Optional[int] = None  # while set, messages name this line
+
     def fail(self, key: Tuple[str, ...], message: str) -> SSPError:
-        return SSPError(f"{self.where(*key)}: {'.'.join(key)}: {message}")
+        where = f"{self.path}:{self.at_line}" if self.at_line else self.where(*key)
+        return SSPError(f"{where}: {'.'.join(k for k in key if not k.startswith('['))}"
+                        f"{''.join(k for k in key if k.startswith('['))}: {message}")
 
     def table(self, key: Tuple[str, ...], value: Any, allowed: set) -> Dict[str, Any]:
         if not isinstance(value, dict):
@@ -224,87 +228,132 @@ def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
     """Read and check the spec at `spec_path`. Shipped FMUs are `fmu_dir/<name>.fmu`, shipped
     parameter sets `parameters_dir/<name>.ssv`. SSPError (file:line: key: what is allowed) on
     anything the system could not be written from."""
-    r = SpecReader(Path(spec_path))
-    doc = r.doc
-    for k in doc:
-        if k not in TOP_KEYS:
-            raise SSPError(f"{r.where(k)}: unknown table or key {k!r}{near(k, TOP_KEYS)}; allowed: "
-                           f"{', '.join(sorted(TOP_KEYS))}")
-    system = r.table(("system",), doc.get("system"), SYSTEM_KEYS)
-    name = system.get("name")
-    if not isinstance(name, str) or not NAME.match(name):
-        raise r.fail(("system", "name"), f"{name!r}: expected a name of letters, digits and _ (not starting with a "
-                     "digit)")
-    description = system.get("description", "")
-    if not isinstance(description, str):
-        raise r.fail(("system", "description"), "expected a string")
-    version = system.get("ssp_version", "1.0")
-    if version not in SSP_VERSIONS:
-        raise r.fail(("system", "ssp_version"), f"{version!r}: expected one of {', '.join(SSP_VERSIONS)}")
-    ssv_files: Dict[str, Any] = {}
-    base = Path(spec_path).parent
+    return _Composer(Path(spec_path), Path(fmu_dir), Path(parameters_dir)).composition()
 
-    def parameter_file(key, entry):
+
+class _Composer:
+    """One spec's composition, table by table."""
+
+    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir: Path):
+        self.spec_path, self.fmu_dir, self.parameters_dir = spec_path, fmu_dir, parameters_dir
+        self.r = r = SpecReader(spec_path)
+        for k in r.doc:
+            if k not in TOP_KEYS:
+                raise SSPError(f"{r.where(k)}: unknown table or key {k!r}{near(k, TOP_KEYS)}; allowed: "
+                               f"{', '.join(sorted(TOP_KEYS))}")
+        self.ssv_files: Dict[str, Any] = {}
+        self.components: Dict[str, ComponentSpec] = {}
+        self.links: List[LinkSpec] = []
+        self.fed: Dict[Tuple[str, str], str] = {}
+
+    def composition(self) -> Composition:
+        r = self.r
+        system = r.table(("system",), r.doc.get("system"), SYSTEM_KEYS)
+        name = system.get("name")
+        if not isinstance(name, str) or not NAME.match(name):
+            raise r.fail(("system", "name"), f"{name!r}: expected a name of letters, digits and _ (not starting "
+                         "with a digit)")
+        description = system.get("description", "")
+        if not isinstance(description, str):
+            raise r.fail(("system", "description"), "expected a string")
+        version = system.get("ssp_version", "1.0")
+        if version not in SSP_VERSIONS:
+            raise r.fail(("system", "ssp_version"), f"{version!r}: expected one of {', '.join(SSP_VERSIONS)}")
+        self.read_components()
+        sys_params, sys_values = self.system_parameters()
+        system_files = [self.parameter_file(("system", "parameter_files"), e)[0]
+                        for e in r.strings(("system", "parameter_files"), system.get("parameter_files", []))]
+        self.read_links()
+        targets = {t for _, ts in sys_params.values() for t in ts}
+        self.auto_links(targets)
+        writer_spec = {"description": description, **self.master()}
+        for cname, comp in self.components.items():
+            if comp.parameters:
+                stem = f"{name}.{cname}"
+                self.ssv_files[stem] = (f"{cname}'s parameters from {self.spec_path.name}", comp.parameters)
+                comp.parameter_files.append((stem, Path(stem + ".ssv")))
+        if sys_values:
+            self.ssv_files[name] = (f"{name}'s system parameters from {self.spec_path.name}", sys_values)
+            system_files = system_files + [name]
+        resources = _resource_names(self.components)
+        writer_spec["components"] = [(c.name, resources[c.name], [stem for stem, _ in c.parameter_files])
+                                     for c in self.components.values()]
+        writer_spec["connections"] = [(lk.src, lk.src_var, lk.dst, lk.dst_var, 0)
+                                      + ((_transform(lk),) if _transform(lk) else ()) for lk in self.links]
+        if sys_params:
+            writer_spec["parameters"] = sys_params
+        if system_files:
+            writer_spec["parameter_bindings"] = system_files
+        unconnected, unused = self.loose_ends(targets)
+        return Composition(name=name, spec_path=self.spec_path, components=self.components, links=self.links,
+                           writer_spec=writer_spec, ssv_files=self.ssv_files, ssp_version=version,
+                           unconnected=unconnected, unused=unused)
+
+    def parameter_file(self, key, entry):
+        """(stem, path) of a parameter file entry: a path ending in .ssv, or a shipped set's name."""
+        r = self.r
         if entry.endswith(".ssv"):
-            path = Path(entry) if Path(entry).is_absolute() else base / entry
+            path = Path(entry) if Path(entry).is_absolute() else self.spec_path.parent / entry
             if not path.is_file():
                 raise r.fail(key, f"{entry!r}: no such file ({path})")
             stem = path.stem
         else:
-            path = parameters_dir / f"{entry}.ssv"
+            path = self.parameters_dir / f"{entry}.ssv"
             if not path.is_file():
-                known = sorted(p.stem for p in parameters_dir.glob("*.ssv"))
+                known = sorted(p.stem for p in self.parameters_dir.glob("*.ssv"))
                 raise r.fail(key, f"{entry!r}: no shipped parameter set of that name{near(entry, known)}; give a "
                              "path to an .ssv file (ending in .ssv) or a shipped set's name")
             stem = entry
-        previous = ssv_files.get(stem)
+        previous = self.ssv_files.get(stem)
         if previous is not None and Path(previous).resolve() != path.resolve():
             raise r.fail(key, f"{entry!r}: another parameter file of the spec has the name {stem}.ssv ({previous})")
-        ssv_files[stem] = path
+        self.ssv_files[stem] = path
         return stem, path
 
-    components: Dict[str, ComponentSpec] = {}
-    comps_doc = doc.get("components")
-    if not isinstance(comps_doc, dict) or not comps_doc:
-        raise SSPError(f"{r.where('components')}: a system spec needs [components.<name>] tables (fmu = ...)")
-    shipped = shipped_fmu_names(fmu_dir)
-    for cname, c in comps_doc.items():
-        key = ("components", cname)
-        if not COMPONENT_NAME.match(cname):
-            raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit)")
-        c = r.table(key, c, COMPONENT_KEYS)
-        fmu = c.get("fmu")
-        if not isinstance(fmu, str) or not fmu:
-            raise r.fail(key + ("fmu",), f"{fmu!r}: expected a shipped FMU's name ({', '.join(shipped)}) or the path "
-                         "of an .fmu file")
-        if fmu.lower().endswith(".fmu"):
-            path = Path(fmu) if Path(fmu).is_absolute() else base / fmu
-            if not path.is_file():
-                raise r.fail(key + ("fmu",), f"{fmu!r}: no such file ({path})")
-        else:
-            if fmu not in shipped:
+    def read_components(self):
+        r = self.r
+        comps_doc = r.doc.get("components")
+        if not isinstance(comps_doc, dict) or not comps_doc:
+            raise SSPError(f"{r.where('components')}: a system spec needs [components.<name>] tables (fmu = ...)")
+        shipped = shipped_fmu_names(self.fmu_dir)
+        for cname, c in comps_doc.items():
+            key = ("components", cname)
+            if not COMPONENT_NAME.match(cname):
+                raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit)")
+            c = r.table(key, c, COMPONENT_KEYS)
+            fmu = c.get("fmu")
+            if not isinstance(fmu, str) or not fmu:
+                raise r.fail(key + ("fmu",), f"{fmu!r}: expected a shipped FMU's name ({', '.join(shipped)}) or the "
+                             "path of an .fmu file")
+            if fmu.lower().endswith(".fmu"):
+                path = Path(fmu) if Path(fmu).is_absolute() else self.spec_path.parent / fmu
+                if not path.is_file():
+                    raise r.fail(key + ("fmu",), f"{fmu!r}: no such file ({path})")
+            elif fmu in shipped:
+                path = self.fmu_dir / f"{fmu}.fmu"
+            else:
                 raise r.fail(key + ("fmu",), f"{fmu!r}: no shipped FMU of that name{near(fmu, shipped)}; give a path "
                              "ending in .fmu for any other FMU")
-            path = fmu_dir / f"{fmu}.fmu"
-        files = [parameter_file(key + ("parameter_files",), e)
-                 for e in r.strings(key + ("parameter_files",), c.get("parameter_files", []))]
-        comp = ComponentSpec(name=cname, fmu=fmu, fmu_path=path, parameter_files=files, parameters={},
-                             line=r.lines.line(*key))
-        _read_fmu(r, key, comp)
-        values = c.get("parameters", {})
-        if not isinstance(values, dict):
-            raise r.fail(key + ("parameters",), "expected a table of variable = value")
-        for var, value in values.items():
-            comp.parameters.update(_start_values(r, key + ("parameters", var), comp, var, value))
-        components[cname] = comp
-    resources = _resource_names(components)
+            files = [self.parameter_file(key + ("parameter_files",), e)
+                     for e in r.strings(key + ("parameter_files",), c.get("parameter_files", []))]
+            comp = ComponentSpec(name=cname, fmu=fmu, fmu_path=path, parameter_files=files, parameters={},
+                                 line=r.lines.line(*key))
+            _read_fmu(r, key, comp)
+            values = c.get("parameters", {})
+            if not isinstance(values, dict):
+                raise r.fail(key + ("parameters",), "expected a table of variable = value")
+            for var, value in values.items():
+                comp.parameters.update(_start_values(r, key + ("parameters", var), comp, var, value))
+            self.components[cname] = comp
 
-    def endpoint(key, text, causality):
-        """'comp.var' -> (component, [variable names]) (a vector name gives its elements)."""
+    def endpoint(self, key, text, causality):
+        """'comp.var' -> (component, [variable names]) (a vector name gives its elements); the
+        longest component name that prefixes `text` wins (a.b.x: component a.b's x)."""
+        r, components = self.r, self.components
         if not isinstance(text, str) or "." not in text:
             raise r.fail(key, f"{text!r}: expected 'component.variable'")
         cname, var = text.split(".", 1)
-        for known in sorted(components, key=len, reverse=True):  # the longest name wins (a.b.x: a.b's x)
+        for known in sorted(components, key=len, reverse=True):
             if text.startswith(known + "."):
                 cname, var = known, text[len(known) + 1:]
                 break
@@ -314,7 +363,7 @@ def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
         comp = components[cname]
         names = _elements(comp, var)
         if not names:
-            candidates = [v.name for v in comp.variables.values() if v.causality in causality]
+            candidates = sorted({v.name.split("[", 1)[0] for v in comp.variables.values() if v.causality in causality})
             raise r.fail(key, f"{text!r}: {comp.fmu} has no {' or '.join(causality)} {var!r}{near(var, candidates)}")
         bad = [n for n in names if comp.variables[n].causality not in causality]
         if bad:
@@ -322,51 +371,62 @@ def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
                          f"{' or '.join(causality)}")
         return cname, names
 
-    # ---- system parameters: one value handed to parameters of several components -------------
-    sys_params: Dict[str, Tuple[str, List[Tuple[str, str]]]] = {}
-    sys_values: Dict[str, Any] = {}
-    for pname, p in (doc.get("system_parameters") or {}).items():
-        key = ("system_parameters", pname)
-        p = r.table(key, p, SYSTEM_PARAMETER_KEYS)
-        targets = []
-        for k, t in enumerate(r.strings(key + ("to",), p.get("to", []))):
-            cname, names = endpoint(key + ("to",), t, ("parameter",))
-            targets += [(cname, n) for n in names]
-        if not targets:
-            raise r.fail(key + ("to",), "expected the parameters it sets: to = [\"component.parameter\", ...]")
-        sys_params[pname] = (str(p.get("description", pname)), targets)
-        if "value" in p:
-            sys_values[pname] = p["value"]
-    system_files = [parameter_file(("system", "parameter_files"), e)[0]
-                    for e in r.strings(("system", "parameter_files"), system.get("parameter_files", []))]
+    def system_parameters(self):
+        """{name: (description, [(component, parameter)])} and {name: value} of [system_parameters]."""
+        r = self.r
+        params: Dict[str, Tuple[str, List[Tuple[str, str]]]] = {}
+        values: Dict[str, Any] = {}
+        doc = r.doc.get("system_parameters") or {}
+        if not isinstance(doc, dict):
+            raise r.fail(("system_parameters",), "expected [system_parameters.<name>] tables")
+        for pname, p in doc.items():
+            key = ("system_parameters", pname)
+            p = r.table(key, p, SYSTEM_PARAMETER_KEYS)
+            targets = []
+            for t in r.strings(key + ("to",), p.get("to", [])):
+                cname, names = self.endpoint(key + ("to",), t, ("parameter",))
+                targets += [(cname, n) for n in names]
+            if not targets:
+                raise r.fail(key + ("to",), "expected the parameters it sets: to = [\"component.parameter\", ...]")
+            params[pname] = (str(p.get("description", pname)), targets)
+            if "value" in p:
+                cname, var = targets[0]
+                values[pname] = _typed(r, key + ("value",), self.components[cname].variables[var], p["value"])
+        return params, values
 
-    # ---- connections -------------------------------------------------------------------------
-    conn_doc = r.table(("connections",), doc.get("connections", {}), CONNECTION_KEYS)
-    auto = conn_doc.get("auto", True)
-    if not isinstance(auto, bool):
-        raise r.fail(("connections", "auto"), f"{auto!r}: expected true or false")
-    exclude = r.strings(("connections", "exclude"), conn_doc.get("exclude", []))
-    links: List[LinkSpec] = []
-    fed: Dict[Tuple[str, str], str] = {}
-    raw_links = conn_doc.get("links", [])
-    if not isinstance(raw_links, list):
-        raise r.fail(("connections", "links"), "expected a list of \"a.x -> b.y\" strings or { from, to } tables")
-    for k, item in enumerate(raw_links):
-        key = ("connections", "links")
-        if isinstance(item, str):
-            a, arrow, b = item.partition("->")
-            if not arrow:
-                raise r.fail(key, f"{item!r}: expected \"component.output -> component.input\"")
-            item = {"from": a.strip(), "to": b.strip()}
-        if not isinstance(item, dict):
-            raise r.fail(key, f"{item!r}: expected \"a.x -> b.y\" or {{ from = \"a.x\", to = \"b.y\" }}")
-        for kk in item:
-            if kk not in LINK_KEYS:
-                raise r.fail(key, f"unknown key {kk!r} in a link{near(kk, LINK_KEYS)}; allowed: "
-                             f"{', '.join(sorted(LINK_KEYS))}")
-        where = key + (f"[{k + 1}]",)
-        src, outs = endpoint(where, item.get("from"), ("output",))
-        dst, ins = endpoint(where, item.get("to"), ("input",))
+    def read_links(self):
+        r = self.r
+        conn_doc = r.table(("connections",), r.doc.get("connections", {}), CONNECTION_KEYS)
+        raw = conn_doc.get("links", [])
+        if not isinstance(raw, list):
+            raise r.fail(("connections", "links"), "expected a list of \"a.x -> b.y\" strings or { from, to } tables")
+        for k, item in enumerate(raw):
+            key = ("connections", "links")
+            if isinstance(item, str):
+                a, arrow, b = item.partition("->")
+                if not arrow:
+                    raise r.fail(key, f"{item!r}: expected \"component.output -> component.input\"")
+                item = {"from": a.strip(), "to": b.strip()}
+            if not isinstance(item, dict):
+                raise r.fail(key, f"{item!r}: expected \"a.x -> b.y\" or {{ from = \"a.x\", to = \"b.y\" }}")
+            for kk in item:
+                if kk not in LINK_KEYS:
+                    raise r.fail(key, f"unknown key {kk!r} in a link{near(kk, LINK_KEYS)}; allowed: "
+                                 f"{', '.join(sorted(LINK_KEYS))}")
+            line = r.lines.line_of_text(str(item.get("from")), r.lines.line(*key)) or r.lines.line(*key)
+            self.add_link(key + (f"[{k + 1}]",), item, line)
+
+    def add_link(self, where, item, line):
+        self.r.at_line = line  # a message about a link names the link's own line
+        try:
+            self._add_link(where, item)
+        finally:
+            self.r.at_line = None
+
+    def _add_link(self, where, item):
+        r = self.r
+        src, outs = self.endpoint(where, item.get("from"), ("output",))
+        dst, ins = self.endpoint(where, item.get("to"), ("input",))
         if len(outs) != len(ins):
             raise r.fail(where, f"{item['from']} has {len(outs)} element(s), {item['to']} {len(ins)}")
         factor = r.number(where + ("factor",), item["factor"]) if "factor" in item else None
@@ -375,121 +435,101 @@ def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
         if not isinstance(suppress, bool):
             raise r.fail(where + ("suppress_unit_conversion",), "expected true or false")
         for o, i in zip(outs, ins):
-            _check_types(r, where, components, src, o, dst, i, factor is not None or offset is not None)
-            if (dst, i) in fed:
-                raise r.fail(where, f"{dst}.{i} is already fed by {fed[(dst, i)]}: an input takes one connection")
-            fed[(dst, i)] = f"{src}.{o}"
-            links.append(LinkSpec(src, o, dst, i, factor, offset, suppress))
-    targets = {t for _, ts in sys_params.values() for t in ts}
+            _check_types(r, where, self.components, src, o, dst, i, factor is not None or offset is not None)
+            if (dst, i) in self.fed:
+                raise r.fail(where, f"{dst}.{i} is already fed by {self.fed[(dst, i)]}: an input takes one "
+                             "connection")
+            self.fed[(dst, i)] = f"{src}.{o}"
+            self.links.append(LinkSpec(src, o, dst, i, factor, offset, suppress))
 
-    def excluded(cname, var):
-        base_name = var.split("[", 1)[0]
-        return any(fnmatch.fnmatchcase(f"{cname}.{var}", pat) or fnmatch.fnmatchcase(f"{cname}.{base_name}", pat)
-                   for pat in exclude)
+    def auto_links(self, targets):
+        """Each input not linked, not excluded and not a system parameter's target, fed by the one
+        output of another component with its name (several: refused, naming them)."""
+        r = self.r
+        conn_doc = r.doc.get("connections", {})
+        auto = conn_doc.get("auto", True)
+        if not isinstance(auto, bool):
+            raise r.fail(("connections", "auto"), f"{auto!r}: expected true or false")
+        exclude = r.strings(("connections", "exclude"), conn_doc.get("exclude", []))
+        if not auto:
+            return
 
-    if auto:
+        def excluded(cname, var):
+            plain = var.split("[", 1)[0]
+            return any(fnmatch.fnmatchcase(f"{cname}.{var}", p) or fnmatch.fnmatchcase(f"{cname}.{plain}", p)
+                       for p in exclude)
+
         outputs: Dict[str, List[Tuple[str, Any]]] = {}
-        for cname, comp in components.items():
+        for cname, comp in self.components.items():
             for v in comp.variables.values():
                 if v.causality == "output" and not excluded(cname, v.name):
                     outputs.setdefault(v.name, []).append((cname, v))
-        for cname, comp in components.items():
+        for cname, comp in self.components.items():
             for v in comp.variables.values():
-                if v.causality != "input" or (cname, v.name) in fed or excluded(cname, v.name):
+                if v.causality != "input" or (cname, v.name) in self.fed or (cname, v.name) in targets \
+                        or excluded(cname, v.name):
                     continue
-                sources = [(s, sv) for s, sv in outputs.get(v.name, []) if s != cname and sv.type == v.type]
+                sources = [s for s, sv in outputs.get(v.name, []) if s != cname and sv.type == v.type]
                 if len(sources) > 1:
                     raise SSPError(f"{r.where('connections')}: {cname}.{v.name}: several outputs of that name could "
-                                   f"feed it ({', '.join(f'{s}.{v.name}' for s, _ in sources)}); link one in "
+                                   f"feed it ({', '.join(f'{s}.{v.name}' for s in sources)}); link one in "
                                    "connections.links or exclude the others in connections.exclude")
                 if sources:
-                    src = sources[0][0]
-                    fed[(cname, v.name)] = f"{src}.{v.name}"
-                    links.append(LinkSpec(src, v.name, cname, v.name, how="name"))
+                    self.fed[(cname, v.name)] = f"{sources[0]}.{v.name}"
+                    self.links.append(LinkSpec(sources[0], v.name, cname, v.name, how="name"))
 
-    # ---- master ------------------------------------------------------------------------------
-    m = r.table(("master",), doc.get("master"), MASTER_KEYS)
-    for need in ("step_size", "stop_time"):
-        if need not in m:
-            raise SSPError(f"{r.where('master')}: [master] needs {need} (seconds)")
-    step = r.number(("master", "step_size"), m["step_size"], positive=True)
-    stop = r.number(("master", "stop_time"), m["stop_time"], positive=True)
-    algorithm = m.get("algorithm", "gauss-seidel")
-    if algorithm not in ALGORITHMS:
-        raise r.fail(("master", "algorithm"), f"{algorithm!r}: expected one of {', '.join(ALGORITHMS)}"
-                     f"{near(str(algorithm), ALGORITHMS)}")
-    order = r.strings(("master", "order"), m.get("order", []))
-    for c in order:
-        if c not in components:
-            raise r.fail(("master", "order"), f"{c!r}: unknown component{near(c, components)}")
-    missing = [c for c in components if c not in order]
-    if order and missing:
-        raise r.fail(("master", "order"), f"leaves out {', '.join(missing)}: the order lists every component once")
-    stop_when = []
-    for s in r.strings(("master", "stop_when"), m.get("stop_when", [])):
-        cname, names = endpoint(("master", "stop_when"), s, ("output",))
-        if components[cname].variables[names[0]].type != "Boolean":
-            raise r.fail(("master", "stop_when"), f"{s!r}: a stop condition is a Boolean output")
-        stop_when.append((cname, names[0]))
-    record = []
-    for s in r.strings(("master", "record"), m.get("record", [])):
-        cname, names = endpoint(("master", "record"), s, ("output", "input", "parameter", "local"))
-        record += [f"{cname}.{n}" for n in names]
-    schedule = _schedule(r, m.get("schedule"), components, endpoint) if "schedule" in m else None
+    def master(self):
+        """The writer's master settings from [master]."""
+        r = self.r
+        m = r.table(("master",), r.doc.get("master"), MASTER_KEYS)
+        for need in ("step_size", "stop_time"):
+            if need not in m:
+                raise SSPError(f"{r.where('master')}: [master] needs {need} (seconds)")
+        out: Dict[str, Any] = {"step_size": r.number(("master", "step_size"), m["step_size"], positive=True),
+                               "stop_time": r.number(("master", "stop_time"), m["stop_time"], positive=True)}
+        algorithm = m.get("algorithm", "gauss-seidel")
+        if algorithm not in ALGORITHMS:
+            raise r.fail(("master", "algorithm"), f"{algorithm!r}: expected one of {', '.join(ALGORITHMS)}"
+                         f"{near(str(algorithm), ALGORITHMS)}")
+        if algorithm != "gauss-seidel":
+            out["algorithm"] = algorithm
+        order = r.strings(("master", "order"), m.get("order", []))
+        for c in order:
+            if c not in self.components:
+                raise r.fail(("master", "order"), f"{c!r}: unknown component{near(c, self.components)}")
+        missing = [c for c in self.components if c not in order]
+        if order and missing:
+            raise r.fail(("master", "order"), f"leaves out {', '.join(missing)}: the order lists every component")
+        stop_when = []
+        for s in r.strings(("master", "stop_when"), m.get("stop_when", [])):
+            cname, names = self.endpoint(("master", "stop_when"), s, ("output",))
+            if self.components[cname].variables[names[0]].type != "Boolean":
+                raise r.fail(("master", "stop_when"), f"{s!r}: a stop condition is a Boolean output")
+            stop_when.append((cname, names[0]))
+        record = []
+        for s in r.strings(("master", "record"), m.get("record", [])):
+            cname, names = self.endpoint(("master", "record"), s, ("output", "input", "parameter", "local"))
+            record += [f"{cname}.{n}" for n in names]
+        for key, value in (("stop", stop_when), ("order", order), ("record", record)):
+            if value:
+                out[key] = value
+        if "schedule" in m:
+            out["schedule"] = _schedule(r, m["schedule"], self.components, self.endpoint)
+        return out
 
-    # ---- what the writer needs ---------------------------------------------------------------
-    for cname, comp in components.items():
-        if comp.parameters:
-            stem = f"{name}.{cname}"
-            ssv_files[stem] = (f"{cname}'s parameters from {Path(spec_path).name}", comp.parameters)
-            comp.parameter_files.append((stem, Path(stem + ".ssv")))
-    if sys_values:
-        unknown = sorted(set(sys_values) - set(sys_params))
-        if unknown:
-            raise r.fail(("system_parameters", unknown[0]), "has a value but no targets")
-        typed = {}
-        for pname, value in sys_values.items():
-            comp_name, var = sys_params[pname][1][0]
-            typed[pname] = _typed(r, ("system_parameters", pname, "value"), components[comp_name].variables[var],
-                                  value)
-        ssv_files[name] = (f"{name}'s system parameters from {Path(spec_path).name}", typed)
-        system_files = system_files + [name]
-    writer_spec = {
-        "description": description,
-        "components": [(c.name, resources[c.name], [stem for stem, _ in c.parameter_files])
-                       for c in components.values()],
-        "connections": [(lk.src, lk.src_var, lk.dst, lk.dst_var, 0) + ((_transform(lk),) if _transform(lk) else ())
-                        for lk in links],
-        "stop_time": stop,
-        "step_size": step,
-    }
-    if algorithm != "gauss-seidel":
-        writer_spec["algorithm"] = algorithm
-    if sys_params:
-        writer_spec["parameters"] = sys_params
-    if system_files:
-        writer_spec["parameter_bindings"] = system_files
-    if stop_when:
-        writer_spec["stop"] = stop_when
-    if order:
-        writer_spec["order"] = order
-    if schedule is not None:
-        writer_spec["schedule"] = schedule
-    if record:
-        writer_spec["record"] = record
-    unconnected = []
-    for cname, comp in components.items():
-        given = {n for n in comp.parameters}
-        for v in comp.variables.values():
-            if v.causality == "input" and (cname, v.name) not in fed and (cname, v.name) not in targets:
-                unconnected.append((cname, v.name, comp.parameters.get(v.name, v.start) if v.name in given else v.start,
-                                    getattr(v, "unit", None) or ""))
-    used = {(lk.src, lk.src_var) for lk in links}
-    unused = [(cname, v.name) for cname, comp in components.items() for v in comp.variables.values()
-              if v.causality == "output" and (cname, v.name) not in used]
-    return Composition(name=name, spec_path=Path(spec_path), components=components, links=links,
-                       writer_spec=writer_spec, ssv_files=ssv_files, ssp_version=version, unconnected=unconnected,
-                       unused=unused)
+    def loose_ends(self, targets):
+        """(inputs nothing feeds, with their start values; outputs that feed nothing)."""
+        unconnected = []
+        for cname, comp in self.components.items():
+            for v in comp.variables.values():
+                if v.causality == "input" and (cname, v.name) not in self.fed and (cname, v.name) not in targets:
+                    unit = getattr(v, "unit", None) or ""
+                    unconnected.append((cname, v.name, comp.parameters.get(v.name, v.start),
+                                        "" if unit == "1" else unit))
+        used = {(lk.src, lk.src_var) for lk in self.links}
+        unused = [(cname, v.name) for cname, comp in self.components.items() for v in comp.variables.values()
+                  if v.causality == "output" and (cname, v.name) not in used]
+        return unconnected, unused
 
 
 def _read_fmu(r, key, comp):

@@ -56,6 +56,8 @@ def ssv_text(name, description, params):
 def connector_xml(var):
     if var.type == "Real":
         t = f'<ssc:Real unit="{var.unit}"/>' if var.unit else "<ssc:Real/>"
+    elif var.type == "Enumeration":  # SSP names the enumeration type (an FMU's declaredType)
+        t = f'<ssc:Enumeration name={quoteattr(var.declaredType.name if var.declaredType else "")}/>'
     else:
         t = f"<ssc:{var.type}/>"
     return f'        <ssd:Connector name={quoteattr(var.name)} kind="{var.causality}">{t}</ssd:Connector>'
@@ -163,6 +165,8 @@ class SystemWriter:
                 out.append(f'      <ssd:Connection startConnector={quoteattr(pname)} endElement="{comp}" '
                            f'endConnector={quoteattr(var)}/>')
         out.append("    </ssd:Connections>")
+        if out[-2] == "    <ssd:Connections>":  # the schema refuses an empty ssd:Connections
+            del out[-2:]
         dt = spec["step_size"]
         for comp, var in spec.get("stop", []):
             if comp_vars[comp][var].type != "Boolean" or comp_vars[comp][var].causality != "output":
@@ -178,12 +182,13 @@ class SystemWriter:
         if spec.get("record"):
             out.append(f'          <nc:Record>{escape(" ".join(spec["record"]))}</nc:Record>')
         out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
-        out.append("  <ssd:Units>")
+        out.append("  <ssd:Units>" if all_units else "")  # the schema refuses an empty ssd:Units
         for uname in sorted(all_units):
             bu = all_units[uname]
             attrs = " ".join(f'{k}="{getattr(bu, k)}"' for k in SI_BASE_UNITS if bu is not None and getattr(bu, k))
             out.append(f'    <ssc:Unit name="{uname}"><ssc:BaseUnit {attrs}/></ssc:Unit>')
-        out.append("  </ssd:Units>")
+        out.append("  </ssd:Units>" if all_units else "")
+        out = [line for line in out if line]
         # libcosim takes its fixed step from this OSP annotation (our master reads its own).
         out += [f'  <ssd:DefaultExperiment startTime="0.0" stopTime="{spec["stop_time"]!r}">',
                 "    <ssd:Annotations>",

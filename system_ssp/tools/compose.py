@@ -43,6 +43,7 @@ def _shipped_fmus(fmu_dir):
 def write_folder(composition, folder, fmu_dir):
     """The composed system as a folder: SystemStructure.ssd, parameters/, resources/."""
     folder = Path(folder)
+    folder.mkdir(parents=True, exist_ok=True)
     writer = SystemWriter(folder, fmu_dir)
     resources = {res: composition.components[c].fmu_path for c, res, _ in composition.writer_spec["components"]}
     writer.fmu_files = dict(resources)
@@ -127,6 +128,51 @@ def _grouped_values(values, variables):
     return out
 
 
+def _master_lines(s):
+    """The [master] table (and its schedule) of a loaded system."""
+    desc, m = s.desc, s.desc.master
+    lines = []
+    try:
+        step = step_size_of(s)[0]
+    except SSPError:  # the system has none: the user gives one
+        step = None
+    stop = desc.stop_time
+    lines += ["", "[master]", f"step_size = {_toml_value(float(step))}" if step is not None else
+              "# step_size = ...  (the system has none: give one)"]
+    if stop is not None:
+        lines.append(f"stop_time = {_toml_value(float(stop))}")
+    else:
+        lines.append("# stop_time = ...  (the system has none: give one)")
+    algorithm = m.algorithm or m.osp_algorithm
+    if algorithm and algorithm != "gauss-seidel":
+        lines.append(f"algorithm = {json.dumps(algorithm)}")
+    if m.order:
+        lines.append(f"order = {_toml_value(list(m.order))}")
+    if m.stop_conditions:
+        lines.append(f"stop_when = {_toml_value(list(m.stop_conditions))}")
+    if m.record:
+        lines.append(f"record = {_toml_value(list(m.record))}")
+    if m.schedule is not None:
+        if m.schedule.events:
+            lines += ["", "[master.schedule]",
+                      f"events = {_toml_value([f'{c}.{v}' for c, v in m.schedule.events])}"]
+        for mode in m.schedule.modes:
+            lines += ["", "[[master.schedule.mode]]", f"name = {json.dumps(mode.name)}",
+                      f"step_size = {_toml_value(float(mode.step_size))}"]
+            if mode.active is not None:
+                lines.append(f"active = {_toml_value(list(mode.active))}")
+            if mode.record_every != 1:
+                lines.append(f"record_every = {mode.record_every}")
+            if mode.every:
+                lines.append("every = { " + ", ".join(f"{_toml_key(c)} = {k}" for c, k in mode.every.items())
+                             + " }")
+            if mode.conditions:
+                lines.append("when = { " + ", ".join(f"{json.dumps(f'{w.component}.{w.connector}')} = "
+                                                     f"{_toml_value(list(w.values))}" for w in mode.conditions)
+                             + " }")
+    return lines
+
+
 def spec_from_system(source, out, fmu_dir=FMU_DIR):
     """Write the spec of the system at `source` to `out` (.toml) and its FMUs that are not the
     shipped ones into <out stem>_files/ beside it. Parameter values are written as the master
@@ -137,7 +183,6 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
     files_dir = out.parent / f"{out.stem}_files"
     with System(source) as s:
         desc = s.desc
-        m = desc.master
         name = re.sub(r"[^A-Za-z0-9_]", "_", desc.name or desc.system_name or "system")
         if not NAME.match(name):
             name = f"system_{name}"
@@ -146,40 +191,7 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
                  f"#   neighbor-cosim compose {out.name} --out {out.stem}.ssp",
                  "", "[system]", f"name = {json.dumps(name)}"]
         lines.append(f"description = {json.dumps(f'{desc.system_name} (from {Path(str(source)).name})')}")
-        step, _ = step_size_of(s)
-        stop = desc.stop_time
-        lines += ["", "[master]", f"step_size = {_toml_value(float(step))}"]
-        if stop is not None:
-            lines.append(f"stop_time = {_toml_value(float(stop))}")
-        else:
-            lines.append("# stop_time = ...  (the system has none: give one)")
-        algorithm = m.algorithm or m.osp_algorithm
-        if algorithm and algorithm != "gauss-seidel":
-            lines.append(f"algorithm = {json.dumps(algorithm)}")
-        if m.order:
-            lines.append(f"order = {_toml_value(list(m.order))}")
-        if m.stop_conditions:
-            lines.append(f"stop_when = {_toml_value(list(m.stop_conditions))}")
-        if m.record:
-            lines.append(f"record = {_toml_value(list(m.record))}")
-        if m.schedule is not None:
-            if m.schedule.events:
-                lines += ["", "[master.schedule]",
-                          f"events = {_toml_value([f'{c}.{v}' for c, v in m.schedule.events])}"]
-            for mode in m.schedule.modes:
-                lines += ["", "[[master.schedule.mode]]", f"name = {json.dumps(mode.name)}",
-                          f"step_size = {_toml_value(float(mode.step_size))}"]
-                if mode.active is not None:
-                    lines.append(f"active = {_toml_value(list(mode.active))}")
-                if mode.record_every != 1:
-                    lines.append(f"record_every = {mode.record_every}")
-                if mode.every:
-                    lines.append("every = { " + ", ".join(f"{_toml_key(c)} = {k}" for c, k in mode.every.items())
-                                 + " }")
-                if mode.conditions:
-                    lines.append("when = { " + ", ".join(f"{json.dumps(f'{w.component}.{w.connector}')} = "
-                                                         f"{_toml_value(list(w.values))}" for w in mode.conditions)
-                                 + " }")
+        lines += _master_lines(s)
         values = s.collect_parameters()
         shipped = {p.stem: p for p in Path(fmu_dir).glob("*.fmu")}
         copied = {}

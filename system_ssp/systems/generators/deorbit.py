@@ -78,5 +78,5 @@ def generate(writer):
     for name in SCENARIOS:
         for burn in (True, False):
             writer.ssv_copy(scenario_set(cowell, name, burn), scenario_set(averaged, name, burn))
-    for orbit, name in DEORBIT_SYSTEMS.items():
+    for name in DEORBIT_SYSTEMS.values():
         write_system(writer, name)

@@ -75,7 +75,8 @@ from components.environment import atmosphere
 from components.orbit import averaged, propulsion
 from components.core import time_utils
 from components.core.constants import DAY, R_EQ
-from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS, SPACECRAFT, scenario_set)
+from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS,
+                                         SPACECRAFT, scenario_set)
 
 from ...ssp.writer import vec
 from . import attitude_determination as ad
@@ -154,7 +155,8 @@ GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynam
 
 
 # The spacecraft's physical values, each given once (system parameters of the SSD, in
-# parameters/mission_spacecraft.ssv; the spec's [system_parameters] say which components take them): `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
+# parameters/mission_spacecraft.ssv; the spec's [system_parameters] say which components take
+# them): `--set spacecraft_mass=14` changes the rigid body, the tracking law's inertia and the
 # propulsion's initial mass together.
 SPACECRAFT_VALUES = {"spacecraft_mass": SPACECRAFT.mass, "spacecraft_edge_a": SPACECRAFT.edge_a,
                      "spacecraft_edge_b": SPACECRAFT.edge_b, "spacecraft_edge_c": SPACECRAFT.edge_c,
