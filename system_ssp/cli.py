@@ -1,5 +1,5 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `compose`, `replace`, `compare`, `flatten`, `convert`, `campaign`, `thesis`, `deorbit-study`, `mission`,
+`info`, `compose`, `export-fmu`, `replace`, `compare`, `flatten`, `convert`, `campaign`, `thesis`, `deorbit-study`, `mission`,
 `propulsion`, `validation`, `build` and `export`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
@@ -21,7 +21,7 @@ import fmpy
 
 from . import __version__, archive
 from .neighbor import deorbit_study, mission, thesis, validation
-from .tools import campaign, compose, convert, flatten, plot, release, replace
+from .tools import campaign, compose, convert, export_fmu, flatten, plot, release, replace
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
                             add_console_arguments, console_settings, parse_sets, system_path)
 from .errors import RunInterrupted, SimulationError, SSPError
@@ -37,7 +37,7 @@ from .ssp.writer import single_fmu_system
 
 APPS = {"thesis": thesis.main, "deorbit-study": deorbit_study.main, "mission": mission.main,
         "replace": replace.main_replace, "compare": replace.main_compare, "flatten": flatten.main,
-        "convert": convert.main, "compose": compose.main,
+        "convert": convert.main, "compose": compose.main, "export-fmu": export_fmu.main,
         "campaign": campaign.main, "plot": plot.main,
         "propulsion": mission.main_propulsion, "validation": validation.main, "build": release.build_main,
         "export": release.export_main}
@@ -89,6 +89,8 @@ def _parser():
                    "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
     sub.add_parser("compose", add_help=False, help="a system from a system spec (compose SPEC.toml --out X.ssp), or "
                    "the spec of a system (compose --from SYSTEM --out SPEC.toml)")
+    sub.add_parser("export-fmu", add_help=False, help="the system as one co-simulation FMU, for tools that import only "
+                   "FMUs (export-fmu SYSTEM --out X.fmu [--fmi 2|3])")
     sub.add_parser("compare", add_help=False, help="the interface differences of two FMUs (compare A.fmu B.fmu)")
     sub.add_parser("convert", add_help=False, help="the system in SSP 1.0 or 2.0, for tools that read only one "
                    "(convert SYSTEM --ssp-version 2.0 --out X.ssp)")

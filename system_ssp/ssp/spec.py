@@ -224,18 +224,20 @@ def shipped_fmu_names(fmu_dir: Path) -> List[str]:
     return sorted(p.stem for p in Path(fmu_dir).glob("*.fmu"))
 
 
-def compose(spec_path, fmu_dir: Path, parameters_dir: Path) -> Composition:
+def compose(spec_path, fmu_dir: Path, parameters_dir) -> Composition:
     """Read and check the spec at `spec_path`. Shipped FMUs are `fmu_dir/<name>.fmu`, shipped
-    parameter sets `parameters_dir/<name>.ssv`. SSPError (file:line: key: what is allowed) on
+    parameter sets `parameters_dir/<name>.ssv` (a folder, or a list of folders searched in turn). SSPError (file:line: key: what is allowed) on
     anything the system could not be written from."""
-    return _Composer(Path(spec_path), Path(fmu_dir), Path(parameters_dir)).composition()
+    return _Composer(Path(spec_path), Path(fmu_dir), parameters_dir).composition()
 
 
 class _Composer:
     """One spec's composition, table by table."""
 
-    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir: Path):
-        self.spec_path, self.fmu_dir, self.parameters_dir = spec_path, fmu_dir, parameters_dir
+    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir):
+        self.spec_path, self.fmu_dir = spec_path, fmu_dir
+        self.parameters_dirs = [Path(d) for d in (parameters_dir if isinstance(parameters_dir, (list, tuple))
+                                                  else [parameters_dir])]
         self.r = r = SpecReader(spec_path)
         for k in r.doc:
             if k not in TOP_KEYS:
@@ -298,9 +300,10 @@ class _Composer:
                 raise r.fail(key, f"{entry!r}: no such file ({path})")
             stem = path.stem
         else:
-            path = self.parameters_dir / f"{entry}.ssv"
+            path = next((d / f"{entry}.ssv" for d in self.parameters_dirs if (d / f"{entry}.ssv").is_file()),
+                        self.parameters_dirs[0] / f"{entry}.ssv")
             if not path.is_file():
-                known = sorted(p.stem for p in self.parameters_dir.glob("*.ssv"))
+                known = sorted({p.stem for d in self.parameters_dirs for p in d.glob("*.ssv")})
                 raise r.fail(key, f"{entry!r}: no shipped parameter set of that name{near(entry, known)}; give a "
                              "path to an .ssv file (ending in .ssv) or a shipped set's name")
             stem = entry
