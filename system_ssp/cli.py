@@ -1,6 +1,6 @@
 """Command line: `neighbor-cosim` (or `python -m system_ssp`) with the subcommands `run`,
-`info`, `compose`, `export-fmu`, `replace`, `compare`, `flatten`, `convert`, `campaign`, `thesis`, `deorbit-study`, `mission`,
-`propulsion`, `validation`, `build` and `export`, and `--version`.
+`info`, `compose`, `export-fmu`, `replace`, `compare`, `flatten`, `convert`, `campaign`, `thesis`,
+`deorbit-study`, `mission`, `propulsion`, `validation`, `build` and `export`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
 re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the

@@ -226,8 +226,8 @@ def shipped_fmu_names(fmu_dir: Path) -> List[str]:
 
 def compose(spec_path, fmu_dir: Path, parameters_dir) -> Composition:
     """Read and check the spec at `spec_path`. Shipped FMUs are `fmu_dir/<name>.fmu`, shipped
-    parameter sets `parameters_dir/<name>.ssv` (a folder, or a list of folders searched in turn). SSPError (file:line: key: what is allowed) on
-    anything the system could not be written from."""
+    parameter sets `parameters_dir/<name>.ssv` (a folder, or a list of folders searched in turn).
+    SSPError (file:line: key: what is allowed) on anything the system could not be written from."""
     return _Composer(Path(spec_path), Path(fmu_dir), parameters_dir).composition()
 
 
