@@ -234,8 +234,9 @@ def compose(spec_path, fmu_dir: Path, parameters_dir) -> Composition:
 class _Composer:
     """One spec's composition, table by table."""
 
-    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir):
+    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir, within=()):
         self.spec_path, self.fmu_dir = spec_path, fmu_dir
+        self.within = tuple(within) + (spec_path.resolve(),)  # the specs this one is a sub-system of
         self.parameters_dirs = [Path(d) for d in (parameters_dir if isinstance(parameters_dir, (list, tuple))
                                                   else [parameters_dir])]
         self.r = r = SpecReader(spec_path)
@@ -247,6 +248,8 @@ class _Composer:
         self.components: Dict[str, ComponentSpec] = {}
         self.links: List[LinkSpec] = []
         self.fed: Dict[Tuple[str, str], str] = {}
+        self.exclude: List[str] = []
+        self.sealed: set = set()  # (component, variable) of sub-systems that wiring by name leaves alone
 
     def composition(self) -> Composition:
         r = self.r
@@ -323,7 +326,10 @@ class _Composer:
             key = ("components", cname)
             if not COMPONENT_NAME.match(cname):
                 raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit)")
-            c = r.table(key, c, COMPONENT_KEYS)
+            c = r.table(key, c, COMPONENT_KEYS | {"system"})
+            if "system" in c:
+                self.add_subsystem(key, cname, c)
+                continue
             fmu = c.get("fmu")
             if not isinstance(fmu, str) or not fmu:
                 raise r.fail(key + ("fmu",), f"{fmu!r}: expected a shipped FMU's name ({', '.join(shipped)}) or the "
@@ -348,6 +354,73 @@ class _Composer:
             for var, value in values.items():
                 comp.parameters.update(_start_values(r, key + ("parameters", var), comp, var, value))
             self.components[cname] = comp
+
+    def add_subsystem(self, key, cname, c):
+        """A system nested as a sub-system (`system = "detumble"`, a shipped system's spec, or the
+        path of a spec): its components join this system under dotted names (cname.dynamics, as
+        the master names the components of a nested system), with their parameter files, values
+        and connections; `parameters = { "dynamics.omega0" = [..] }` changes values inside it.
+        Its master settings are not this system's."""
+        from ..systems import SPECS_DIR  # a path only: the systems package imports nothing else
+
+        r = self.r
+        if set(c) - {"system", "parameters"}:
+            raise r.fail(key, f"a sub-system (system = ...) takes only parameters beside it, not "
+                         f"{', '.join(sorted(set(c) - {'system', 'parameters'}))}")
+        ref = c["system"]
+        if not isinstance(ref, str) or not ref:
+            raise r.fail(key + ("system",), f"{ref!r}: expected a shipped system's name or the path of a spec (.toml)")
+        if ref.endswith(".toml"):
+            path = Path(ref) if Path(ref).is_absolute() else self.spec_path.parent / ref
+        else:
+            path = SPECS_DIR / f"{ref}.toml"
+            if not path.is_file():
+                known = sorted(p.stem for p in SPECS_DIR.glob("*.toml"))
+                raise r.fail(key + ("system",), f"{ref!r}: no shipped system of that name{near(ref, known)}; give the "
+                             "path of a system spec (ending in .toml)")
+        if not path.is_file():
+            raise r.fail(key + ("system",), f"{ref!r}: no such file ({path})")
+        if path.resolve() in self.within:
+            raise r.fail(key + ("system",), f"{ref!r}: the system contains itself")
+        sub = _Composer(path, self.fmu_dir, self.parameters_dirs, self.within)
+        inner = sub.composition()
+        if inner.writer_spec.get("parameters") or inner.writer_spec.get("parameter_bindings"):
+            raise r.fail(key + ("system",), f"{ref!r} has system parameters or parameter sets bound to the whole "
+                         "system, which a sub-system cannot bring yet: give them to its components")
+        auto = bool(sub.r.doc.get("connections", {}).get("auto", True))
+        for name, comp in inner.components.items():
+            # what its spec kept from wiring by name stays so here: its exclusions, and with
+            # auto = false the inputs it left unconnected (its outputs feed this system by name)
+            self.sealed |= {(f"{cname}.{name}", v.name) for v in comp.variables.values()
+                            if (v.causality == "input" and not auto) or
+                            (v.causality in ("input", "output") and sub.excluded(name, v.name))}
+            comp.name = f"{cname}.{name}"
+            files = []
+            for stem, source in comp.parameter_files:
+                if isinstance(inner.ssv_files.get(stem), tuple):
+                    continue  # its values: written again under this system's name
+                previous = self.ssv_files.get(stem)
+                if previous is not None and Path(previous).resolve() != Path(source).resolve():
+                    raise r.fail(key + ("system",), f"{ref!r}: its parameter file {stem}.ssv is another file than "
+                                 f"this system's {previous}")
+                self.ssv_files[stem] = source
+                files.append((stem, source))
+            comp.parameter_files = files
+            self.components[comp.name] = comp
+        for lk in inner.links:
+            lk.src, lk.dst = f"{cname}.{lk.src}", f"{cname}.{lk.dst}"
+            self.fed[(lk.dst, lk.dst_var)] = f"{lk.src}.{lk.src_var}"
+            self.links.append(lk)
+        values = c.get("parameters", {})
+        if not isinstance(values, dict):
+            raise r.fail(key + ("parameters",), "expected a table of \"component.variable\" = value")
+        for name, value in values.items():
+            comp_name, _, var = name.rpartition(".")
+            target = self.components.get(f"{cname}.{comp_name}")
+            if target is None or not var:
+                raise r.fail(key + ("parameters", name), f"expected \"component.variable\" of a component of {ref!r} "
+                             f"({', '.join(inner.components)})")
+            target.parameters.update(_start_values(r, key + ("parameters", name), target, var, value))
 
     def endpoint(self, key, text, causality):
         """'comp.var' -> (component, [variable names]) (a vector name gives its elements); the
@@ -453,14 +526,10 @@ class _Composer:
         auto = conn_doc.get("auto", True)
         if not isinstance(auto, bool):
             raise r.fail(("connections", "auto"), f"{auto!r}: expected true or false")
-        exclude = r.strings(("connections", "exclude"), conn_doc.get("exclude", []))
+        self.exclude = r.strings(("connections", "exclude"), conn_doc.get("exclude", []))
         if not auto:
             return
-
-        def excluded(cname, var):
-            plain = var.split("[", 1)[0]
-            return any(fnmatch.fnmatchcase(f"{cname}.{var}", p) or fnmatch.fnmatchcase(f"{cname}.{plain}", p)
-                       for p in exclude)
+        excluded = self.excluded
 
         outputs: Dict[str, List[Tuple[str, Any]]] = {}
         for cname, comp in self.components.items():
@@ -480,6 +549,15 @@ class _Composer:
                 if sources:
                     self.fed[(cname, v.name)] = f"{sources[0]}.{v.name}"
                     self.links.append(LinkSpec(sources[0], v.name, cname, v.name, how="name"))
+
+    def excluded(self, cname, var):
+        """Whether `cname.var` is left out of wiring by name: this spec's exclusions, and a
+        sub-system's inputs and outputs its own spec did not wire (exclusions, auto = false)."""
+        if (cname, var) in self.sealed:
+            return True
+        plain = var.split("[", 1)[0]
+        return any(fnmatch.fnmatchcase(f"{cname}.{var}", p) or fnmatch.fnmatchcase(f"{cname}.{plain}", p)
+                   for p in self.exclude)
 
     def master(self):
         """The writer's master settings from [master]."""

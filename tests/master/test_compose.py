@@ -255,3 +255,51 @@ def test_an_ambiguous_name_is_refused_and_exclude_resolves_it(tmp_path):
     spec = write_spec(tmp_path / "b", text.replace("[connections]\n", '[connections]\nexclude = ["sun2.*"]\n'))
     report = compose_system(spec, tmp_path / "b.ssp").report()
     assert "  sun2.r_SN_N[1..3]" in report.split("outputs that feed nothing")[1]
+
+
+NESTED = """\
+[system]
+name = "detumble_with_gyro"
+description = "The shipped detumble as a sub-system, and a gyro on its rigid body"
+
+[master]
+step_size = 0.015
+stop_time = 20.0
+stop_when = ["maneuver.detumble.done"]
+
+[components.maneuver]
+system = "detumble"
+parameters = { "dynamics.omega0" = [0.1, -0.05, 0.08], "detumble.omega_tol" = [0.002, 0.002, 0.002] }
+
+[components.gyro]
+fmu = "Gyro"
+"""
+
+
+def test_a_shipped_system_nested_as_a_sub_system(tmp_path):
+    spec = tmp_path / "outer.toml"
+    spec.write_text(NESTED)
+    report = compose_system(spec, tmp_path / "outer.ssp").report()
+    # the sub-system's own wiring, under its components' dotted names, and ours to the gyro; what
+    # the detumble's spec excludes (its controller's q_BN) stays unconnected here too
+    assert "  maneuver.thrusters.torque_B[1..3] -> maneuver.dynamics.torque_B[1..3]" in report
+    assert "  maneuver.dynamics.omega_BN_B[1..3] -> gyro.omega_BN_B[1..3]" in report
+    assert "maneuver.detumble.q_BN[1] = 0.0" in report
+    nested = system_ssp.simulate(tmp_path / "outer.ssp")
+    alone = system_ssp.simulate("detumble", parameters={
+        **{f"dynamics.omega0[{k}]": w for k, w in enumerate([0.1, -0.05, 0.08], 1)},
+        **{f"detumble.omega_tol[{k}]": 0.002 for k in (1, 2, 3)}})
+    assert alone.stop_reason.startswith("stop condition detumble.done")
+    assert nested.stop_time == alone.stop_time and nested.stop_reason.replace("maneuver.", "") == alone.stop_reason
+    for name in alone.names:
+        np.testing.assert_array_equal(nested.data[f"maneuver.{name}"], alone.data[name], err_msg=name)
+    np.testing.assert_array_equal(nested.data["gyro.omega_BN_B[2]"], alone.data["dynamics.omega_BN_B[2]"])
+    # a spec that contains itself, and an unknown shipped system, are refused by line
+    spec.write_text(NESTED.replace('system = "detumble"', 'system = "outer.toml"'))
+    with pytest.raises(SSPError, match=r"outer.toml:11: components.maneuver.system: 'outer.toml': the system "
+                                       r"contains itself"):
+        compose_system(spec, tmp_path / "x.ssp")
+    spec.write_text(NESTED.replace('system = "detumble"', 'system = "detumbel"'))
+    with pytest.raises(SSPError, match=r"outer.toml:11: components.maneuver.system: 'detumbel': no shipped system "
+                                       r"of that name \(did you mean 'detumble'"):
+        compose_system(spec, tmp_path / "x.ssp")
