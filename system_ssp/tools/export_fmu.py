@@ -6,8 +6,9 @@ and system parameter, its Gauss-Seidel order and step); the FMU is built by fmu-
 toolbox's FMU Container (a C runtime that embeds the system's FMUs unchanged and steps them in
 that order at that step: no Python of its own, so the target needs what the embedded FMUs need,
 CPython and numpy for ours). Its variables are the signals exported (by default every output of
-every component, named component.variable), with the units and descriptions of the components'
-FMUs and no direct feedthrough declared (the container's outputs change only in a step). What a
+every component, named component.variable) and every parameter of every component (its start the
+value the system binds), with the units and descriptions of the components' FMUs and no direct
+feedthrough declared (the container's outputs change only in a step). What a
 host must allow, and what a container cannot do, is in docs/compose.md#exporting-a-system-as-one-fmu.
 """
 import json
@@ -18,6 +19,7 @@ import shutil
 import tempfile
 import zipfile
 
+from fmpy.validation import validate_fmu
 from lxml import etree
 
 from ..atomic import atomic_write, check_output_place
@@ -57,7 +59,7 @@ def container_description(system, plan, outputs, inputs, name):
     exported = [[files[c.index], var, f"{c.name}.{var}"] for c, var in outputs]
     given = [[f"{c.name}.{var}", files[c.index], var] for c, var in inputs]
     return {"name": f"{name}.fmu", "mt": False, "profiling": False, "sequential": plan.algorithm == "gauss-seidel",
-            "auto_link": False, "auto_input": False, "auto_output": False, "auto_parameter": False,
+            "auto_link": False, "auto_input": False, "auto_output": False, "auto_parameter": True,
             "auto_local": False, "step_size": plan.step_size,
             "fmu": [files[i] for i in plan.order], "link": links, "start": start, "output": exported,
             "input": given}, files
@@ -85,15 +87,43 @@ def _signals(system, names, causality, what):
     return out
 
 
-def _finish_model_description(fmu, system, outputs, inputs, fmi, about):
+def _fix_parameters(root, fmi, by_name, starts):
+    """What the container writes of the parameters it exposes, corrected: a String's start is the
+    value the system binds (the container writes it behind a line break), and FMI 3.0's array
+    aggregates of an FMI 2.0 FMU's elements (no start, which FMI 3.0 requires of a parameter;
+    the elements are there) go."""
+    holder = root.find("ModelVariables")
+    for el in list(holder):
+        if not isinstance(el.tag, str) or el.get("causality") != "parameter":
+            continue
+        if fmi == 3 and el.get("start") is None and el.find("Start") is None and el.find("Dimension") is not None:
+            holder.remove(el)
+            continue
+        name = el.get("name")
+        if name not in by_name:
+            continue
+        comp, var = by_name[name]
+        if comp.vars[var].type != "String":
+            continue
+        value = starts.get((comp.index, var), comp.vars[var].start)
+        if value is None:
+            continue
+        if fmi == 2 and el.find("String") is not None:
+            el.find("String").set("start", str(value))
+        elif fmi == 3 and el.find("Start") is not None:
+            el.find("Start").set("value", str(value))
+
+
+def _finish_model_description(fmu, system, outputs, inputs, fmi, about, starts):
     """The container's modelDescription.xml with what it leaves out: each variable's unit (and the
     unit definitions), the system's description, and, FMI 2.0, its outputs' dependencies (none:
     a container's outputs change only in a step). Rewritten in place, every other member kept."""
     with zipfile.ZipFile(fmu) as z:
         members = {i.filename: (i, z.read(i.filename)) for i in z.infolist()}
     root = etree.fromstring(members["modelDescription.xml"][1])
-    by_name = {f"{c.name}.{v}": (c, v) for c, v in outputs + inputs}
+    by_name = {f"{c.name}.{v}": (c, v) for c in system.comps for v in c.vars}
     _drop_shadowed_locals(root, fmi)
+    _fix_parameters(root, fmi, by_name, starts)
     units = {}
     for el in root.iter():
         if not isinstance(el.tag, str) or el.get("name") not in by_name:
@@ -215,9 +245,12 @@ def export_fmu(source, out, fmi=2, outputs=None, inputs=None, step_size=None):
             built = work / f"{name}.fmu"
             if not built.is_file():
                 raise SSPError(f"{source}: the FMU container wrote no FMU (its log says why)")
-            _finish_model_description(built, system, outs, ins, fmi, about)
-            shutil.copyfile(built, work / "checked.fmu")
-            shutil.move(str(work / "checked.fmu"), str(out))
+            _finish_model_description(built, system, outs, ins, fmi, about, plan.params)
+            problems = validate_fmu(str(built))  # kept only when FMPy finds it a valid FMU
+            if problems:
+                raise SSPError(f"{source}: the exported FMU is not valid ({len(problems)} problems; the first: "
+                               f"{problems[0].strip()})")
+            shutil.move(str(built), str(out))
     return {"outputs": [f"{c.name}.{v}" for c, v in outs], "inputs": [f"{c.name}.{v}" for c, v in ins],
             "step_size": plan.step_size, "left_out": left_out}
 

@@ -96,14 +96,23 @@ def test_the_exported_fmus_are_valid_with_units_descriptions_and_dependencies(ex
         assert about in variables[signal].description
         assert unit in {u.name for u in md.unitDefinitions}
         assert all(not v.dependencies for v in md.outputs)  # declared: no direct feedthrough
+        if name == "detumble":  # the parameters, their starts the values the system binds
+            assert variables["dynamics.omega0[1]"].causality == "parameter"
+            assert float(variables["dynamics.omega0[1]"].start) == 0.17453292519943295
+            assert variables["dynamics.omega0[1]"].unit == "rad/s" and variables["dynamics.integrator"].start == "euler"
         assert md.description.startswith(f"{name}: the system") and "gauss-seidel" in md.description
 
 
-def test_the_exported_fmus_equal_our_master_in_fmpy(exported, master_runs):
+def test_the_exported_fmus_equal_our_master_in_fmpy(exported, master_runs, ssp_paths):
     for (name, _fmi), path in exported.items():
         stop, _, _, step = CASES[name]
         r = fmpy.simulate_fmu(str(path), stop_time=stop, output_interval=step)
         assert_equal_to_master(name, {n: r[n] for n in r.dtype.names[1:]}, master_runs[name])
+    # a parameter the host sets: as --set in our master
+    r = fmpy.simulate_fmu(str(exported["detumble", 2]), stop_time=0.3, output_interval=0.015,
+                          start_values={"dynamics.omega0[2]": 0.05})
+    ours = system_ssp.simulate(ssp_paths["detumble"], stop_time=0.3, parameters={"dynamics.omega0[2]": 0.05})
+    np.testing.assert_array_equal(r["dynamics.omega_BN_B[2]"], ours.data["dynamics.omega_BN_B[2]"])
 
 
 def test_the_exported_fmus_equal_our_master_in_fmusim_here_and_on_a_user_machine(exported, master_runs, fmusim,
