@@ -181,7 +181,13 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
     the spec's text."""
     out = check_output_place(out, "--out", (".toml",))
     files_dir = out.parent / f"{out.stem}_files"
+    if files_dir.exists() and (not files_dir.is_dir() or any(files_dir.iterdir())):
+        raise SSPError(f"{files_dir}: already there (the spec's FMUs go into it): remove it or choose another --out")
     with System(source) as s:
+        for lk in s.links:
+            if lk.mapping:
+                raise SSPError(f"{lk.label}: an Integer/Boolean mapping transformation, which a system spec cannot "
+                               "say yet")
         desc = s.desc
         name = re.sub(r"[^A-Za-z0-9_]", "_", desc.name or desc.system_name or "system")
         if not NAME.match(name):
@@ -226,9 +232,6 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
         lines += ["", "[connections]", "auto = false", "links = ["]
         for lk in s.links:
             a, b = f"{s.comps[lk.src].name}.{lk.src_var}", f"{s.comps[lk.dst].name}.{lk.dst_var}"
-            if lk.mapping:
-                raise SSPError(f"{lk.label}: an Integer/Boolean mapping transformation, which a system spec cannot "
-                               "say yet")
             if lk.factor != 1.0 or lk.offset != 0.0:
                 lines.append(f"  {{ from = {json.dumps(a)}, to = {json.dumps(b)}, factor = {_toml_value(lk.factor)}, "
                              f"offset = {_toml_value(lk.offset)}, suppress_unit_conversion = true }},")

@@ -250,7 +250,8 @@ def export_fmu(source, out, fmi=2, outputs=None, inputs=None, step_size=None):
             if problems:
                 raise SSPError(f"{source}: the exported FMU is not valid ({len(problems)} problems; the first: "
                                f"{problems[0].strip()})")
-            shutil.move(str(built), str(out))
+            with atomic_write(out, "wb") as f:  # a half-written FMU never takes the name
+                f.write(built.read_bytes())
     return {"outputs": [f"{c.name}.{v}" for c, v in outs], "inputs": [f"{c.name}.{v}" for c, v in ins],
             "step_size": plan.step_size, "left_out": left_out}
 
