@@ -63,6 +63,7 @@ def assert_equal_to_master(name, columns, master, rtol=0.0):
     a host that writes fewer digits than a double needs (fmusim's CSV: 16)."""
     stop, last, earlier, _ = CASES[name]
     compared = 0
+    feedthrough = getattr(master, "feedthrough", set())
     for signal, values in columns.items():
         if signal not in master.names:
             continue
@@ -70,7 +71,7 @@ def assert_equal_to_master(name, columns, master, rtol=0.0):
         got = np.asarray(values, dtype=float)[:len(ours)]
         assert len(got) == len(ours), signal
         comp = signal.split(".", 1)[0]
-        if comp != last and signal in master.feedthrough:
+        if comp != last and signal in feedthrough:
             assert comp in earlier
             got, ours = got[1:], ours[:-1]
         # every row but the last bit for bit; a host ends on a last step of its own (stop - t,
@@ -165,21 +166,23 @@ print("ROWS " + json.dumps(rows))
 """
 
 
-def test_the_exported_detumble_equals_our_master_in_libcosim(exported, master_runs):
+@pytest.mark.parametrize("name", ["detumble", "slew"])
+def test_the_exported_maneuvers_equal_our_master_in_libcosim(exported, master_runs, name):
     pytest.importorskip("libcosimpy", reason="libcosimpy is not installed (pip install libcosimpy)")
-    master = master_runs["detumble"]
-    names = [f"dynamics.omega_BN_B[{k}]" for k in (1, 2, 3)] + [f"detumble.torque_cmd_B[{k}]" for k in (1, 2, 3)]
+    master = master_runs[name]
+    names = [f"dynamics.omega_BN_B[{k}]" for k in (1, 2, 3)] + [f"{name}.torque_cmd_B[{k}]" for k in (1, 2, 3)]
     n = len(master.data) - 1
-    proc = subprocess.run([sys.executable, "-c", LIBCOSIM_ONE_FMU, str(exported["detumble", 2]),
+    proc = subprocess.run([sys.executable, "-c", LIBCOSIM_ONE_FMU, str(exported[name, 2]),
                            str(15_000_000), str(n), json.dumps(names)], capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr[-3000:]
     rows = np.array(json.loads(next(line[5:] for line in proc.stdout.splitlines() if line.startswith("ROWS "))))
     # libcosim's observer sees the values after each step: our master's rows 1 ..
     columns = {name: np.concatenate([[master.data[name][0]], rows[:, k]]) for k, name in enumerate(names)}
-    assert_equal_to_master("detumble", columns, master)
+    assert_equal_to_master(name, columns, master)
 
 
-def test_the_exported_detumble_runs_in_ecos_on_a_user_machine(exported, master_runs, user_machine, tmp_path):
+@pytest.mark.parametrize("name", ["detumble", "slew"])
+def test_the_exported_maneuvers_run_in_ecos_on_a_user_machine(exported, master_runs, user_machine, tmp_path, name):
     from test_compat import ECOS_TOLERANCE, _user_python
     import importlib.util
     from user_machine import numpy_for, on_user_machine
@@ -196,15 +199,15 @@ def test_the_exported_detumble_runs_in_ecos_on_a_user_machine(exported, master_r
     numpy_dir = numpy_for(target_id, installer, int(target_id.rsplit(".", 1)[1]))
     work = tmp_path / "run"
     work.mkdir()
-    shutil.copy(exported["detumble", 2], work / "detumble.fmu")
+    shutil.copy(exported[name, 2], work / f"{name}.fmu")
     proc = on_user_machine(["sh", "-c", f'cd "{work}" && exec "$@"', "sh", str(binary), "simulate", "--path",
-                            "detumble.fmu", "--stopTime", "9.96", "--stepSize", "0.015", "--noParallel"],
+                            f"{name}.fmu", "--stopTime", repr(CASES[name][0]), "--stepSize", "0.015", "--noParallel"],
                            [bin_dir], str(numpy_dir))
     assert proc.returncode == 0, f"{proc.stdout[-2000:]}\n{proc.stderr[-2000:]}"
     from system_ssp.tools import compat
-    got = compat.read_csv(work / "detumble.csv", separator=", ")
+    got = compat.read_csv(work / f"{name}.csv", separator=", ")
     got = {name.split("::", 1)[-1].rsplit("[", 1)[0]: v for name, v in got.items()}  # instance::x[1][REAL]
-    ours = master_runs["detumble"].data
+    ours = master_runs[name].data
     for k in (1, 2, 3):
         column = np.asarray(got[f"dynamics.omega_BN_B[{k}]"], float)
         assert len(column) >= len(ours) - 1
@@ -228,3 +231,18 @@ def test_export_fmu_names_what_a_container_cannot_do(ssp_paths, tmp_path, capsys
     assert "a connection of the system feeds it" in capsys.readouterr().err
     assert cli.main(["export-fmu", "detumble", "--out", str(tmp_path / "z.fmu"), "--outputs", "dynamics.omega"]) == 2
     assert "did you mean" in capsys.readouterr().err and not (tmp_path / "z.fmu").exists()
+
+
+def test_an_unconnected_input_the_host_sets(ssp_paths, tmp_path):
+    out = tmp_path / "with_input.fmu"
+    done = export_fmu(ssp_paths["detumble"], out, 2, outputs=["dynamics.omega_BN_B"], inputs=["dynamics.wheel_torque_B"])
+    assert done["inputs"] == [f"dynamics.wheel_torque_B[{k}]" for k in (1, 2, 3)]
+    md = fmpy.read_model_description(str(out))
+    torque = next(v for v in md.modelVariables if v.name == "dynamics.wheel_torque_B[3]")
+    assert torque.causality == "input" and torque.unit == "N.m"
+    r = fmpy.simulate_fmu(str(out), stop_time=1.5, output_interval=0.015,
+                          start_values={"dynamics.wheel_torque_B[3]": 0.01})
+    ours = system_ssp.simulate(ssp_paths["detumble"], stop_time=1.5, parameters={"dynamics.wheel_torque_B[3]": 0.01})
+    free = system_ssp.simulate(ssp_paths["detumble"], stop_time=1.5)
+    assert_equal_to_master("detumble", {"dynamics.omega_BN_B[3]": r["dynamics.omega_BN_B[3]"]}, ours)
+    assert ours.final["dynamics.omega_BN_B[3]"] != free.final["dynamics.omega_BN_B[3]"]
