@@ -235,7 +235,8 @@ def test_export_fmu_names_what_a_container_cannot_do(ssp_paths, tmp_path, capsys
 
 def test_an_unconnected_input_the_host_sets(ssp_paths, tmp_path):
     out = tmp_path / "with_input.fmu"
-    done = export_fmu(ssp_paths["detumble"], out, 2, outputs=["dynamics.omega_BN_B"], inputs=["dynamics.wheel_torque_B"])
+    done = export_fmu(ssp_paths["detumble"], out, 2, outputs=["dynamics.omega_BN_B"],
+                      inputs=["dynamics.wheel_torque_B"])
     assert done["inputs"] == [f"dynamics.wheel_torque_B[{k}]" for k in (1, 2, 3)]
     md = fmpy.read_model_description(str(out))
     torque = next(v for v in md.modelVariables if v.name == "dynamics.wheel_torque_B[3]")
