@@ -224,18 +224,19 @@ def shipped_fmu_names(fmu_dir: Path) -> List[str]:
     return sorted(p.stem for p in Path(fmu_dir).glob("*.fmu"))
 
 
-def compose(spec_path, fmu_dir: Path, parameters_dir) -> Composition:
+def compose(spec_path, fmu_dir: Path, parameters_dir, specs_dir: Path) -> Composition:
     """Read and check the spec at `spec_path`. Shipped FMUs are `fmu_dir/<name>.fmu`, shipped
-    parameter sets `parameters_dir/<name>.ssv` (a folder, or a list of folders searched in turn).
+    parameter sets `parameters_dir/<name>.ssv` (a folder, or a list of folders searched in turn),
+    shipped systems' specs `specs_dir/<name>.toml`.
     SSPError (file:line: key: what is allowed) on anything the system could not be written from."""
-    return _Composer(Path(spec_path), Path(fmu_dir), parameters_dir).composition()
+    return _Composer(Path(spec_path), Path(fmu_dir), parameters_dir, specs_dir).composition()
 
 
 class _Composer:
     """One spec's composition, table by table."""
 
-    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir, within=()):
-        self.spec_path, self.fmu_dir = spec_path, fmu_dir
+    def __init__(self, spec_path: Path, fmu_dir: Path, parameters_dir, specs_dir: Path, within=()):
+        self.spec_path, self.fmu_dir, self.specs_dir = spec_path, fmu_dir, Path(specs_dir)
         self.within = tuple(within) + (spec_path.resolve(),)  # the specs this one is a sub-system of
         self.parameters_dirs = [Path(d) for d in (parameters_dir if isinstance(parameters_dir, (list, tuple))
                                                   else [parameters_dir])]
@@ -361,8 +362,6 @@ class _Composer:
         the master names the components of a nested system), with their parameter files, values
         and connections; `parameters = { "dynamics.omega0" = [..] }` changes values inside it.
         Its master settings are not this system's."""
-        from ..systems import SPECS_DIR  # a path only: the systems package imports nothing else
-
         r = self.r
         if set(c) - {"system", "parameters"}:
             raise r.fail(key, f"a sub-system (system = ...) takes only parameters beside it, not "
@@ -373,16 +372,16 @@ class _Composer:
         if ref.endswith(".toml"):
             path = Path(ref) if Path(ref).is_absolute() else self.spec_path.parent / ref
         else:
-            path = SPECS_DIR / f"{ref}.toml"
+            path = self.specs_dir / f"{ref}.toml"
             if not path.is_file():
-                known = sorted(p.stem for p in SPECS_DIR.glob("*.toml"))
+                known = sorted(p.stem for p in self.specs_dir.glob("*.toml"))
                 raise r.fail(key + ("system",), f"{ref!r}: no shipped system of that name{near(ref, known)}; give the "
                              "path of a system spec (ending in .toml)")
         if not path.is_file():
             raise r.fail(key + ("system",), f"{ref!r}: no such file ({path})")
         if path.resolve() in self.within:
             raise r.fail(key + ("system",), f"{ref!r}: the system contains itself")
-        sub = _Composer(path, self.fmu_dir, self.parameters_dirs, self.within)
+        sub = _Composer(path, self.fmu_dir, self.parameters_dirs, self.specs_dir, self.within)
         inner = sub.composition()
         if inner.writer_spec.get("parameters") or inner.writer_spec.get("parameter_bindings"):
             raise r.fail(key + ("system",), f"{ref!r} has system parameters or parameter sets bound to the whole "

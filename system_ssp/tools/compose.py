@@ -25,6 +25,7 @@ from .convert import convert_system
 from .replace import _pack
 
 PARAMETERS_DIR = SYSTEM_SOURCES / "parameters"
+SPECS_DIR = SYSTEM_SOURCES / "specs"  # the shipped systems' specs: a spec's sub-systems by name
 
 
 def _shipped_fmus(fmu_dir):
@@ -68,7 +69,7 @@ def compose_system(spec_path, out, fmu_dir=FMU_DIR, parameters_dir=PARAMETERS_DI
     """Write `out` (.ssp) from the spec at `spec_path`; returns the Composition (its report()).
     Nothing is written unless the spec is sound and the composed system loads in the master."""
     out = check_output_place(out, "--out", (".ssp",))
-    composition = compose(Path(spec_path), _shipped_fmus(fmu_dir), Path(parameters_dir))
+    composition = compose(Path(spec_path), _shipped_fmus(fmu_dir), Path(parameters_dir), SPECS_DIR)
     with tempfile.TemporaryDirectory(prefix="neighbor_compose_") as tmp:
         folder = Path(tmp) / "system"
         ssd = write_folder(composition, folder, fmu_dir)

@@ -20,6 +20,8 @@ import tempfile
 import zipfile
 
 from fmpy.validation import validate_fmu
+from fmu_manipulation_toolbox.assembly import Assembly, AssemblyError
+from fmu_manipulation_toolbox.container import FMUContainerError
 from lxml import etree
 
 from ..atomic import atomic_write, check_output_place
@@ -202,8 +204,6 @@ def export_fmu(source, out, fmi=2, outputs=None, inputs=None, step_size=None):
     if fmi not in FMI_VERSIONS:
         raise SSPError(f"--fmi {fmi!r}: expected 2 or 3")
     out = check_output_place(out, "--out", (".fmu",))
-    from fmu_manipulation_toolbox.assembly import Assembly, AssemblyError
-    from fmu_manipulation_toolbox.container import FMUContainerError
 
     with System(source) as system:
         plan = make_plan(system, RunOptions(step_size=step_size, schedule=False))

@@ -9,7 +9,8 @@ def write_system(writer, name):
     connectors from the writer's FMUs and its parameter files the ones the generator has just
     written into the writer's parameters/ folder."""
     # a set another generator writes (spacecraft.ssv) is the committed one when only this one runs
-    composition = compose(SPECS_DIR / f"{name}.toml", writer.fmu_dir, [writer.parameters, PARAMETERS_DIR])
+    composition = compose(SPECS_DIR / f"{name}.toml", writer.fmu_dir, [writer.parameters, PARAMETERS_DIR],
+                          SPECS_DIR)
     if composition.name != name:
         raise GeneratorError(f"{composition.spec_path}: system.name is {composition.name!r}, expected {name!r}")
     for stem, source in composition.ssv_files.items():
