@@ -71,9 +71,7 @@ class ComponentSpec:
     fmu_path: Path
     parameter_files: List[Tuple[str, Path]]  # (stem in the SSP's parameters/, file)
     parameters: Dict[str, Any]  # variable name (vectors expanded) -> value
-    line: Optional[int]
     variables: Dict[str, Any] = field(default_factory=dict)  # name -> fmpy ScalarVariable
-    units: Dict[str, Any] = field(default_factory=dict)  # unit name -> BaseUnit
     model_identifier: str = ""
 
 
@@ -326,7 +324,8 @@ class _Composer:
         for cname, c in comps_doc.items():
             key = ("components", cname)
             if not COMPONENT_NAME.match(cname):
-                raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit)")
+                raise r.fail(key, "a component name is letters, digits and _ (not starting with a digit), parts "
+                             "joined by dots for a sub-system's components")
             c = r.table(key, c, COMPONENT_KEYS | {"system"})
             if "system" in c:
                 self.add_subsystem(key, cname, c)
@@ -346,8 +345,7 @@ class _Composer:
                              "ending in .fmu for any other FMU")
             files = [self.parameter_file(key + ("parameter_files",), e)
                      for e in r.strings(key + ("parameter_files",), c.get("parameter_files", []))]
-            comp = ComponentSpec(name=cname, fmu=fmu, fmu_path=path, parameter_files=files, parameters={},
-                                 line=r.lines.line(*key))
+            comp = ComponentSpec(name=cname, fmu=fmu, fmu_path=path, parameter_files=files, parameters={})
             _read_fmu(r, key, comp)
             values = c.get("parameters", {})
             if not isinstance(values, dict):
@@ -621,7 +619,6 @@ def _read_fmu(r, key, comp):
         raise r.fail(key + ("fmu",), f"{comp.fmu_path}: has no co-simulation interface (model exchange only)")
     comp.model_identifier = md.coSimulation.modelIdentifier
     comp.variables = {v.name: v for v in md.modelVariables}
-    comp.units = {u.name: u.baseUnit for u in md.unitDefinitions}
 
 
 def _elements(comp, var):

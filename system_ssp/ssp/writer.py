@@ -140,33 +140,28 @@ class SystemWriter:
                 out.append("        </ssd:ParameterBindings>")
             out.append("      </ssd:Component>")
         out.append("    </ssd:Elements>")
-        out.append("    <ssd:Connections>")
+        links = []  # the schema refuses an empty ssd:Connections
         for src, sname, dst, dname, n, *transform in spec["connections"]:
             pairs = [(f"{sname}[{i}]", f"{dname}[{i}]") for i in range(1, n + 1)] if n else [(sname, dname)]
+            tr = transform[0] if transform else {}
             for a, b in pairs:
                 va, vb = comp_vars[src].get(a), comp_vars[dst].get(b)
                 if va is None or vb is None or va.causality != "output" or vb.causality != "input":
                     raise GeneratorError(f"{name}: {src}.{a} -> {dst}.{b} is not output -> input")
                 head = (f'      <ssd:Connection startElement="{src}" startConnector={quoteattr(a)} '
-                        f'endElement="{dst}" endConnector={quoteattr(b)}')
-                tr = transform[0] if transform else None
-                if not tr:
-                    out.append(head + "/>")
-                    continue
-                if tr.get("suppress"):
-                    head += ' suppressUnitConversion="true"'
-                if not tr.get("linear"):
-                    out.append(head + "/>")
-                    continue
-                out += [head + ">", f'        <ssc:LinearTransformation factor="{float(tr["factor"])!r}" '
-                        f'offset="{float(tr["offset"])!r}"/>', "      </ssd:Connection>"]
+                        f'endElement="{dst}" endConnector={quoteattr(b)}'
+                        + (' suppressUnitConversion="true"' if tr.get("suppress") else ""))
+                if tr.get("linear"):
+                    links += [head + ">", f'        <ssc:LinearTransformation factor="{float(tr["factor"])!r}" '
+                              f'offset="{float(tr["offset"])!r}"/>', "      </ssd:Connection>"]
+                else:
+                    links.append(head + "/>")
         for pname, (_, targets) in spec.get("parameters", {}).items():
             for comp, var in targets:
-                out.append(f'      <ssd:Connection startConnector={quoteattr(pname)} endElement="{comp}" '
-                           f'endConnector={quoteattr(var)}/>')
-        out.append("    </ssd:Connections>")
-        if out[-2] == "    <ssd:Connections>":  # the schema refuses an empty ssd:Connections
-            del out[-2:]
+                links.append(f'      <ssd:Connection startConnector={quoteattr(pname)} endElement="{comp}" '
+                             f'endConnector={quoteattr(var)}/>')
+        if links:
+            out += ["    <ssd:Connections>", *links, "    </ssd:Connections>"]
         dt = spec["step_size"]
         for comp, var in spec.get("stop", []):
             if comp_vars[comp][var].type != "Boolean" or comp_vars[comp][var].causality != "output":
@@ -182,13 +177,13 @@ class SystemWriter:
         if spec.get("record"):
             out.append(f'          <nc:Record>{escape(" ".join(spec["record"]))}</nc:Record>')
         out += ["        </nc:Master>", "      </ssc:Annotation>", "    </ssd:Annotations>", "  </ssd:System>"]
-        out.append("  <ssd:Units>" if all_units else "")  # the schema refuses an empty ssd:Units
-        for uname in sorted(all_units):
-            bu = all_units[uname]
-            attrs = " ".join(f'{k}="{getattr(bu, k)}"' for k in SI_BASE_UNITS if bu is not None and getattr(bu, k))
-            out.append(f'    <ssc:Unit name="{uname}"><ssc:BaseUnit {attrs}/></ssc:Unit>')
-        out.append("  </ssd:Units>" if all_units else "")
-        out = [line for line in out if line]
+        if all_units:  # the schema refuses an empty ssd:Units
+            out.append("  <ssd:Units>")
+            for uname in sorted(all_units):
+                bu = all_units[uname]
+                attrs = " ".join(f'{k}="{getattr(bu, k)}"' for k in SI_BASE_UNITS if bu is not None and getattr(bu, k))
+                out.append(f'    <ssc:Unit name="{uname}"><ssc:BaseUnit {attrs}/></ssc:Unit>')
+            out.append("  </ssd:Units>")
         # libcosim takes its fixed step from this OSP annotation (our master reads its own).
         out += [f'  <ssd:DefaultExperiment startTime="0.0" stopTime="{spec["stop_time"]!r}">',
                 "    <ssd:Annotations>",

@@ -78,8 +78,7 @@ def _signals(system, names, causality, what):
                 break
         if comp is None:
             system.split_name(name, what)  # raises with the components and close matches
-        elements = [var] if var in comp.vars else [f"{var}[{i}]" for i in range(1, 10_000)
-                                                   if f"{var}[{i}]" in comp.vars]
+        elements = [var] if var in comp.vars else comp.whole(var)  # a vector: its elements
         if not elements:
             system.split_name(name, what)
         for v in elements:
