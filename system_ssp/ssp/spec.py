@@ -153,7 +153,8 @@ class SpecReader:
 
     def __init__(self, path: Path):
         self.path = Path(path)
-        self.doc, self.lines = self._read(self.path, ())
+        self.files: List[Tuple[Path, KeyLines]] = []  # this spec, then the ones it extends
+        self.doc = self._read(self.path, ())
 
     def _read(self, path, seen):
         text = read_text_input(path, str(path), "the system spec", "a system spec is TOML, which is UTF-8: save it "
@@ -164,9 +165,10 @@ class SpecReader:
             line = re.search(r"line (\d+)", str(exc))
             raise SSPError(f"{path}{':' + line.group(1) if line else ''}: not valid TOML: {exc}") from None
         lines = KeyLines(text)
+        self.files.append((path, lines))
         base = doc.pop("extends", None)
         if base is None:
-            return doc, lines
+            return doc
         where = f"{path}:{lines.line('extends')}"
         if not isinstance(base, str) or not base.endswith(".toml"):
             raise SSPError(f"{where}: extends = {base!r}: expected the path of another system spec (.toml)")
@@ -175,17 +177,33 @@ class SpecReader:
             raise SSPError(f"{where}: extends = {base!r}: no such file ({base_path})")
         if base_path.resolve() in seen or base_path.resolve() == path.resolve():
             raise SSPError(f"{where}: extends = {base!r}: the specs extend each other in a cycle")
-        base_doc, _ = self._read(base_path, seen + (path.resolve(),))
-        return _merged(base_doc, doc), lines
+        base_doc = self._read(base_path, seen + (path.resolve(),))
+        return _merged(base_doc, doc)
+
+    def locate(self, *key: str) -> Tuple[Path, Optional[int]]:
+        """(file, line) of the longest prefix of `key` a file spells: this spec before the ones
+        it extends, so a key is named where the merged value came from."""
+        for n in range(len(key), 0, -1):
+            for path, lines in self.files:
+                if tuple(key[:n]) in lines.lines:
+                    return path, lines.lines[tuple(key[:n])]
+        return self.path, None
 
     def where(self, *key: str) -> str:
-        line = self.lines.line(*key)
-        return f"{self.path}:{line}" if line else str(self.path)
+        path, line = self.locate(*key)
+        return f"{path}:{line}" if line else str(path)
 
-    at_line: Optional[int] = None  # while set, messages name this line
+    def line_of_text(self, needle: str, *key: str) -> str:
+        """file:line of the first line holding `needle` at or after `key`'s (a value in a list)."""
+        path, start = self.locate(*key)
+        lines = dict(self.files)[path]
+        line = lines.line_of_text(needle, start) or start
+        return f"{path}:{line}" if line else str(path)
+
+    at_line: Optional[str] = None  # while set, messages name this file:line
 
     def fail(self, key: Tuple[str, ...], message: str) -> SSPError:
-        where = f"{self.path}:{self.at_line}" if self.at_line else self.where(*key)
+        where = self.at_line or self.where(*key)
         return SSPError(f"{where}: {'.'.join(k for k in key if not k.startswith('['))}"
                         f"{''.join(k for k in key if k.startswith('['))}: {message}")
 
@@ -486,11 +504,10 @@ class _Composer:
                 if kk not in LINK_KEYS:
                     raise r.fail(key, f"unknown key {kk!r} in a link{near(kk, LINK_KEYS)}; allowed: "
                                  f"{', '.join(sorted(LINK_KEYS))}")
-            line = r.lines.line_of_text(str(item.get("from")), r.lines.line(*key)) or r.lines.line(*key)
-            self.add_link(key + (f"[{k + 1}]",), item, line)
+            self.add_link(key + (f"[{k + 1}]",), item, r.line_of_text(str(item.get("from")), *key))
 
     def add_link(self, where, item, line):
-        self.r.at_line = line  # a message about a link names the link's own line
+        self.r.at_line = line  # a message about a link names the link's own file:line
         try:
             self._add_link(where, item)
         finally:

@@ -306,3 +306,18 @@ def test_a_shipped_system_nested_as_a_sub_system(tmp_path):
     with pytest.raises(SSPError, match=r"outer.toml:11: components.maneuver.system: 'detumbel': no shipped system "
                                        r"of that name \(did you mean 'detumble'"):
         compose_system(spec, tmp_path / "x.ssp")
+
+
+def test_a_spec_that_extends_another_names_the_file_a_bad_key_came_from(tmp_path):
+    base = write_spec(tmp_path, SPEC.replace('fmu = "Gyro"', 'fmu = "Gyr"'))
+    child = tmp_path / "child.toml"
+    child.write_text(f'extends = "{base.name}"\n\n[system]\nname = "child"\n\n'
+                     '[components.orbit]\nfmu = "CircularOrbit"\n')
+    with pytest.raises(SSPError, match=r"system.toml:23: components.gyro.fmu: 'Gyr'"):
+        compose_system(child, tmp_path / "c.ssp")
+    base.write_text(SPEC.replace("FMU_PATH", "Feedthrough.fmu"))
+    child.write_text(child.read_text().replace('"CircularOrbit"', '"CircularOrbt"'))
+    with pytest.raises(SSPError, match=r"child.toml:7: components.orbit.fmu: 'CircularOrbt'"):
+        compose_system(child, tmp_path / "c.ssp")
+    child.write_text(child.read_text().replace('"CircularOrbt"', '"CircularOrbit"'))
+    assert compose_system(child, tmp_path / "c.ssp").name == "child"
