@@ -6,6 +6,7 @@ system (any tool's), its FMUs beside it in SPEC_files/, to start from.
 """
 import filecmp
 import json
+import os
 from pathlib import Path
 import re
 import shutil
@@ -65,6 +66,16 @@ def write_folder(composition, folder, fmu_dir):
     return folder / "SystemStructure.ssd"
 
 
+def _users_names(message, composition, folder):
+    """`message` with the composed folder's files named as the user knows them: a parameter file
+    by the path the spec gave, the rest relative to the composed system."""
+    text = str(message)
+    for stem, source in composition.ssv_files.items():
+        if not isinstance(source, tuple):
+            text = text.replace(str(folder / "parameters" / f"{stem}.ssv"), str(source))
+    return text.replace(f"{folder}{os.sep}", "(the composed system) ")
+
+
 def compose_system(spec_path, out, fmu_dir=FMU_DIR, parameters_dir=PARAMETERS_DIR):
     """Write `out` (.ssp) from the spec at `spec_path`; returns the Composition (its report()).
     Nothing is written unless the spec is sound and the composed system loads in the master."""
@@ -77,7 +88,8 @@ def compose_system(spec_path, out, fmu_dir=FMU_DIR, parameters_dir=PARAMETERS_DI
             with System(ssd):
                 pass
         except SSPError as exc:
-            raise SSPError(f"{spec_path}: the composed system does not load: {exc}") from None
+            why = _users_names(exc, composition, folder)
+            raise SSPError(f"{spec_path}: the composed system does not load: {why}") from None
         if composition.ssp_version == "2.0":
             convert_system(folder, "2.0", out)
         else:

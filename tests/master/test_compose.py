@@ -248,6 +248,16 @@ def test_a_bad_spec_is_refused_in_one_line_and_nothing_is_written(tmp_path, caps
     assert not out.exists()
 
 
+def test_a_bad_parameter_file_is_named_by_the_path_the_spec_gave(tmp_path, capsys):
+    (tmp_path / "mine.ssv").write_text(h.ssv_text([("seed", "Integer", "7", None)]).replace('value="7"', 'valu="7"'))
+    spec = write_spec(tmp_path, SPEC.replace('[components.gyro]\nfmu = "Gyro"',
+                                             '[components.gyro]\nfmu = "Gyro"\nparameter_files = ["mine.ssv"]'))
+    assert cli.main(["compose", str(spec), "--out", str(tmp_path / "out.ssp")]) == 2
+    err = capsys.readouterr().err
+    assert f"the composed system does not load: {tmp_path / 'mine.ssv'}:" in err and "neighbor_compose_" not in err
+    assert not (tmp_path / "out.ssp").exists()
+
+
 def test_an_ambiguous_name_is_refused_and_exclude_resolves_it(tmp_path):
     text = SPEC.replace("[components.computer]", '[components.sun2]\nfmu = "SunEphemeris"\n[components.computer]')
     spec = write_spec(tmp_path / "a", text)
