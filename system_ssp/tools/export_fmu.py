@@ -50,7 +50,14 @@ def container_description(system, plan, outputs, inputs, name):
         slow = [comps[i].name for i, k in enumerate(plan.multiples) if k != 1]
         raise SSPError(f"{system.desc.display}: {', '.join(slow)} step every k-th step (nc:StepMultiple): a container "
                        "steps every FMU every step")
-    files = {c.index: f"{re.sub(r'[^A-Za-z0-9_]', '_', c.name)}.fmu" for c in comps}
+    files = {}  # component -> its FMU's file name in the container (unique; a.b and a_b both give a_b)
+    for c in comps:
+        stem = re.sub(r"[^A-Za-z0-9_]", "_", c.name)
+        file, k = f"{stem}.fmu", 1
+        while file in files.values():
+            k += 1
+            file = f"{stem}_{k}.fmu"
+        files[c.index] = file
     links = []
     for lk in system.links:
         if lk.factor != 1.0 or lk.offset != 0.0 or lk.mapping:

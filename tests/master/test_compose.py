@@ -6,6 +6,7 @@ import re
 import shutil
 import zipfile
 
+import fmpy
 import numpy as np
 import pytest
 
@@ -17,6 +18,7 @@ from system_ssp import cli
 from system_ssp.errors import SSPError
 from system_ssp.locations import FMU_DIR
 from system_ssp.tools.compose import compose_system, spec_from_system
+from system_ssp.tools.export_fmu import export_fmu
 from test_ssp_shapes import as_ssp2, balls, nested_system, top_level_connectors_system
 
 FEEDTHROUGH = DATA / "reference_fmus" / "2.0" / "Feedthrough.fmu"
@@ -331,3 +333,14 @@ def test_a_spec_that_extends_another_names_the_file_a_bad_key_came_from(tmp_path
         compose_system(child, tmp_path / "c.ssp")
     child.write_text(child.read_text().replace('"CircularOrbt"', '"CircularOrbit"'))
     assert compose_system(child, tmp_path / "c.ssp").name == "child"
+
+
+def test_a_composed_system_with_dotted_names_exports_as_one_fmu(tmp_path):
+    spec = tmp_path / "outer.toml"
+    spec.write_text(NESTED)
+    compose_system(spec, tmp_path / "outer.ssp")
+    export_fmu(tmp_path / "outer.ssp", tmp_path / "outer.fmu")
+    r = fmpy.simulate_fmu(str(tmp_path / "outer.fmu"), stop_time=3.0, output_interval=0.015)
+    ours = system_ssp.simulate(tmp_path / "outer.ssp", stop_time=3.0)
+    for name in ("maneuver.dynamics.omega_BN_B[1]", "gyro.omega_meas_B[2]"):  # stepped after the controller
+        np.testing.assert_array_equal(r[name][:-1], ours.data[name][:-1], err_msg=name)
