@@ -39,8 +39,10 @@ from fmpy import read_model_description
 from ..errors import SSPError
 from ..limits import read_text_input
 from ..master.names import near
+from .interface import unit_definitions
 from .schedule import Schedule, ScheduleMode, When
 from .toml_lines import KeyLines
+from .units import BUILTIN, conversion, describe
 
 if sys.version_info >= (3, 11):
     import tomllib
@@ -55,7 +57,7 @@ MODE_KEYS = {"name", "step_size", "active", "record_every", "every", "when"}
 COMPONENT_KEYS = {"fmu", "parameter_files", "parameters"}
 SYSTEM_PARAMETER_KEYS = {"description", "value", "to"}
 CONNECTION_KEYS = {"auto", "exclude", "links"}
-LINK_KEYS = {"from", "to", "factor", "offset", "suppress_unit_conversion"}
+LINK_KEYS = {"from", "to", "factor", "offset", "suppress_unit_conversion", "from_unit", "to_unit"}
 ALGORITHMS = ("gauss-seidel", "jacobi")
 SSP_VERSIONS = ("1.0", "2.0")
 NAME = re.compile(r"^[A-Za-z_][A-Za-z0-9_]*$")
@@ -72,6 +74,7 @@ class ComponentSpec:
     parameter_files: List[Tuple[str, Path]]  # (stem in the SSP's parameters/, file)
     parameters: Dict[str, Any]  # variable name (vectors expanded) -> value
     variables: Dict[str, Any] = field(default_factory=dict)  # name -> fmpy ScalarVariable
+    unit_defs: Dict[str, Any] = field(default_factory=dict)  # unit name -> units.Unit
     model_identifier: str = ""
 
 
@@ -204,8 +207,7 @@ class SpecReader:
 
     def fail(self, key: Tuple[str, ...], message: str) -> SSPError:
         where = self.at_line or self.where(*key)
-        return SSPError(f"{where}: {'.'.join(k for k in key if not k.startswith('['))}"
-                        f"{''.join(k for k in key if k.startswith('['))}: {message}")
+        return SSPError(f"{where}: {dotted(key)}: {message}")
 
     def table(self, key: Tuple[str, ...], value: Any, allowed: set) -> Dict[str, Any]:
         if not isinstance(value, dict):
@@ -226,6 +228,14 @@ class SpecReader:
                 or (positive and value <= 0):
             raise self.fail(key, f"{value!r}: expected a finite number{' > 0' if positive else ''}")
         return float(value)
+
+
+def dotted(key: Tuple[str, ...]) -> str:
+    """('connections', 'links', '[2]', 'to_unit') -> 'connections.links[2].to_unit'."""
+    out = ""
+    for k in key:
+        out += k if k.startswith("[") or not out else f".{k}"
+    return out
 
 
 def _merged(base, over):
@@ -524,6 +534,9 @@ class _Composer:
         suppress = item.get("suppress_unit_conversion", False)
         if not isinstance(suppress, bool):
             raise r.fail(where + ("suppress_unit_conversion",), "expected true or false")
+        if "from_unit" in item or "to_unit" in item:
+            factor, offset = self._unit_conversion(where, item, src, dst, factor, offset)
+            suppress = True  # the conversion asked for is the link's whole conversion
         for o, i in zip(outs, ins):
             _check_types(r, where, self.components, src, o, dst, i, factor is not None or offset is not None)
             if (dst, i) in self.fed:
@@ -531,6 +544,28 @@ class _Composer:
                              "connection")
             self.fed[(dst, i)] = f"{src}.{o}"
             self.links.append(LinkSpec(src, o, dst, i, factor, offset, suppress))
+
+    def _unit_conversion(self, where, item, src, dst, factor, offset):
+        """(factor, offset) of a link's `from_unit` -> `to_unit` (for FMUs that declare no units,
+        or other ones than the values carry): units of our table or of either FMU."""
+        r = self.r
+        if factor is not None or offset is not None:
+            raise r.fail(where, "give from_unit and to_unit, or factor and offset, not both")
+        if not isinstance(item.get("from_unit"), str) or not isinstance(item.get("to_unit"), str):
+            raise r.fail(where, "from_unit and to_unit go together: the unit the value is in, the unit the input "
+                         "takes")
+        known = {**BUILTIN, **self.components[dst].unit_defs, **self.components[src].unit_defs}
+        units = []
+        for key in ("from_unit", "to_unit"):
+            if item[key] not in known:
+                raise r.fail(where + (key,), f"{item[key]!r}: unknown unit{near(item[key], known)} (units: ours "
+                             "and the two FMUs' definitions)")
+            units.append(known[item[key]])
+        done = conversion(*units)
+        if done is None:
+            raise r.fail(where, f"{item['from_unit']} ({describe(units[0])}) cannot be converted to {item['to_unit']} "
+                         f"({describe(units[1])})")
+        return done
 
     def auto_links(self, targets):
         """Each input not linked, not excluded and not a system parameter's target, fed by the one
@@ -636,6 +671,7 @@ def _read_fmu(r, key, comp):
         raise r.fail(key + ("fmu",), f"{comp.fmu_path}: has no co-simulation interface (model exchange only)")
     comp.model_identifier = md.coSimulation.modelIdentifier
     comp.variables = {v.name: v for v in md.modelVariables}
+    comp.unit_defs = unit_definitions(md)
 
 
 def _elements(comp, var):

@@ -53,9 +53,11 @@ fmu = "Gyro"
 fmu = "FMU_PATH"
 
 [connections]
-links = ["shadow.orbit_day -> sun_sensor.sunlit",
-         { from = "gyro.omega_meas_B[1]", to = "computer.Float64_continuous_input", factor = 57.29577951308232 },
-         { from = "computer.Float64_continuous_output", to = "dynamics.torque_B[1]", factor = -1e-6 }]
+links = [
+  "shadow.orbit_day -> sun_sensor.sunlit",
+  { from = "gyro.omega_meas_B[1]", to = "computer.Float64_continuous_input", from_unit = "rad/s", to_unit = "deg/s" },
+  { from = "computer.Float64_continuous_output", to = "dynamics.torque_B[1]", factor = -1e-6 },
+]
 """
 
 # The same system as a tool's user writes it by hand: components without connector lists, the
@@ -131,7 +133,7 @@ def assert_same_results(a, b):
 
 def test_a_spec_of_our_fmus_and_a_third_party_one_equals_the_system_written_by_hand(tmp_path, capsys):
     spec = write_spec(tmp_path / "spec")
-    assert len(spec.read_text().splitlines()) <= 36
+    assert len(spec.read_text().splitlines()) <= 32
     out = tmp_path / "composed.ssp"
     assert cli.main(["compose", str(spec), "--out", str(out)]) == 0
     report = capsys.readouterr().out
@@ -228,7 +230,7 @@ def test_a_spec_can_ask_for_ssp_2(tmp_path):
                                       r"\(did you mean 'Gyro'"),
     (("[master]\n", "[master]\nstep = 1\n"), r"system.toml:\d+: master.step: unknown key \(did you mean 'step_size'"),
     (("shadow.orbit_day -> sun_sensor.sunlit", "shadow.orbit_dy -> sun_sensor.sunlit"),
-     r"system.toml:28: connections.links\[1\]: 'shadow.orbit_dy': EarthShadow has no output 'orbit_dy' "
+     r"system.toml:29: connections.links\[1\]: 'shadow.orbit_dy': EarthShadow has no output 'orbit_dy' "
      r"\(did you mean 'orbit_day'"),
     (("seed = 7", "seed = 7.5"), r"system.toml:21: components.sun_sensor.parameters.seed: 7.5: seed is Integer"),
     (("omega0 = [0.05, -0.02, 0.01]", "omega0 = [0.05, -0.02]"),
@@ -238,6 +240,10 @@ def test_a_spec_can_ask_for_ssp_2(tmp_path):
      r"\(did you mean 'spacecraft'"),
     (("[connections]\n", "[connections]\nexclude = []\n[extra]\n"), r"system.toml:\d+: unknown table or key 'extra'"),
     (("stop_time = 30.0\n", ""), r"system.toml:\d+: \[master\] needs stop_time"),
+    (('to_unit = "deg/s"', 'to_unit = "deg/sec"'),
+     r"system.toml:30: connections.links\[2\].to_unit: 'deg/sec': unknown unit \(did you mean 'deg/s'"),
+    (('to_unit = "deg/s"', 'to_unit = "m"'),
+     r"system.toml:30: connections.links\[2\]: rad/s \(s\^-1\*rad\) cannot be converted to m \(m\)"),
 ])
 def test_a_bad_spec_is_refused_in_one_line_and_nothing_is_written(tmp_path, capsys, change, message):
     spec = write_spec(tmp_path, SPEC.replace(*change))
