@@ -593,13 +593,19 @@ def resolve_system(name):
     elif (path.suffix != ".ssp" or path.stem not in system_names()
           or path.parent.resolve() not in ((BUILD / "ssp").resolve(), (BUILD / "ssp3").resolve())):
         raise SSPError(f"{path}: file not found")
+    build_on_first_use()
+    return path
+
+
+def build_on_first_use():
+    """Build every FMU and system into the build folder, with one line on stderr: what the first
+    command that needs them does on an installed wheel. SSPError when the build fails."""
     print(f"neighbor-cosim: the FMUs and systems are not built yet; building them into {BUILD} "
           "(once per version, under a minute; `neighbor-cosim build` does it ahead)", file=sys.stderr, flush=True)
     try:
         build_all(verbose=False)
     except (BuildError, OSError) as exc:
         raise SSPError(f"building the systems into {BUILD} failed: {build_failure(exc)}") from None
-    return path
 
 
 def build_failure(exc):

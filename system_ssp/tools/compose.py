@@ -10,7 +10,6 @@ import os
 from pathlib import Path
 import re
 import shutil
-import sys
 import tempfile
 
 from .. import builder
@@ -33,12 +32,7 @@ def _shipped_fmus(fmu_dir):
     """The shipped FMUs' folder, built first when the default one is empty (a wheel's first use)."""
     fmu_dir = Path(fmu_dir)
     if fmu_dir == FMU_DIR and not any(fmu_dir.glob("*.fmu")):
-        print(f"neighbor-cosim: the FMUs are not built yet; building them into {builder.BUILD} (once per version)",
-              file=sys.stderr, flush=True)
-        try:
-            builder.build_all(verbose=False)
-        except (builder.BuildError, OSError) as exc:
-            raise SSPError(f"building the FMUs into {builder.BUILD} failed: {builder.build_failure(exc)}") from None
+        builder.build_on_first_use()
     return fmu_dir
 
 
@@ -211,7 +205,9 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
                  "", "[system]", f"name = {json.dumps(name)}"]
         lines.append(f"description = {json.dumps(f'{desc.system_name} (from {Path(str(source)).name})')}")
         lines += _master_lines(s)
-        values = s.collect_parameters()
+        values = {}  # component index -> {variable: the value the master applies}
+        for (ci, var), v in s.collect_parameters().items():
+            values.setdefault(ci, {})[var] = v
         shipped = {p.stem: p for p in Path(fmu_dir).glob("*.fmu")}
         copied = {}
         for comp in s.comps:
@@ -231,8 +227,7 @@ def spec_from_system(source, out, fmu_dir=FMU_DIR):
                     copied[target.name] = fmu
                 given = f"{files_dir.name}/{target.name}"
             lines += ["", f"[components.{_toml_key(comp.name)}]", f"fmu = {json.dumps(given)}"]
-            own = {var: v for (ci, var), v in values.items() if ci == comp.index}
-            grouped = _grouped_values(own, comp.vars)
+            grouped = _grouped_values(values.get(comp.index, {}), comp.vars)
             if grouped:
                 lines.append(f"[components.{_toml_key(comp.name)}.parameters]")
                 lines += [f"{_toml_key(k)} = {_toml_value(v)}" for k, v in grouped.items()]

@@ -78,15 +78,12 @@ def _signals(system, names, causality, what):
     """[(component, variable)] of `names` ("comp.var" or "comp.vector"), each of `causality`."""
     out = []
     for name in names:
-        comp, var = None, None
-        for c in sorted(system.comps, key=lambda c: -len(c.name)):
-            if name.startswith(c.name + "."):
-                comp, var = c, name[len(c.name) + 1:]
-                break
-        if comp is None:
-            system.split_name(name, what)  # raises with the components and close matches
-        elements = [var] if var in comp.vars else comp.whole(var)  # a vector: its elements
-        if not elements:
+        # the longest component name that prefixes `name` wins, as the master's split_name has it
+        comp = next((c for c in sorted(system.comps, key=lambda c: -len(c.name)) if name.startswith(c.name + ".")),
+                    None)
+        var = name[len(comp.name) + 1:] if comp is not None else ""
+        elements = ([var] if var in comp.vars else comp.whole(var)) if comp is not None else None
+        if not elements:  # a vector name gives its elements; anything else is refused with close matches
             system.split_name(name, what)
         for v in elements:
             if comp.vars[v].causality != causality:
