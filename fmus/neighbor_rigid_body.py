@@ -12,6 +12,9 @@ Euler's equation into the gyrostat equation J omega_dot = L - wheel_torque_B - o
 the original variables are unchanged; left at zero the model is bit-identical to the wheel-less
 one. H_B stays the body's own J omega (the total is H_B + wheel_momentum_B).
 
+Disturbances (appended last): the input disturbance_torque_B (DisturbanceTorques' torque_B) is
+added to torque_B; left at zero the model is the undisturbed one bit for bit.
+
 Mass properties that follow the tank (appended last, off by default): with
 `propellant_mass_properties` the inertia is the one about the centre of mass once
 propellant_used + rcs_propellant kg left the tank at the NEIGHBOR module's centre
@@ -92,8 +95,13 @@ class RigidBody(NeighborSlave):
                              "Fractional error of the body's second moment of mass along body x, y, z (the integral "
                              "of x_i^2 dm) against the nominal inertia (the box, or inertia_B) the flight software "
                              "assumes, in [-0.5, 0.5]; 0: the nominal inertia")
+        # The environment's torque (appended last, issue 56): summed with torque_B; 0 is the model bit for bit
+        self.input_array("disturbance_torque_B", [0.0, 0.0, 0.0], "N.m",
+                         "Disturbance torque on the body in B (DisturbanceTorques.torque_B: gravity gradient, drag, "
+                         "solar pressure, residual dipole), added to torque_B, held over a step; 0 without")
         self.share_values()
-        self._inputs_at = self.shared_indices((("torque_B", 3), ("wheel_torque_B", 3), ("wheel_momentum_B", 3)))
+        self._inputs_at = self.shared_indices((("torque_B", 3), ("wheel_torque_B", 3), ("wheel_momentum_B", 3),
+                                               ("disturbance_torque_B", 3)))
         self._outputs_at = self.shared_indices(rigid_body.PUBLISHED)
 
     def build_model(self):

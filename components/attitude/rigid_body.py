@@ -76,7 +76,7 @@ Q, OMEGA, OMEGA_DOT, ANGLES, CENTER, J_ROWS, JINV_ROWS, RAW_Q, STATE_SIZE = 0, 4
 # publish_into's outputs, in the order of its `outputs` indices
 PUBLISHED = (("q_BN", 4), ("omega_BN_B", 3), ("omega_dot_BN_B", 3), ("euler123", 3), ("H_B", 3),
              ("euler_integrated", 3), ("center_of_mass_B", 3))
-_INPUT_NAMES = ("torque_B", "wheel_torque_B", "wheel_momentum_B")
+_INPUT_NAMES = ("torque_B", "wheel_torque_B", "wheel_momentum_B", "disturbance_torque_B")
 NINE = np.arange(9)  # step()'s inputs: the whole of its own array
 
 
@@ -176,7 +176,7 @@ class RigidBody:
         else:
             error = rk4_step_into(self.x, values, inputs, h, max(1, math.ceil(h / self.max_substep - 1e-9)))
         if error:
-            if error <= 3:
+            if error <= 4:
                 name = _INPUT_NAMES[error - 1]
                 raise ValueError(f"{name} {values[inputs[3 * error - 3:3 * error]].tolist()} must be finite")
             rotations.normalized(tuple(self.x[RAW_Q:RAW_Q + 4].tolist()))  # raises its error
@@ -283,15 +283,25 @@ def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
 
 
 @njit(cache=True)
+def _body_torque(values, inputs):
+    """The external torque: torque_B at values[inputs[0:3]], plus the disturbance torque at
+    values[inputs[9:12]] where the caller passes twelve inputs (the FMU) rather than nine."""
+    if inputs.shape[0] > 9:
+        return (values[inputs[0]] + values[inputs[9]], values[inputs[1]] + values[inputs[10]],
+                values[inputs[2]] + values[inputs[11]])
+    return (values[inputs[0]], values[inputs[1]], values[inputs[2]])
+
+
+@njit(cache=True)
 def euler_step_into(x, values, inputs, h):
     """The thesis scripts' StateChange on the state array x in place: one explicit Euler step of h
     with the inputs at values[inputs[0:9]] as in rk4_step_into, q not normalized, then Eq. 31's
-    angles += the new omega h (Appendix C-D). Returns 0, or 1-3 when that input vector is not
+    angles += the new omega h (Appendix C-D). Returns 0, or 1-4 when that input vector is not
     finite (nothing changed)."""
-    for k in range(9):
+    for k in range(inputs.shape[0]):
         if not math.isfinite(values[inputs[k]]):
             return k // 3 + 1
-    torque = (values[inputs[0]], values[inputs[1]], values[inputs[2]])
+    torque = _body_torque(values, inputs)
     tw = (values[inputs[3]], values[inputs[4]], values[inputs[5]])
     J = (x[16], x[17], x[18], x[19], x[20], x[21], x[22], x[23], x[24])
     Ji = (x[25], x[26], x[27], x[28], x[29], x[30], x[31], x[32], x[33])
@@ -310,13 +320,13 @@ def rk4_step_into(x, values, inputs, h, n):
     """RigidBody's RK4 communication step on its state array x in place: the torque, wheel torque
     and wheel momentum at values[inputs[0:9]], n sub-steps of h / n (rk4_steps), the quaternion
     normalized (rotations.normalized) and omega_dot the mean over the step; the same operations
-    as the step in Python. Returns 0, or 1-3 when that input vector is not finite (nothing
-    changed), or 4 when the quaternion's norm is zero or not finite (the angles are updated, the
+    as the step in Python. Returns 0, or 1-4 when that input vector is not finite (nothing
+    changed), or 5 when the quaternion's norm is zero or not finite (the angles are updated, the
     quaternion is left in x[RAW_Q:])."""
-    for k in range(9):
+    for k in range(inputs.shape[0]):
         if not math.isfinite(values[inputs[k]]):
             return k // 3 + 1
-    torque = (values[inputs[0]], values[inputs[1]], values[inputs[2]])
+    torque = _body_torque(values, inputs)
     tw = (values[inputs[3]], values[inputs[4]], values[inputs[5]])
     hw = (values[inputs[6]], values[inputs[7]], values[inputs[8]])
     J = (x[16], x[17], x[18], x[19], x[20], x[21], x[22], x[23], x[24])
@@ -327,7 +337,7 @@ def rk4_step_into(x, values, inputs, h, n):
     norm = math.sqrt(q[0] * q[0] + q[1] * q[1] + q[2] * q[2] + q[3] * q[3])
     if not math.isfinite(norm) or norm < 1e-12:
         x[34], x[35], x[36], x[37] = q
-        return 4
+        return 5
     x[0], x[1], x[2], x[3] = q[0] / norm, q[1] / norm, q[2] / norm, q[3] / norm
     x[4], x[5], x[6] = w
     x[7], x[8], x[9] = (w[0] - w0[0]) / h, (w[1] - w0[1]) / h, (w[2] - w0[2]) / h
