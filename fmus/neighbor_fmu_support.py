@@ -21,6 +21,7 @@ publishes its outputs into it (see the section "values shared with the runtime" 
 """
 import copy
 import math
+import os
 from collections import OrderedDict
 from operator import itemgetter
 from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
@@ -74,6 +75,17 @@ def _picker(indices):
 
 
 _SHARED = object()  # marks a get or set plan served by the shared array
+
+
+def in_this_extraction(path, module, resources):
+    """`path`, a file of the FMU's bundled `module`, in this instance's extraction of the FMU:
+    every instance gets its own `resources` folder, while the module may have been imported from
+    an earlier extraction of the same build that is gone by now. Unchanged outside an FMU."""
+    parts = module.__name__.split(".")
+    if not resources or not __package__ or parts[0] != __package__.split(".")[0]:
+        return path
+    relative = os.path.relpath(path, os.path.dirname(os.path.abspath(module.__file__)))
+    return os.path.join(resources, *parts[:-1], relative)
 
 
 class ParameterError(ValueError):

@@ -6,6 +6,8 @@ file (build_fmus.py bundles what a wrapper imports)."""
 import math
 import os
 
+from neighbor_fmu_support import in_this_extraction
+
 from components.mission.neighbor import SPACECRAFT
 
 
@@ -88,17 +90,6 @@ def atmosphere_parameters(slave):
 
 
 _ATMOSPHERE_CACHE = {}
-
-
-def in_this_extraction(path, module, resources):
-    """`path`, a file of the FMU's bundled `module`, in this instance's extraction of the FMU:
-    every instance gets its own `resources` folder, while the module may have been imported from
-    an earlier extraction of the same build that is gone by now. Unchanged outside an FMU."""
-    parts = module.__name__.split(".")
-    if not resources or not __package__ or parts[0] != __package__.split(".")[0]:
-        return path
-    relative = os.path.relpath(path, os.path.dirname(os.path.abspath(module.__file__)))
-    return os.path.join(resources, *parts[:-1], relative)
 
 
 def atmosphere_model(values, inclination=None, resources=None):

@@ -253,13 +253,26 @@ def _support_module():
     """fmus/neighbor_orbit_support.py loaded under another module name, so that it cannot stand
     in for anything an FMU loads."""
     import importlib.util
+    import sys
 
-    path = REPO / "fmus" / "neighbor_orbit_support.py"
-    spec = importlib.util.spec_from_file_location("_atmosphere_test_fmu_support", path)
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    _INSTANCES.append(module)  # never garbage-collected while pytest runs (see _INSTANCES)
-    return module
+    def load(name, file):
+        spec = importlib.util.spec_from_file_location(name, REPO / "fmus" / file)
+        module = importlib.util.module_from_spec(spec)
+        spec.loader.exec_module(module)
+        _INSTANCES.append(module)  # never garbage-collected while pytest runs (see _INSTANCES)
+        return module
+
+    # the module imports the wrappers' base module by its bare name, as inside an FMU: a private copy
+    # stands in for it while it loads
+    before = sys.modules.get("neighbor_fmu_support")
+    sys.modules["neighbor_fmu_support"] = load("_atmosphere_test_fmu_base", "neighbor_fmu_support.py")
+    try:
+        return load("_atmosphere_test_fmu_support", "neighbor_orbit_support.py")
+    finally:
+        if before is None:
+            del sys.modules["neighbor_fmu_support"]
+        else:
+            sys.modules["neighbor_fmu_support"] = before
 
 
 def test_fmu_support_atmosphere_model(tmp_path):
