@@ -1,5 +1,8 @@
 """FMU `Orbit` (instance `orbit`): Cowell orbit propagation with EGM96 zonal gravity, drag and thrust.
 
+Optionally (gravity_degree, sun_gravity, moon_gravity): the GGM03S spherical-harmonic field to
+degree and order 36 in the Earth-fixed frame, and the Sun and Moon as point masses.
+
 Wraps components.orbit.cowell.CowellOrbit (gravity point mass + J2..J6, drag per thesis Eq. 1 with the
 velocity relative to the rotating atmosphere, thrust F_B rotated to N with q_BN or along -v when
 `retrograde`). Integrated across each communication step with adaptive DOP853 (minutes in coast,
@@ -52,6 +55,16 @@ class Orbit(NeighborSlave):
                     "Latched true once the geodetic altitude is below reentry_altitude; the model then holds "
                     "its state", bool)
         impulse_input(self)
+        # The full gravity field and the third bodies (appended last, issue 56)
+        self.parameter("gravity_degree", 0, None,
+                       "0: the zonal terms of zonal_degree (EGM96); 2..36: the GGM03S spherical-harmonic field to this "
+                       "degree in the Earth-fixed frame (GMST rotation), replacing them", int)
+        self.parameter("gravity_order", -1, None, "Highest order of the GGM03S field, 0..gravity_degree; -1: the "
+                       "degree (0: its zonal terms only)", int)
+        self.parameter("sun_gravity", False, None, "The Sun as a third body (Vallado's low-precision ephemeris, "
+                       "about 0.01 deg)", bool)
+        self.parameter("moon_gravity", False, None, "The Moon as a third body (Montenbruck and Gill's low-precision "
+                       "series, a few arcminutes and about 500 km)", bool)
 
     def build_model(self):
         v = self.values
@@ -62,7 +75,9 @@ class Orbit(NeighborSlave):
         return cowell.CowellOrbit(
             epoch=v["epoch"], sma0=sma, ecc0=ecc, inc0=inc, raan0=raan, argp0=argp,
             ta0=ta, Cd=v["Cd"], area=v["area"], mass=v["mass"], reentry_altitude=v["reentry_altitude"],
-            density_model=density, drag=v["drag"], zonal_degree=v["zonal_degree"], mu=v["mu"], t0=self.start_time)
+            density_model=density, drag=v["drag"], zonal_degree=v["zonal_degree"], mu=v["mu"], t0=self.start_time,
+            gravity_degree=v["gravity_degree"], gravity_order=None if v["gravity_order"] == -1 else v["gravity_order"],
+            sun_gravity=v["sun_gravity"], moon_gravity=v["moon_gravity"])
 
     def do_step(self, current_time, step_size):
         m = self.model

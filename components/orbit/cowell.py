@@ -4,7 +4,11 @@ Equations of motion (N frame, m and s):
 
     r' = v
     v' = a_grav(r) + a_drag + a_thrust
-    a_grav   : components.environment.gravity.accel_zonal (point mass + J2..J`zonal_degree`)
+    a_grav   : components.environment.gravity.accel_zonal (point mass + J2..J`zonal_degree`); with
+               `gravity_degree` > 0 the point mass plus the GGM03S field to that degree and order
+               (gravity.accel_harmonics) in the Earth-fixed frame (N rotated by the GMST of each
+               stage's time), and optionally the Sun and the Moon as third bodies (gravity.third_body,
+               the ephemerides of components.environment.sun and .moon)
     a_drag   = -1/2 rho(r, t) Cd A / m |v_rel| v_rel,  v_rel = v - omega_E x r       (thesis Eq. 1,
                with the velocity relative to the co-rotating atmosphere, omega_E = 7.292115e-5 rad/s
                about z)
@@ -46,8 +50,12 @@ from ..core import rotations, time_utils
 from ..environment import atmosphere, geodesy
 from ..environment.atmosphere import base, exponential, harris_priester, jacchia_roberts
 from ..core.checks import positive
-from ..environment.gravity import accel_zonal, zonal_coefficients
-from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
+from ..environment import magnetic_field, sun
+from ..environment.gravity import (MU_MOON, MU_SUN, accel_harmonics, accel_zonal, spherical_harmonic_coefficients,
+                                   third_body, zonal_coefficients)
+from ..environment.moon import moon_position
+from ..environment.sun import AU
+from ..core.constants import DAY, DAYS_PER_CENTURY, MU_EARTH, OMEGA_EARTH_WGS84, R_EQ, WGS84_A, WGS84_F
 from ..mission.neighbor import SPACECRAFT
 from . import dop853
 from .propulsion import ImpulseWindow
@@ -63,6 +71,10 @@ _A, _B, _C, _E3, _E5 = (np.ascontiguousarray(x) for x in (dop853.A, dop853.B, do
 
 # indices into the force-parameter vector `fp`
 _MU, _REQ, _DRAG, _BC, _JD0, _WE, _TX, _TY, _TZ, _TMAG, _RETRO = range(11)
+# and into `grav`, the gravity beyond the zonal terms
+_G_DEGREE, _G_SUN, _G_MOON, _G_S_J2000 = range(4)
+gmst_nb = njit(cache=True)(magnetic_field.gmst)
+sun_position_au_nb = njit(cache=True)(sun.sun_position_au)
 
 
 @njit(cache=True)
@@ -90,6 +102,31 @@ def geodetic_altitude_nb(x, y, z):
     return z / sl - n * (1.0 - e2)
 
 
+@njit(cache=True)
+def _extra_gravity(t, x, y, z, mu, r_eq, grav, Cnm, Snm):
+    """The gravity beyond the zonal kernel's at time t (s since the epoch) and position (m, N):
+    the spherical-harmonic terms of Cnm, Snm to degree grav[_G_DEGREE] in the Earth-fixed frame
+    (N rotated by the GMST of the time), the Sun and the Moon as point masses (their flags)."""
+    seconds = grav[_G_S_J2000] + t
+    T = seconds / (DAY * DAYS_PER_CENTURY)
+    ax = ay = az = 0.0
+    degree = int(grav[_G_DEGREE])
+    if degree > 0:
+        th = gmst_nb(T)
+        c, s = math.cos(th), math.sin(th)
+        gx, gy, gz = accel_harmonics(c * x + s * y, -s * x + c * y, z, mu, r_eq, Cnm, Snm, degree)
+        ax, ay, az = c * gx - s * gy, s * gx + c * gy, gz
+    if grav[_G_SUN] != 0.0:
+        sx, sy, sz = sun_position_au_nb(T)
+        bx, by, bz = third_body(x, y, z, sx * AU, sy * AU, sz * AU, MU_SUN)
+        ax, ay, az = ax + bx, ay + by, az + bz
+    if grav[_G_MOON] != 0.0:
+        mx, my, mz = moon_position(T)
+        bx, by, bz = third_body(x, y, z, mx, my, mz, MU_MOON)
+        ax, ay, az = ax + bx, ay + by, az + bz
+    return ax, ay, az
+
+
 # _deriv and _advance take the atmosphere's kernel as an argument, and numba types a function
 # argument by the identity of its dispatcher object: the cache never matches one in another
 # process, so cache=True only added a ~0.5 MB entry per run to the user's cache (for ever), and
@@ -98,7 +135,7 @@ def geodetic_altitude_nb(x, y, z):
 # below (the kernel a module's global, their signatures without it); any other kernel is passed
 # to _advance, compiled in each process (4-6 s).
 @njit(cache=False)
-def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
+def _deriv(t, y, fp, J, nmax, grav, Cnm, Snm, kernel, kdata, out):
     x = y[0]
     yy = y[1]
     z = y[2]
@@ -106,6 +143,11 @@ def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
     vy = y[4]
     vz = y[5]
     ax, ay, az = accel_zonal(x, yy, z, fp[_MU], fp[_REQ], J, nmax)
+    if grav[_G_DEGREE] > 0.0 or grav[_G_SUN] != 0.0 or grav[_G_MOON] != 0.0:
+        gx, gy, gz = _extra_gravity(t, x, yy, z, fp[_MU], fp[_REQ], grav, Cnm, Snm)
+        ax += gx
+        ay += gy
+        az += gz
     if fp[_DRAG] != 0.0:
         rho = kernel(y[0:3], fp[_JD0] + t / DAY, kdata)
         w = fp[_WE]
@@ -135,7 +177,7 @@ def _deriv(t, y, fp, J, nmax, kernel, kdata, out):
 
 
 @njit(cache=False)
-def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E3, E5,
+def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, kernel, kdata, A, B, C, E3, E5,
              reentry_altitude, max_steps):
     """DOP853 from t to t_end (lands exactly). Returns (t, y, h_next, reentered, steps, rejected).
 
@@ -145,7 +187,7 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
     K = np.empty((13, n))
     ytmp = np.empty(n)
     ynew = np.empty(n)
-    _deriv(t, y, fp, J, nmax, kernel, kdata, K[0])
+    _deriv(t, y, fp, J, nmax, grav, Cnm, Snm, kernel, kdata, K[0])
     steps = 0
     rejected = 0
     reentered = False
@@ -164,14 +206,14 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
                     for j in range(s):
                         acc += A[s, j] * K[j, k]
                     ytmp[k] = y[k] + hh * acc
-                _deriv(t + C[s] * hh, ytmp, fp, J, nmax, kernel, kdata, K[s])
+                _deriv(t + C[s] * hh, ytmp, fp, J, nmax, grav, Cnm, Snm, kernel, kdata, K[s])
             for k in range(n):
                 acc = 0.0
                 for j in range(12):
                     acc += B[j] * K[j, k]
                 ynew[k] = y[k] + hh * acc
             t_new = t_end if last else t + hh
-            _deriv(t_new, ynew, fp, J, nmax, kernel, kdata, K[12])
+            _deriv(t_new, ynew, fp, J, nmax, grav, Cnm, Snm, kernel, kdata, K[12])
             e5 = 0.0
             e3 = 0.0
             for k in range(n):
@@ -219,31 +261,31 @@ def _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, kernel, kdata, A, B, C, E
 
 
 @njit(cache=True)
-def _advance_jacchia_roberts(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
-                             max_steps):
-    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, jacchia_roberts.jacchia_roberts_kernel, kdata, A, B, C,
-                    E3, E5, reentry_altitude, max_steps)
+def _advance_jacchia_roberts(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, kdata, A, B, C, E3, E5,
+                             reentry_altitude, max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, jacchia_roberts.jacchia_roberts_kernel,
+                    kdata, A, B, C, E3, E5, reentry_altitude, max_steps)
 
 
 @njit(cache=True)
-def _advance_harris_priester(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
-                             max_steps):
-    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, harris_priester.harris_priester_kernel, kdata, A, B, C,
-                    E3, E5, reentry_altitude, max_steps)
+def _advance_harris_priester(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, kdata, A, B, C, E3, E5,
+                             reentry_altitude, max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, harris_priester.harris_priester_kernel,
+                    kdata, A, B, C, E3, E5, reentry_altitude, max_steps)
 
 
 @njit(cache=True)
-def _advance_exponential(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
-                         max_steps):
-    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, exponential.exponential_kernel, kdata, A, B, C,
-                    E3, E5, reentry_altitude, max_steps)
+def _advance_exponential(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, kdata, A, B, C, E3, E5,
+                         reentry_altitude, max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, exponential.exponential_kernel,
+                    kdata, A, B, C, E3, E5, reentry_altitude, max_steps)
 
 
 @njit(cache=True)
-def _advance_without_drag(t, y0, t_end, h, rtol, atol, fp, J, nmax, kdata, A, B, C, E3, E5, reentry_altitude,
-                          max_steps):
-    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, base.vacuum_kernel, kdata, A, B, C,
-                    E3, E5, reentry_altitude, max_steps)
+def _advance_without_drag(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, kdata, A, B, C, E3, E5,
+                          reentry_altitude, max_steps):
+    return _advance(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, Snm, base.vacuum_kernel,
+                    kdata, A, B, C, E3, E5, reentry_altitude, max_steps)
 
 
 _CACHED_ADVANCE = {jacchia_roberts.jacchia_roberts_kernel: _advance_jacchia_roberts,
@@ -262,7 +304,8 @@ class CowellOrbit:
                  raan0=0.0, argp0=0.0, ta0=0.0, Cd=SPACECRAFT.Cd, area=SPACECRAFT.drag_area,
                  mass=SPACECRAFT.mass, reentry_altitude=250e3,
                  density_model=None, drag=True, zonal_degree=6, mu=MU_EARTH, t0=0.0, space_weather=None,
-                 rtol=RTOL, atol_position=ATOL_POSITION, atol_velocity=ATOL_VELOCITY):
+                 rtol=RTOL, atol_position=ATOL_POSITION, atol_velocity=ATOL_VELOCITY, gravity_degree=0,
+                 gravity_order=None, sun_gravity=False, moon_gravity=False):
         self.epoch = epoch
         self.jd0 = time_utils.julian_date(time_utils.parse_epoch(epoch, "epoch"))
         self.mu = positive("mu", mu, "m3/s2")
@@ -275,6 +318,7 @@ class CowellOrbit:
             raise ValueError(f"zonal_degree = {zonal_degree!r} must be 0 (point mass) or an integer in [2, 6]")
         self.zonal_degree = int(zonal_degree)
         self.J = zonal_coefficients(self.zonal_degree)
+        self._gravity_field(gravity_degree, gravity_order, sun_gravity, moon_gravity)
         self.rtol = positive("rtol", rtol, "")
         self.atol = np.array([positive("atol_position", atol_position, "m")] * 3
                              + [positive("atol_velocity", atol_velocity, "m/s")] * 3)
@@ -317,6 +361,25 @@ class CowellOrbit:
         self.retrograde = False
         self.mass = positive("mass", mass, "kg")
         self._outputs = None
+
+    def _gravity_field(self, degree, order, sun_gravity, moon_gravity):
+        """gravity_degree > 0: the GGM03S field to that degree and order (default: the degree) in
+        the Earth-fixed frame replaces the EGM96 zonal terms; the Sun and Moon point masses."""
+        for name, value in (("sun_gravity", sun_gravity), ("moon_gravity", moon_gravity)):
+            if not isinstance(value, (bool, np.bool_)):
+                raise ValueError(f"{name} = {value!r} must be true or false")
+        if isinstance(degree, bool) or int(degree) != degree or int(degree) < 0:
+            raise ValueError(f"gravity_degree = {degree!r} must be 0 (the zonal model of zonal_degree) or an "
+                             "integer in [2, 36] (GGM03S)")
+        degree = int(degree)
+        if degree:
+            self._Cnm, self._Snm = spherical_harmonic_coefficients(degree, degree if order is None else order)
+            self.J, self.zonal_degree = zonal_coefficients(0), 0  # point mass only: the field has the zonal terms
+        else:
+            self._Cnm = self._Snm = np.zeros((1, 1))
+        self.gravity_degree = degree
+        self._grav = np.array([float(degree), float(bool(sun_gravity)), float(bool(moon_gravity)),
+                               time_utils.seconds_since_j2000(self.epoch)])
 
     # ---- inputs --------------------------------------------------------------------------
     def set_inputs(self, F_thrust_B=None, q_BN=None, retrograde=None, mass=None, impulse_B=None, step=0.0):
@@ -374,7 +437,7 @@ class CowellOrbit:
             return
         if not self.reentered:
             args = (self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
-                    self.zonal_degree)
+                    self.zonal_degree, self._grav, self._Cnm, self._Snm)
             tail = (self._kdata, _A, _B, _C, _E3, _E5, self.reentry_altitude, MAX_INTERNAL_STEPS)
             cached = _CACHED_ADVANCE.get(self._kernel)
             ts, y, h, reentered, steps, _ = (cached(*args, *tail) if cached is not None
