@@ -47,6 +47,48 @@ SPACECRAFT = Spacecraft()
 
 
 @dataclass(frozen=True)
+class Facet:
+    """A flat outer face of the spacecraft for the drag and solar-pressure disturbances
+    (components.attitude.disturbances): unit outward normal and centre in B (m, from the centre of
+    mass at takeover), area, drag coefficient, specular and diffuse reflection coefficients."""
+    name: str
+    normal_B: Tuple[float, float, float]
+    area: float
+    centre_B: Tuple[float, float, float]
+    specular: float
+    diffuse: float
+    Cd: float = SPACECRAFT.Cd
+
+
+def _box_facets() -> Tuple[Facet, ...]:
+    """The outer faces of the 6U stack (the thesis' box: c = 0.3 m along x, a = 0.1 m along y,
+    b = 0.2 m along z, uniform, so its centre is the centre of mass), split where the 2U NEIGHBOR
+    module (the -x 0.1 m, at the tank: components.attitude.mass_properties) meets the rest of the
+    host. Optical coefficients are assumed, not from the thesis: the host's faces carry
+    body-mounted solar cells (specular 0.05, diffuse 0.20, the rest absorbed), the module's
+    are bare aluminium alloy (specular 0.20, diffuse 0.40)."""
+    a, b, c = SPACECRAFT.edge_a, SPACECRAFT.edge_b, SPACECRAFT.edge_c
+    module, host = a, c - a  # lengths along x
+    xm, xh = -c / 2 + module / 2, c / 2 - host / 2  # their centres along x
+    cells, aluminium = (0.05, 0.20), (0.20, 0.40)
+    faces = [Facet("host +x", (1.0, 0.0, 0.0), a * b, (c / 2, 0.0, 0.0), *cells),
+             Facet("module -x", (-1.0, 0.0, 0.0), a * b, (-c / 2, 0.0, 0.0), *aluminium)]
+    for part, length, x, optics in (("host", host, xh, cells), ("module", module, xm, aluminium)):
+        for sign in (1.0, -1.0):
+            s = "+" if sign > 0 else "-"
+            faces.append(Facet(f"{part} {s}y", (0.0, sign, 0.0), length * b, (x, sign * a / 2, 0.0), *optics))
+            faces.append(Facet(f"{part} {s}z", (0.0, 0.0, sign), length * a, (x, 0.0, sign * b / 2), *optics))
+    return tuple(Facet(f.name, f.normal_B, round(f.area, 12), tuple(round(x, 12) for x in f.centre_B), f.specular,
+                       f.diffuse) for f in faces)
+
+
+FACETS: Tuple[Facet, ...] = _box_facets()
+# Residual magnetic dipole of the failed host with NEIGHBOR (A.m2, B): assumed, of the order
+# measured on CubeSats of this size (1e-3 to 5e-2 A.m2); the thesis gives none.
+RESIDUAL_DIPOLE_B: Tuple[float, float, float] = (0.005, 0.005, 0.01)
+
+
+@dataclass(frozen=True)
 class Orbit:
     """The host's orbit and the de-orbit's start and end (Section 3.2, Table 3)."""
     inclination_deg: float = 51.6  # ISS-like (Table 3)
@@ -126,7 +168,7 @@ MISSION_RECORD: Tuple[str, ...] = (
     "power.load_power", "data.storage_used", "data.bytes_lost", "data.overflow", "data.downlinked",
     *elements("dynamics.omega_BN_B", 3), *elements("dynamics.euler123", 3),
     *elements("dynamics.euler_integrated", 3), *elements("dynamics.q_BN", 4), *elements("guidance.q_target_BN", 4),
-    "estimator.fixed_without_sun")
+    "estimator.fixed_without_sun", *elements("disturbances.torque_B", 3))
 # What the de-orbit study records for its table and figures.
 DEORBIT_RECORD: Tuple[str, ...] = (
     "orbit.sma", "orbit.ecc", "orbit.perigee_altitude", "orbit.apogee_altitude", "orbit.altitude",

@@ -282,6 +282,10 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     ran = nees_mean > 0.0
     s["nees_mean"] = nees_mean if ran else None
     s["nees_over_fraction_percent"] = 100.0 * nees_over if ran else None
+    # the environment's torque on the stack from the takeover to the end of the burn (0: switched off)
+    maneuver = (t >= t0) & (t <= t_mon)
+    torque = np.linalg.norm(np.column_stack([d[f"disturbances.torque_B[{i}]"][maneuver] for i in (1, 2, 3)]), axis=1)
+    s["disturbance_torque_max_Nm"] = float(torque.max()) if torque.size else 0.0
     s["burn_propellant_kg"] = float(d["propulsion.propellant_used"][i_mon])
     s["total_propellant_kg"] = s["burn_propellant_kg"] + float(rcs[i_mon])
     soc, energy = d["power.state_of_charge"], d["power.energy"]
@@ -335,6 +339,8 @@ def table(s):
              "{:.2f}"),
             ("estimator consistency: steps with the NEES above its 95 % bound (%; 5 when consistent)",
              "nees_over_fraction_percent", "{:.1f}"),
+            ("largest disturbance torque in the de-orbit maneuver (N.m; gravity gradient, drag, solar pressure, "
+             "residual dipole; 0: off)", "disturbance_torque_max_Nm", "{:.3g}"),
             ("total propellant (kg; thesis: sized for the worst-case slew)", "total_propellant_kg", "{:.4f}"),
             ("battery after the de-orbit maneuver (%)", "soc_after_burn_percent", "{:.2f}"),
             ("energy used to the end of the burn (Wh)", "energy_used_Wh", "{:.3f}"),

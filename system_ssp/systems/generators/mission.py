@@ -70,13 +70,13 @@ import datetime as dt
 import math
 
 
-from components.attitude import rigid_body, thruster_control
+from components.attitude import disturbances, rigid_body, thruster_control
 from components.environment import atmosphere
 from components.orbit import averaged, propulsion
 from components.core import time_utils
 from components.core.constants import DAY, R_EQ
-from components.mission.neighbor import (DEFAULT_SCENARIO, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT, SCENARIOS,
-                                         SPACECRAFT, scenario_set)
+from components.mission.neighbor import (DEFAULT_SCENARIO, FACETS, GNC_SETS, MISSION_SYSTEMS, ORBIT as HOST_ORBIT,
+                                         RESIDUAL_DIPOLE_B, SCENARIOS, SPACECRAFT, scenario_set)
 
 from ...ssp.writer import vec
 from . import attitude_determination as ad
@@ -143,6 +143,9 @@ ACCEL_SIGMA = 0.02 * thruster_control.pair_torques()[0] / INERTIA[0, 0]
 TRACKING_LAYER = {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4, "min_on_time": MIN_ON_TIME}
 # What the thesis parameter set restores (names component.variable); every value the closed loop
 # changes appears here.
+# The environment's torques, switched off: the thesis set has none (its published numbers), and
+# parameters/mission_disturbances_off.ssv flies any other set without them, for comparison.
+DISTURBANCES_OFF = {f"disturbances.{source}": False for source in disturbances.SOURCES}
 GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynamics.integrator": "euler",
               "tracking.target_from_input": False, "tracking.knowledge_sigmas": 0.0, "tracking.impulse_bits": 0.0,
               "thrusters.off_pulsing": False, "thrusters.fault_detection": False, "estimator.fault_window": 0,
@@ -151,7 +154,8 @@ GNC_THESIS = {"estimator.truth_feedback": True, "orbit.retrograde": True, "dynam
               "mission.attitude_determination_timeout": 0.0, "mission.safe_without_attitude": False,
               "detumble.settle_time": 0.0, **vec("detumble.omega_tol", [math.radians(0.01)] * 3),
               "slew.target_from_input": False, **vec("slew.omega_tol", [math.radians(0.01)] * 3),
-              **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0}
+              **vec("slew.rate_deadband", [0.0] * 3), "slew.settle_time": 0.0,
+              **DISTURBANCES_OFF}
 
 
 # The spacecraft's physical values, each given once (system parameters of the SSD, in
@@ -185,6 +189,23 @@ def deployment_altitude(target_km, density=HOST_ORBIT.density_model):
         if hi - lo < 0.01:
             break
     return 0.5 * (lo + hi)
+
+
+def facet_values():
+    """The DisturbanceTorques parameters of the mission definition's facets and dipole (its unused
+    slots at area 0)."""
+    values = {source: True for source in disturbances.SOURCES}
+    values.update(vec("residual_dipole_B", list(RESIDUAL_DIPOLE_B)))
+    for i in range(1, disturbances.MAX_FACETS + 1):
+        f = FACETS[i - 1] if i <= len(FACETS) else None
+        values[f"facet_area[{i}]"] = f.area if f else 0.0
+        for j in range(3):
+            values[f"facet_normal_B[{i},{j + 1}]"] = f.normal_B[j] if f else (1.0 if j == 0 else 0.0)
+            values[f"facet_centre_B[{i},{j + 1}]"] = f.centre_B[j] if f else 0.0
+        values[f"facet_Cd[{i}]"] = f.Cd if f else SPACECRAFT.Cd
+        values[f"facet_specular[{i}]"] = f.specular if f else 0.0
+        values[f"facet_diffuse[{i}]"] = f.diffuse if f else 0.0
+    return values
 
 
 def generate(writer):
@@ -249,6 +270,15 @@ def generate(writer):
                "identity slew target, tracking at the Eq. 67 rate latched at the burn start, single-sample stop "
                "tests, Euler attitude integration", GNC_THESIS)
     writer.ssv("mission_sun", "Sun ephemeris from the mission epoch", {"epoch": MISSION_EPOCH})
+    writer.ssv("mission_field", "IGRF-14 magnetic field to degree 13 from the mission epoch, secular variation on",
+               {"epoch": MISSION_EPOCH, "secular_variation": True, "degree": 13})
+    writer.ssv("mission_disturbances",
+               f"Disturbance torques of the 6U stack: its {len(FACETS)} outer faces (the host's with body-mounted "
+               "cells, the 2U NEIGHBOR module's bare aluminium; components.mission.neighbor.FACETS), Cd "
+               f"{SPACECRAFT.Cd:g}, residual dipole {list(RESIDUAL_DIPOLE_B)} A.m2 (assumed), all four sources on",
+               facet_values())
+    writer.ssv("mission_disturbances_off", "The mission without the environment's torques (the thesis set's "
+               "choice), to compare with the default (neighbor-cosim mission, option ssv)", DISTURBANCES_OFF)
     writer.ssv("mission_gps", "GPS receiver (OEM7700): 1.5 m per axis, seed", {"sigma": ad.GPS_SIGMA, "seed": 14})
     writer.ssv("mission_horizon", "Horizon sensor (CubeIR class): 0.25 deg RMS, seed", {"sigma": ad.HORIZON_SIGMA,
                                                                                          "seed": 11})
