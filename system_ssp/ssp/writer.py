@@ -42,9 +42,17 @@ def typed_value(value):
     return f"<ssv:String value={quoteattr(value)}/>"
 
 
+def xml_comment(text):
+    """`text` as the content of an XML comment, which may not hold "--" nor end with "-"."""
+    text = str(text)
+    while "--" in text:
+        text = text.replace("--", "- -")
+    return text + " " if text.endswith("-") else text
+
+
 def ssv_text(name, description, params):
     lines = ['<?xml version="1.0" encoding="UTF-8"?>',
-             f'<!-- {description} -->',
+             f'<!-- {xml_comment(description)} -->',
              f'<ssv:ParameterSet xmlns:ssv="{NS_SSV}" version="1.0" name={quoteattr(name)}>',
              "  <ssv:Parameters>"]
     for key, value in params.items():
@@ -218,7 +226,7 @@ def _system_parameters_xml(name, spec, comp_vars):
             raise GeneratorError(f"{name}: system parameter {pname}: its targets differ in type or unit: {kinds}")
         vtype, unit = kinds.pop()
         t = f'<ssc:Real unit="{unit}"/>' if vtype == "Real" and unit else f"<ssc:{vtype}/>"
-        out.append(f"      <!-- {description} -->")
+        out.append(f"      <!-- {xml_comment(description)} -->")
         out.append(f'      <ssd:Connector name={quoteattr(pname)} kind="parameter">{t}</ssd:Connector>')
     out.append("    </ssd:Connectors>")
     files = spec.get("parameter_bindings", [])
