@@ -109,9 +109,22 @@ def pytest_collection_modifyitems(config, items):
     items.sort(key=lambda item: 0 if item.nodeid.startswith(LONG_FIRST) else 1)  # stable: the rest keep their order
 
 
+# What the comparisons with other tools measured (a test's record_property("worst difference",
+# text)), printed at the end of the run, also from pytest-xdist's workers
+WORST_DIFFERENCES = []
+
+
 def pytest_runtest_logreport(report):
     if report.when == "call":
         RAN.add(report.nodeid.split("[")[0])
+        WORST_DIFFERENCES.extend(value for key, value in report.user_properties if key == "worst difference")
+
+
+def pytest_terminal_summary(terminalreporter):
+    if WORST_DIFFERENCES:
+        terminalreporter.section("worst differences against the reference implementations")
+        for line in sorted(WORST_DIFFERENCES):
+            terminalreporter.line(line)
 
 
 @pytest.hookimpl(optionalhook=True)

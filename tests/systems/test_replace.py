@@ -23,6 +23,7 @@ FAMILIES = [
     ("RCS attitude controller", ["DetumbleController", "SlewController", "TrackingController"],
      [("detumble", "detumble"), ("slew", "slew")]),
     ("RCS thrusters", ["RcsThrusters", "RcsThrusterSet"], [("detumble", "thrusters"), ("slew", "thrusters")]),
+    ("magnetic field", ["MagneticField", "MagneticFieldIgrf"], [("acs_modes", "field"), ("neighbor_mission", "field")]),
 ]
 # Connectors a family member may have beyond the family's (its own outputs; the tracking law's
 # desired-attitude signals)
@@ -178,10 +179,11 @@ def test_compare_command(fmu_paths):
     p = _cli("compare", fmu_paths["Orbit"], fmu_paths["OrbitAveraged"])
     assert p.returncode == 0
     assert re.search(r"zonal_degree\s+A: parameter Integer\s+B: -\s+\(only in A\)", p.stdout)
-    assert "6 difference(s)" in p.stdout and "F_thrust_B" not in p.stdout
+    assert "10 difference(s)" in p.stdout and "F_thrust_B" not in p.stdout
     p = _cli("compare", fmu_paths["Orbit"], fmu_paths["OrbitAveraged"], "--json")
     assert {d["name"] for d in json.loads(p.stdout)} == {"zonal_degree", "j2", "quadrature_nodes", "max_step",
-                                                          "max_da_step", "thrust_step"}
+                                                          "max_da_step", "thrust_step", "gravity_degree",
+                                                          "gravity_order", "sun_gravity", "moon_gravity"}
 
 
 def test_info_lists_every_parameter_of_every_fmu(fmu_paths):
