@@ -131,4 +131,5 @@ class DisturbanceTorques(NeighborSlave):
         self.mark_published()
 
     def do_step(self, current_time, step_size):
-        return True  # stateless: the outputs published for the current inputs stay right
+        self.publish_after_step()  # as every sharing wrapper: the outputs are fresh after a step
+        return True

@@ -269,6 +269,13 @@ class DisturbanceTorques:
         self.last = out
         return out
 
+    # ---- full state: none (the outputs are functions of the inputs) -------------------------
+    def get_state(self):
+        return {}
+
+    def set_state(self, state):
+        pass
+
     @staticmethod
     def total_torque(out):
         """The sum of the four torques of an `out` array (N.m, B)."""

@@ -100,8 +100,25 @@ def _selector_inputs(rng, k):
     return v
 
 
+def _disturbance_inputs(rng, k):
+    v = _sun_sensor_inputs(rng, k)
+    del v["sunlit"]
+    v.update({f"r_BN_N[{i}]": x for i, x in enumerate((6.8e6 * np.array(_unit(rng, 3))).tolist(), 1)})
+    v["sunlit_fraction"] = float(rng.choice([0.0, 1.0, rng.uniform(0.0, 1.0)]))
+    v["density"] = float(10 ** rng.uniform(-14, -10))
+    v.update({f"v_BN_N[{i}]": 7600.0 * x for i, x in enumerate(_unit(rng, 3), 1)})
+    v.update({f"B_N[{i}]": 3e-5 * x for i, x in enumerate(_unit(rng, 3), 1)})
+    v.update({f"center_of_mass_B[{i}]": float(x) for i, x in enumerate(rng.uniform(-0.01, 0.01, 3), 1)})
+    return v
+
+
 # FMU -> [(parameters, inputs(rng, step))]: every model option a wrapper's publish must follow
 SCENARIOS = {
+    "DisturbanceTorques": [({}, _disturbance_inputs),
+                           ({"aerodynamic": False, "residual_dipole": False, "inertia_from_box": False,
+                             "inertia_B[1,1]": 0.1, "inertia_B[2,2]": 0.2, "inertia_B[3,3]": 0.25,
+                             "facet_area[12]": 0.05, "facet_normal_B[12,1]": 0.0, "facet_normal_B[12,3]": 1.0,
+                             "facet_centre_B[12,3]": 0.3, "facet_specular[12]": 0.5}, _disturbance_inputs)],
     "RigidBody": [
         ({"integrator": "euler", "omega0[1]": 0.17, "omega0[2]": -0.1}, _rigid_body_inputs),
         ({"integrator": "rk4", "q0[1]": 0.3, "q0[4]": 0.9, "omega0[3]": 0.2, "inertia_error[1]": 0.1,

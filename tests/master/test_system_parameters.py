@@ -11,8 +11,8 @@ from system_ssp import SSPError
 from system_ssp.tools.flatten import flatten_system_parameters
 from system_ssp.master.parameters import collect_parameters
 
-MASS_USERS = [("dynamics", "mass"), ("tracking", "mass"), ("estimator", "mass"), ("propulsion", "mass0"),
-              ("thrusters", "mass")]
+MASS_USERS = [("dynamics", "mass"), ("disturbances", "mass"), ("tracking", "mass"), ("estimator", "mass"),
+              ("propulsion", "mass0"), ("thrusters", "mass")]
 
 
 def _values(system, **kw):

@@ -341,13 +341,16 @@ def test_fmus_are_valid_with_units_descriptions_and_dependencies(ma_fmus):
             tank = (["propellant_mass_properties", "propellant_used", "rcs_propellant"]
                     + [f"center_of_mass_B[{i}]" for i in (1, 2, 3)])
             # then the body's own inertia off the nominal one (issue 28's dispersions)
-            last = [f"inertia_error[{i}]" for i in (1, 2, 3)]
-            assert names[-22:-16] == new and names[-23] == "H_B[3]" and names[-16:-9] == later
-            assert names[-9:-3] == tank and names[-3:] == last
-            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-22])
+            dispersion = [f"inertia_error[{i}]" for i in (1, 2, 3)]
+            # then the environment's torque (issue 56)
+            last = [f"disturbance_torque_B[{i}]" for i in (1, 2, 3)]
+            assert names[-25:-19] == new and names[-26] == "H_B[3]" and names[-19:-12] == later
+            assert names[-12:-6] == tank and names[-6:-3] == dispersion and names[-3:] == last
+            assert min(vr[n] for n in new) > max(vr[n] for n in names[:-25])
             assert min(vr[n] for n in later) > max(vr[n] for n in new)
             assert min(vr[n] for n in tank) > max(vr[n] for n in later)
-            assert min(vr[n] for n in last) > max(vr[n] for n in tank)
+            assert min(vr[n] for n in dispersion) > max(vr[n] for n in tank)
+            assert min(vr[n] for n in last) > max(vr[n] for n in dispersion)
             assert names.index("torque_B[1]") < names.index("q_BN[1]")
 
 

@@ -265,3 +265,24 @@ def test_igrf_fmu_equals_the_model_and_the_orbit_takes_the_full_field(fmu_paths,
     assert res["r_BN_N[1]"][-1] == pytest.approx(o.y[0], rel=1e-12)
     with pytest.raises(Exception):
         fmpy.simulate_fmu(str(fmu_paths["Orbit"]), stop_time=1.0, start_values={"gravity_degree": 40})
+
+
+def test_disturbance_fmu_names_an_input_out_of_range():
+    """The compiled publish refuses what the model refuses; the getters' path then names the input,
+    and a step leaves the outputs stale so that the host's get gets the error."""
+    import build_fmus
+    from system_ssp import builder
+
+    cls = builder._import_wrapper(build_fmus.FMU_SOURCES / "neighbor_disturbance_torques.py")
+    slave = cls(instance_name="disturbances", resources=str(builder.FMU_SOURCES))
+    slave.setup_experiment(0.0, 10.0)
+    slave.enter_initialization_mode()
+    slave.exit_initialization_mode()
+    vr = {v.name: k for k, v in slave.vars.items()}
+    slave.set_real([vr["sunlit_fraction"]], [1.5])
+    assert slave.do_step(0.0, 0.1) and not slave.share_flags[1]
+    with pytest.raises(ValueError, match=r"sunlit_fraction = 1.5 must be in \[0, 1\]"):
+        slave.publish()
+    slave.set_real([vr["sunlit_fraction"]], [0.5])
+    slave.publish()
+    assert slave.share_flags[0] and slave.share_flags[1]
