@@ -71,6 +71,16 @@ def _attitude(q, A):
 
 
 @njit(cache=True)
+def _add_facet(out, at, force, centre, com, fi):
+    """A facet's force fi into the sum `force` and its torque (centre - com) x fi into out[at:at+3]."""
+    ax, ay, az = centre[0] - com[0], centre[1] - com[1], centre[2] - com[2]
+    out[at] += ay * fi[2] - az * fi[1]
+    out[at + 1] += az * fi[0] - ax * fi[2]
+    out[at + 2] += ax * fi[1] - ay * fi[0]
+    force += fi
+
+
+@njit(cache=True)
 def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, normals, areas, centres, cd,
              specular, diffuse, dipole, solar_flux, switches, out):
     """The disturbances (module docstring) into out[0:18] in the order of OUTPUTS. `switches`:
@@ -100,11 +110,7 @@ def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, norm
                 proj = normals[i, 0] * vh[0] + normals[i, 1] * vh[1] + normals[i, 2] * vh[2]
                 if areas[i] * proj > 0.0:
                     fi = -0.5 * density * vm * vm * cd[i] * areas[i] * proj * vh
-                    ax, ay, az = centres[i, 0] - com[0], centres[i, 1] - com[1], centres[i, 2] - com[2]
-                    out[3] += ay * fi[2] - az * fi[1]
-                    out[4] += az * fi[0] - ax * fi[2]
-                    out[5] += ax * fi[1] - ay * fi[0]
-                    f += fi
+                    _add_facet(out, 3, f, centres[i], com, fi)
             f_N = A.T @ f
             out[6], out[7], out[8] = f_N[0], f_N[1], f_N[2]
     if switches[2] and sunlit > 0.0:
@@ -120,11 +126,7 @@ def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, norm
                 if areas[i] * c > 0.0:
                     fi = -pressure * areas[i] * c * ((1.0 - specular[i]) * sh
                                                      + 2.0 * (diffuse[i] / 3.0 + specular[i] * c) * normals[i])
-                    ax, ay, az = centres[i, 0] - com[0], centres[i, 1] - com[1], centres[i, 2] - com[2]
-                    out[9] += ay * fi[2] - az * fi[1]
-                    out[10] += az * fi[0] - ax * fi[2]
-                    out[11] += ax * fi[1] - ay * fi[0]
-                    f += fi
+                    _add_facet(out, 9, f, centres[i], com, fi)
             f_N = A.T @ f
             out[12], out[13], out[14] = f_N[0], f_N[1], f_N[2]
     if switches[3]:

@@ -29,9 +29,11 @@ def wrappers():
     """{FMU class name: (wrapper path, module docstring)} read from fmus/*.py without importing."""
     out = {}
     for path in sorted(FMU_SOURCES.glob("neighbor_*.py")):
+        if path.stem.endswith("_support"):
+            continue  # the bases the wrappers share (NeighborSlave, FieldSlave)
         tree = ast.parse(path.read_text(encoding="utf-8"))
         for node in tree.body:
-            if isinstance(node, ast.ClassDef) and any(getattr(b, "id", "") == "NeighborSlave" for b in node.bases):
+            if isinstance(node, ast.ClassDef) and any(getattr(b, "id", "").endswith("Slave") for b in node.bases):
                 out[node.name] = (path, ast.get_docstring(tree) or "")
     return out
 
