@@ -70,6 +70,24 @@ def _attitude(q, A):
     return True
 
 
+# 3x3 products by hand: numba's `@` calls BLAS through scipy, which a user's machine (numpy only,
+# the FMUs' one requirement) does not have, and then aborts the host process.
+@njit(cache=True)
+def _times(M, x):
+    """M x for a 3x3 M."""
+    return np.array([M[0, 0] * x[0] + M[0, 1] * x[1] + M[0, 2] * x[2],
+                     M[1, 0] * x[0] + M[1, 1] * x[1] + M[1, 2] * x[2],
+                     M[2, 0] * x[0] + M[2, 1] * x[1] + M[2, 2] * x[2]])
+
+
+@njit(cache=True)
+def _times_transposed(M, x):
+    """M^T x for a 3x3 M."""
+    return np.array([M[0, 0] * x[0] + M[1, 0] * x[1] + M[2, 0] * x[2],
+                     M[0, 1] * x[0] + M[1, 1] * x[1] + M[2, 1] * x[2],
+                     M[0, 2] * x[0] + M[1, 2] * x[1] + M[2, 2] * x[2]])
+
+
 @njit(cache=True)
 def _add_facet(out, at, force, centre, com, fi):
     """A facet's force fi into the sum `force` and its torque (centre - com) x fi into out[at:at+3]."""
@@ -92,9 +110,9 @@ def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, norm
         return False
     for k in range(18):
         out[k] = 0.0
-    r_B = A @ r
+    r_B = _times(A, r)
     if switches[0]:
-        Jr = J @ r_B
+        Jr = _times(J, r_B)
         k3 = 3.0 * mu / rr ** 5
         out[0] = k3 * (r_B[1] * Jr[2] - r_B[2] * Jr[1])
         out[1] = k3 * (r_B[2] * Jr[0] - r_B[0] * Jr[2])
@@ -104,20 +122,20 @@ def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, norm
         w = np.array([v[0] + omega_earth * r[1], v[1] - omega_earth * r[0], v[2]])  # v - omega_E x r
         vm = math.sqrt(w[0] * w[0] + w[1] * w[1] + w[2] * w[2])
         if vm > 0.0:
-            vh = (A @ w) / vm
+            vh = _times(A, w) / vm
             f = np.zeros(3)
             for i in range(n_facets):
                 proj = normals[i, 0] * vh[0] + normals[i, 1] * vh[1] + normals[i, 2] * vh[2]
                 if areas[i] * proj > 0.0:
                     fi = -0.5 * density * vm * vm * cd[i] * areas[i] * proj * vh
                     _add_facet(out, 3, f, centres[i], com, fi)
-            f_N = A.T @ f
+            f_N = _times_transposed(A, f)
             out[6], out[7], out[8] = f_N[0], f_N[1], f_N[2]
     if switches[2] and sunlit > 0.0:
         s_N = np.array([r_sun[0] - r[0], r_sun[1] - r[1], r_sun[2] - r[2]])
         d = math.sqrt(s_N[0] * s_N[0] + s_N[1] * s_N[1] + s_N[2] * s_N[2])
         if d > 0.0:
-            sh = (A @ s_N) / d
+            sh = _times(A, s_N) / d
             au = ASTRONOMICAL_UNIT / d
             pressure = sunlit * solar_flux / SPEED_OF_LIGHT * au * au
             f = np.zeros(3)
@@ -127,10 +145,10 @@ def evaluate(r, v, q, density, r_sun, sunlit, b_N, com, J, mu, omega_earth, norm
                     fi = -pressure * areas[i] * c * ((1.0 - specular[i]) * sh
                                                      + 2.0 * (diffuse[i] / 3.0 + specular[i] * c) * normals[i])
                     _add_facet(out, 9, f, centres[i], com, fi)
-            f_N = A.T @ f
+            f_N = _times_transposed(A, f)
             out[12], out[13], out[14] = f_N[0], f_N[1], f_N[2]
     if switches[3]:
-        b = A @ b_N
+        b = _times(A, b_N)
         out[15] = dipole[1] * b[2] - dipole[2] * b[1]
         out[16] = dipole[2] * b[0] - dipole[0] * b[2]
         out[17] = dipole[0] * b[1] - dipole[1] * b[0]

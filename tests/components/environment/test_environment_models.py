@@ -286,3 +286,41 @@ def test_disturbance_fmu_names_an_input_out_of_range():
     slave.set_real([vr["sunlit_fraction"]], [0.5])
     slave.publish()
     assert slave.share_flags[0] and slave.share_flags[1]
+
+
+def test_the_compiled_kernels_run_without_scipy(tmp_path):
+    """numba's matrix products call BLAS through scipy, which the FMUs' target machine (numpy, and
+    numba where it is installed) need not have: there they aborted the host process. The new
+    kernels, compiled, in a process where scipy cannot be imported."""
+    import subprocess
+    import sys
+
+    from paths import REPO
+
+    code = """
+import importlib.abc, sys
+class HideScipy(importlib.abc.MetaPathFinder):
+    def find_spec(self, name, path, target=None):
+        if name == "scipy" or name.startswith("scipy."):
+            raise ImportError("scipy is hidden")
+sys.meta_path.insert(0, HideScipy())
+from components.core import jit
+assert jit.ENABLED
+from components.attitude import disturbances
+from components.environment import igrf
+from components.orbit import cowell
+facets = disturbances.Facets([[1.0, 0.0, 0.0]], [0.02], [[0.1, 0.0, 0.0]], [2.2], [0.1], [0.2])
+m = disturbances.DisturbanceTorques([[0.1, 0.0, 0.0], [0.0, 0.2, 0.0], [0.0, 0.0, 0.3]], facets, (0.01, 0.0, 0.0))
+out = m.compute((6.8e6, 1e5, 0.0), (0.0, 7600.0, 0.0), (0.1, 0.2, 0.3, 0.9), 3e-12, (1.5e11, 0.0, 0.0), 1.0,
+                (1e-5, 2e-5, 0.0))
+assert abs(out).sum() > 0.0
+igrf.IgrfField().field_N((6.8e6, 1e5, 2e5))
+o = cowell.CowellOrbit(drag=False, gravity_degree=8, sun_gravity=True, moon_gravity=True)
+o.advance_to(600.0)
+assert "scipy" not in sys.modules
+print("ok")
+"""
+    env = {k: v for k, v in __import__("os").environ.items() if k != "NEIGHBOR_COSIM_NUMBA"}
+    proc = subprocess.run([sys.executable, "-c", code], cwd=REPO, capture_output=True, text=True, timeout=600,
+                          env=env)
+    assert proc.returncode == 0 and proc.stdout.strip().endswith("ok"), proc.stderr[-3000:]
