@@ -7,8 +7,8 @@ The written files are committed (system_ssp/systems/); `python -m system_ssp.sys
 regenerates them into a temporary folder and fails on any difference, so the committed systems
 always match their generators and the FMUs they were generated from.
 """
-from . import (acs_modes, air_bearing, atmosphere, attitude_determination, deorbit, maneuvers, mission,
-               sun_avoidance, sun_eclipse, sunline)
+from . import (acs_modes, air_bearing, atmosphere, attitude_determination, cubesat_3u, deorbit, maneuvers,
+               mission, sun_avoidance, sun_eclipse, sunline)
 
 # name -> module, in the order they are written
 GENERATORS = {
@@ -22,6 +22,7 @@ GENERATORS = {
     "deorbit": deorbit,
     "atmosphere": atmosphere,
     "mission": mission,
+    "cubesat_3u": cubesat_3u,  # the second reference spacecraft (components.mission.cubesat_3u)
 }
 
 
