@@ -9,7 +9,7 @@ is the law's state, updated at each step's end.
 """
 from neighbor_fmu_support import NeighborSlave
 
-from components.attitude import mrp_feedback
+from components.attitude import mrp_feedback, rigid_body
 
 
 class MrpFeedback(NeighborSlave):
@@ -24,11 +24,8 @@ class MrpFeedback(NeighborSlave):
         self.parameter("integral_limit", 0.0, "N.m.s", "Limit on each component of the integrated attitude error "
                        "K int(sigma dt), > 0 with Ki > 0")
         self.parameter("control_law", 0, None, "Gyroscopic term: 0 with omega_RN_B + Ki z, 1 with omega_BN_B", int)
-        for i in range(3):
-            for j in range(3):
-                self.parameter(f"inertia_B[{i + 1},{j + 1}]", (0.05, 0.05, 0.01)[i] if i == j else 0.0, "kg.m2",
-                               f"Spacecraft inertia about its centre of mass in B, wheels included (row {i + 1}, "
-                               f"column {j + 1})")
+        # the spacecraft's inertia, wheels included: the parameters RigidBody and the RCS controllers share
+        self.inertia_parameters("Spacecraft mass (the box inertia's)")
         self.parameter_array("known_torque_B", [0.0, 0.0, 0.0], "N.m", "Known external torque to cancel (feed-forward)")
         error = (self.input_array("sigma_BR", [0.0] * 3, "1", "Attitude error: MRP of B relative to R")
                  + self.input_array("omega_BR_B", [0.0] * 3, "rad/s", "Body rate relative to the reference, in B")
@@ -45,9 +42,8 @@ class MrpFeedback(NeighborSlave):
 
     def build_model(self):
         v = self.values
-        inertia = [[v[f"inertia_B[{i},{j}]"] for j in (1, 2, 3)] for i in (1, 2, 3)]
-        return mrp_feedback.MrpFeedback(inertia, v["K"], v["P"], v["Ki"], v["integral_limit"], v["control_law"],
-                                        self.vector("known_torque_B", 3))
+        return mrp_feedback.MrpFeedback(self.inertia(rigid_body.box_inertia), v["K"], v["P"], v["Ki"],
+                                        v["integral_limit"], v["control_law"], self.vector("known_torque_B", 3))
 
     def _evaluate(self):
         return self.model.torque(self.vector("sigma_BR", 3), self.vector("omega_BR_B", 3),

@@ -52,3 +52,9 @@ class WheelTorqueDistribution:
             d = -self.null_space_gain * (np.asarray(speeds, float) - self.desired)
             return us, us + self.tau @ d
         return us, us
+
+    def get_state(self):
+        return {}  # stateless
+
+    def set_state(self, state):
+        pass

@@ -66,7 +66,8 @@ WHEELS = {"wheel_count": mission.WHEELS.count, **_axes(), **_per_wheel("J_s", mi
           **_per_wheel("max_torque", mission.WHEELS.max_torque), **_per_wheel("max_speed", mission.WHEELS.max_speed),
           **_per_wheel("Omega0", mission.WHEELS.speed0)}
 DISTRIBUTION = {"wheel_count": mission.WHEELS.count, **_axes()}
-CONTROL = {"K": mission.POINTING.K, "P": mission.POINTING.P, **_matrix("inertia_B", mission.SPACECRAFT.inertia_B)}
+CONTROL = {"K": mission.POINTING.K, "P": mission.POINTING.P, "mass": mission.SPACECRAFT.mass,
+           "inertia_from_box": False, **_matrix("inertia_B", mission.SPACECRAFT.inertia_B)}
 GUIDANCE = vec("sigma_R0N", list(mission.POINTING.sigma_R0N))
 # the Hill frame's x is the zenith: R = R0 turned +90 deg about its y has its z on R0's x, so the
 # body's +z is on the zenith and -z at nadir (sigma_R0R, the MRP of R0 relative to R, is -90 deg about y)
