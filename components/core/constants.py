@@ -20,6 +20,8 @@ MU_EARTH_WGS84 = 3.986004418e14  # m^3/s^2, WGS-84 (atmosphere included)
 OMEGA_EARTH_WGS84 = 7.292115e-5  # rad/s, WGS-84 nominal Earth rotation rate
 OMEGA_EARTH = 7.292115146706979e-5  # rad/s, Earth rotation rate (IERS conventions, as GMAT)
 
+ASTRONOMICAL_UNIT = 149597870700.0  # m (IAU 2012 Resolution B2, exact)
+
 DAY = 86400.0  # s
 DAYS_PER_JULIAN_YEAR = 365.25
 YEAR = DAYS_PER_JULIAN_YEAR * DAY  # s, Julian year
