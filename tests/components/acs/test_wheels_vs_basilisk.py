@@ -14,6 +14,8 @@ import math
 import numpy as np
 import pytest
 
+from basilisk_oracle import CASES, initialized, random_unit, record_worst, require_basilisk
+
 from components.acs import reaction_wheel_array as rwa
 from components.acs.wheel_torque_distribution import WheelTorqueDistribution
 from components.attitude import pointing
@@ -22,29 +24,13 @@ from components.attitude.rigid_body import RigidBody
 from components.core import mrp, rotations
 from components.mission import cubesat_3u
 
-CASES = 25
 NANO = 1_000_000_000
-
-
-def _basilisk():
-    return pytest.importorskip("Basilisk", reason="Basilisk is not installed (pip install bsk, a test extra): "
-                                                  "the comparisons with its modules are skipped")
-
-
-def _worst(record_property, what, worst, bound):
-    record_property("worst difference", f"{what}: {worst:.2e} (bound {bound:.0e})")
-    assert worst < bound, f"{what}: worst difference {worst:.3e} over {CASES} cases, bound {bound:.0e}"
-
-
-def _unit(rng, n=3):
-    v = rng.normal(size=n)
-    return v / np.linalg.norm(v)
 
 
 def _orbit_state(rng):
     """A random position and velocity of an elliptic orbit (300-1500 km, up to e ~ 0.1)."""
-    r = _unit(rng) * (6378e3 + rng.uniform(300e3, 1500e3))
-    v = np.cross(r, _unit(rng))
+    r = random_unit(rng) * (6378e3 + rng.uniform(300e3, 1500e3))
+    v = np.cross(r, random_unit(rng))
     v = v / np.linalg.norm(v) * rng.uniform(7000.0, 8200.0) + rng.normal(size=3) * 100.0
     return r, v
 
@@ -57,18 +43,6 @@ def _inertia(rng):
 
 def _sigma(q):
     return np.array(mrp.from_quaternion(tuple(q), short=True))
-
-
-def _initialized(*modules):
-    """A Basilisk simulation holding the modules, initialized (their SelfInit and Reset at t = 0):
-    a module's UpdateState crashes the process outside one. Keep it alive while they are used."""
-    from Basilisk.utilities import SimulationBaseClass, macros
-    sim = SimulationBaseClass.SimBaseClass()
-    sim.CreateNewProcess("p").addTask(sim.CreateNewTask("t", macros.sec2nano(1.0)))
-    for priority, module in enumerate(reversed(modules)):
-        sim.AddModelToTask("t", module, priority)
-    sim.InitializeSimulation()
-    return sim
 
 
 def _messages():
@@ -106,7 +80,7 @@ def _basilisk_reference_chain(reference, q, omega, r, v, sigma_R0R):
     tracking.sigma_R0R = sigma_R0R.tolist()
     tracking.attRefInMsg.subscribeTo(reference.attRefOutMsg)
     tracking.attNavInMsg.subscribeTo(msg("NavAtt", sigma_BN=_sigma(q), omega_BN_B=omega))
-    sim = _initialized(reference, tracking)  # noqa: F841 (kept alive)
+    sim = initialized(reference, tracking)  # noqa: F841 (kept alive)
     reference.UpdateState(0)
     tracking.UpdateState(0)
     return _guidance(tracking.attGuidOutMsg.read())
@@ -126,14 +100,14 @@ def _difference(ours, theirs):
 def test_reference_frames_and_tracking_error_equal_basilisks(mode, record_property):
     """inertial3D / hillPoint / velocityPoint + attTrackingError with a random body offset
     sigma_R0R, at random attitudes, rates and elliptic orbit states."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.fswAlgorithms import hillPoint, inertial3D, velocityPoint
     rng = np.random.default_rng({"inertial": 5701, "nadir": 5702, "velocity": 5703}[mode])
     worst = 0.0
     for _ in range(CASES):
-        q, omega = _unit(rng, 4), rng.normal(size=3) * 0.05
+        q, omega = random_unit(rng, 4), rng.normal(size=3) * 0.05
         r, v = _orbit_state(rng)
-        sigma_R0N, sigma_R0R = _unit(rng) * rng.uniform(0.0, 0.9), _unit(rng) * rng.uniform(0.0, 0.9)
+        sigma_R0N, sigma_R0R = random_unit(rng) * rng.uniform(0.0, 0.9), random_unit(rng) * rng.uniform(0.0, 0.9)
         if mode == "inertial":
             reference = inertial3D.inertial3D()
             reference.sigma_R0N = sigma_R0N.tolist()
@@ -147,25 +121,25 @@ def test_reference_frames_and_tracking_error_equal_basilisks(mode, record_proper
         mode_number = {"inertial": pointing.INERTIAL, "nadir": pointing.NADIR, "velocity": pointing.VELOCITY}[mode]
         ours = guidance.guidance(mode_number, tuple(q), omega, r, v, (0.0, 0.0, 1.0), True)[:4]
         worst = max(worst, _difference(ours, theirs))
-    _worst(record_property, f"{mode} pointing + tracking error vs Basilisk (relative)", worst, 1e-12)
+    record_worst(record_property, f"{mode} pointing + tracking error vs Basilisk (relative)", worst, 1e-12)
 
 
 def test_sun_safe_pointing_equals_basilisks(record_property):
     """sunSafePoint at random Sun headings (some near the axis, some opposite, some not seen),
     random body axes, spin rates and search rates."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.fswAlgorithms import sunSafePoint
     rng = np.random.default_rng(5704)
     worst = 0.0
     for k in range(CASES):
-        axis, omega = _unit(rng), rng.normal(size=3) * 0.05
-        sun = _unit(rng) * rng.uniform(0.5, 1.0)
+        axis, omega = random_unit(rng), rng.normal(size=3) * 0.05
+        sun = random_unit(rng) * rng.uniform(0.5, 1.0)
         if k % 5 == 1:
             sun = (axis + rng.normal(size=3) * 1e-4) * 0.9  # within the small angle: no error
         elif k % 5 == 2:
             sun = -axis + rng.normal(size=3) * 1e-4  # opposite: the 180 deg axis
         elif k % 5 == 3:
-            sun = _unit(rng) * 0.05  # too short: not seen, the search rate
+            sun = random_unit(rng) * 0.05  # too short: not seen, the search rate
         spin, search = rng.uniform(-0.01, 0.01), rng.normal(size=3) * 0.01
         module = sunSafePoint.sunSafePoint()
         module.sHatBdyCmd, module.minUnitMag = axis.tolist(), pointing.DEFAULT_MIN_SUN_NORM
@@ -174,7 +148,7 @@ def test_sun_safe_pointing_equals_basilisks(record_property):
         msg = _Inputs()
         module.sunDirectionInMsg.subscribeTo(msg("NavAtt", vehSunPntBdy=sun))
         module.imuInMsg.subscribeTo(msg("NavAtt", omega_BN_B=omega))
-        sim = _initialized(module)  # noqa: F841 (kept alive)
+        sim = initialized(module)  # noqa: F841 (kept alive)
         module.UpdateState(0)
         theirs = _guidance(module.attGuidanceOutMsg.read())
         guidance = pointing.PointingGuidance(sun_axis_B=axis, sun_spin_rate=spin, search_rate_B=search)
@@ -182,22 +156,22 @@ def test_sun_safe_pointing_equals_basilisks(record_property):
                                  True)[:4]
         worst = max(worst, _difference(ours, theirs))
     # 1e-11: at the near-opposite headings acos amplifies the last bit of the cosine ~1e4 times
-    _worst(record_property, "Sun-safe pointing vs Basilisk (relative)", worst, 1e-11)
+    record_worst(record_property, "Sun-safe pointing vs Basilisk (relative)", worst, 1e-11)
 
 
 def test_ground_target_pointing_equals_basilisks_over_successive_calls(record_property):
     """locationPointing on a ground target that moves with the Earth: our WGS-84 target position
     given to Basilisk as the location, 25 random targets, orbits and tumbling attitudes, each over
     four 0.5 s updates (the rate is a finite difference of the error, zero at the first)."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.fswAlgorithms import locationPointing
     rng = np.random.default_rng(5705)
     worst = 0.0
     for _ in range(CASES):
         lat, lon = rng.uniform(-1.4, 1.4), rng.uniform(-math.pi, math.pi)
-        boresight, damping = _unit(rng), bool(rng.integers(2))
+        boresight, damping = random_unit(rng), bool(rng.integers(2))
         r, v = _orbit_state(rng)
-        q, omega = _unit(rng, 4), rng.normal(size=3) * 0.02
+        q, omega = random_unit(rng, 4), rng.normal(size=3) * 0.02
         guidance = pointing.PointingGuidance(boresight_B=boresight, target_latitude=lat, target_longitude=lon,
                                              target_height=rng.uniform(0.0, 3000.0), boresight_rate_damping=damping)
         module = locationPointing.locationPointing()
@@ -208,7 +182,7 @@ def test_ground_target_pointing_equals_basilisks_over_successive_calls(record_pr
         module.scAttInMsg.subscribeTo(att)
         module.scTransInMsg.subscribeTo(trans)
         module.locationInMsg.subscribeTo(ground)
-        sim = _initialized(module)  # noqa: F841 (kept alive)
+        sim = initialized(module)  # noqa: F841 (kept alive)
         for k in range(4):
             t = 0.5 * k
             body = RigidBody(np.eye(3))  # the attitude at t, tumbling at omega
@@ -228,7 +202,7 @@ def test_ground_target_pointing_equals_basilisks_over_successive_calls(record_pr
             ours = guidance.guidance(pointing.TARGET, tuple(qt), body.omega, rt, v, (0.0, 0.0, 1.0), True)[:4]
             guidance.step(pointing.TARGET, tuple(qt), rt, 0.5)
             worst = max(worst, _difference(ours[:3], theirs[:3]))
-    _worst(record_property, "ground-target pointing vs Basilisk over 4 updates (relative)", worst, 1e-10)
+    record_worst(record_property, "ground-target pointing vs Basilisk over 4 updates (relative)", worst, 1e-10)
 
 
 def _wheel_config(messaging, G, J, u_max=None):
@@ -243,7 +217,7 @@ def _wheel_config(messaging, G, J, u_max=None):
 def test_mrp_feedback_with_wheels_and_integral_equals_basilisks(record_property):
     """mrpFeedback over six successive 0.2 s updates of a random error history: random inertia,
     gains, integral gain and limit, control law, known torque and 3-6 wheels' speeds."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.fswAlgorithms import mrpFeedback
     messaging = _messages()
     rng = np.random.default_rng(5706)
@@ -251,7 +225,7 @@ def test_mrp_feedback_with_wheels_and_integral_equals_basilisks(record_property)
     for k in range(CASES):
         inertia = _inertia(rng)
         n = int(rng.integers(3, 7))
-        G = np.array([_unit(rng) for _ in range(n)])
+        G = np.array([random_unit(rng) for _ in range(n)])
         J = rng.uniform(1e-5, 5e-5, n)
         K, P = rng.uniform(1e-4, 1e-2), rng.uniform(1e-3, 1e-1)
         Ki, limit = (rng.uniform(1e-4, 1e-2), rng.uniform(1e-4, 5e-3)) if k % 4 else (0.0, 0.0)
@@ -268,14 +242,14 @@ def test_mrp_feedback_with_wheels_and_integral_equals_basilisks(record_property)
         module.guidInMsg.subscribeTo(guid)
         module.rwSpeedsInMsg.subscribeTo(speeds)
         ours = MrpFeedback(inertia, K, P, Ki, limit, law, known)
-        sim = _initialized(module)  # noqa: F841 (kept alive)
+        sim = initialized(module)  # noqa: F841 (kept alive)
         # Basilisk's first update is at a non-zero time: it takes priorTime == 0 as "no update yet",
         # so a run starting at t = 0 would skip its second integration too
         t0 = 10.0
         for step in range(6):
             t = t0 + 0.2 * step
-            sigma, w_BR, w_RN, dw_RN = _unit(rng) * rng.uniform(0.0, 0.8), *(rng.normal(size=(3, 3)) * [[0.05], [0.01],
-                                                                                                          [1e-4]])
+            sigma = random_unit(rng) * rng.uniform(0.0, 0.8)
+            w_BR, w_RN, dw_RN = rng.normal(size=(3, 3)) * [[0.05], [0.01], [1e-4]]
             Omega = rng.uniform(-600.0, 600.0, n)
             g = messaging.AttGuidMsgPayload()
             g.sigma_BR, g.omega_BR_B, g.omega_RN_B, g.domega_RN_B = (x.tolist() for x in (sigma, w_BR, w_RN, dw_RN))
@@ -292,20 +266,20 @@ def test_mrp_feedback_with_wheels_and_integral_equals_basilisks(record_property)
             scale = max(float(np.max(np.abs(theirs))), 1e-12)
             worst = max(worst, float(np.max(np.abs(torque - theirs))) / scale,
                         float(np.max(np.abs(integral - theirs_integral))) / scale)
-    _worst(record_property, "MRP feedback with wheels, 6 updates vs Basilisk (relative)", worst, 1e-12)
+    record_worst(record_property, "MRP feedback with wheels, 6 updates vs Basilisk (relative)", worst, 1e-12)
 
 
 def test_wheel_torque_distribution_and_null_space_equal_basilisks(record_property):
     """rwMotorTorque (3 control axes, random wheels unavailable) then rwNullSpace (desired speeds,
     gain) on 4-6 random wheels."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.fswAlgorithms import rwMotorTorque, rwNullSpace
     messaging = _messages()
     rng = np.random.default_rng(5707)
     worst = 0.0
     for k in range(CASES):
         n = int(rng.integers(4, 7))
-        G = np.array([_unit(rng) for _ in range(n)])
+        G = np.array([random_unit(rng) for _ in range(n)])
         available = np.ones(n, bool)
         if k % 3 == 1:
             available[rng.integers(n)] = False
@@ -334,7 +308,7 @@ def test_wheel_torque_distribution_and_null_space_equal_basilisks(record_propert
         null.rwMotorTorqueInMsg.subscribeTo(motor.rwMotorTorqueOutMsg)
         null.rwSpeedsInMsg.subscribeTo(msg("RWSpeed", wheelSpeeds=speeds.tolist() + [0.0] * (36 - n)))
         null.rwDesiredSpeedsInMsg.subscribeTo(msg("RWSpeed", wheelSpeeds=desired.tolist() + [0.0] * (36 - n)))
-        sim = _initialized(motor, null)  # noqa: F841 (kept alive)
+        sim = initialized(motor, null)  # noqa: F841 (kept alive)
         motor.UpdateState(0)
         null.UpdateState(0)
         theirs_min = np.array(motor.rwMotorTorqueOutMsg.read().motorTorque[:n])
@@ -344,7 +318,7 @@ def test_wheel_torque_distribution_and_null_space_equal_basilisks(record_propert
         scale = max(float(np.max(np.abs(theirs))), 1e-12)
         worst = max(worst, float(np.max(np.abs(ours_min - theirs_min))) / scale,
                     float(np.max(np.abs(ours - theirs))) / scale)
-    _worst(record_property, "wheel torque distribution + null space vs Basilisk (relative)", worst, 1e-12)
+    record_worst(record_property, "wheel torque distribution + null space vs Basilisk (relative)", worst, 1e-12)
 
 
 def test_wheel_command_limits_equal_basilisks_effector(record_property):
@@ -352,7 +326,7 @@ def test_wheel_command_limits_equal_basilisks_effector(record_property):
     torque, power limit, speed saturation): 25 random sets of 4-6 wheels at random speeds (some at
     or beyond their maximum) and commands (some below the minimum torque), the torque each wheel's
     motor applies compared."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.simulation import reactionWheelStateEffector, spacecraft
     from Basilisk.utilities import simIncludeRW
     messaging = _messages()
@@ -360,7 +334,7 @@ def test_wheel_command_limits_equal_basilisks_effector(record_property):
     worst, limited = 0.0, 0
     for _ in range(CASES):
         n = int(rng.integers(4, 7))
-        G = np.array([_unit(rng) for _ in range(n)])
+        G = np.array([random_unit(rng) for _ in range(n)])
         J, u_max = rng.uniform(1e-5, 5e-5, n), rng.uniform(5e-4, 5e-3, n)
         speed_max, u_min = rng.uniform(300.0, 700.0, n), rng.uniform(0.0, 1e-4, n)
         p_max = np.where(rng.uniform(size=n) < 0.5, rng.uniform(0.05, 1.0, n), 0.0)
@@ -381,7 +355,7 @@ def test_wheel_command_limits_equal_basilisks_effector(record_property):
         command.motorTorque = commands.tolist() + [0.0] * (36 - n)
         keep = messaging.ArrayMotorTorqueMsg().write(command)
         effector.rwMotorCmdInMsg.subscribeTo(keep)
-        sim = _initialized(effector, sc)  # noqa: F841 (kept alive)
+        sim = initialized(effector, sc)  # noqa: F841 (kept alive)
         effector.UpdateState(0)
         theirs = np.array([effector.rwOutMsgs[i].read().u_current for i in range(n)])
         wheels = rwa.ReactionWheelArray(G, J, u_max, speed_max, max_power=p_max, min_torque=u_min,
@@ -390,7 +364,7 @@ def test_wheel_command_limits_equal_basilisks_effector(record_property):
         limited += int(np.sum(ours != commands))
         worst = max(worst, float(np.max(np.abs(ours - theirs)) / np.max(u_max)))
     assert limited > CASES, f"only {limited} commands were limited: the cases do not exercise the limits"
-    _worst(record_property, "wheel command limits vs Basilisk's effector (relative to max torque)", worst, 1e-15)
+    record_worst(record_property, "wheel command limits vs Basilisk's effector (relative to max torque)", worst, 1e-15)
 
 
 # ---- the closed loop -----------------------------------------------------------------------
@@ -505,7 +479,7 @@ def test_closed_loop_wheels_mrp_feedback_inertial_pointing_flies_as_basilisk(rec
     wheels spinning: the attitude error histories of both products agree to round-off, and the
     loop converges (error < 0.01 deg). The speeds are compared too: they carry the momentum the
     tumble had."""
-    _basilisk()
+    require_basilisk()
     theirs_sigma, theirs_speed = basilisk_closed_loop()
     ours_sigma, ours_speed = _our_closed_loop()
     assert ours_sigma.shape == theirs_sigma.shape, (ours_sigma.shape, theirs_sigma.shape)
@@ -516,8 +490,8 @@ def test_closed_loop_wheels_mrp_feedback_inertial_pointing_flies_as_basilisk(rec
     # two RK4 integrations of the same equations in a different order of operations: the tumble
     # amplifies the round-off to ~4e-10; a 0.1 % error in the wheels' momentum makes 2e-5,
     # leaving their spin inertia in the body's 7e-5
-    _worst(record_property, "closed loop sigma_BR over 300 s vs Basilisk", sigma_worst, 1e-8)
-    _worst(record_property, "closed loop wheel speeds over 300 s vs Basilisk (relative)", speed_worst, 1e-8)
+    record_worst(record_property, "closed loop sigma_BR over 300 s vs Basilisk", sigma_worst, 1e-8)
+    record_worst(record_property, "closed loop wheel speeds over 300 s vs Basilisk (relative)", speed_worst, 1e-8)
 
 
 # ---- the shipped system: the FMUs through the master -------------------------------------------
@@ -547,12 +521,12 @@ def test_shipped_pointing_system_flies_as_the_components_and_basilisk(ssp_paths,
     assert np.degrees(error[t >= 200.0]).max() < 0.01, np.degrees(error[t >= 200.0]).max()
     assert np.abs(speed).max() < cubesat_3u.WHEELS.max_speed
     try:
-        _basilisk()
+        require_basilisk()
     except pytest.skip.Exception:
         return  # the comparison with the components above stands; Basilisk's is the test above
     theirs_sigma, _ = basilisk_closed_loop()
     worst = float(np.max(np.abs(sigma - theirs_sigma)))
-    _worst(record_property, "cubesat_3u_pointing system sigma_BR over 300 s vs Basilisk", worst, 1e-8)
+    record_worst(record_property, "cubesat_3u_pointing system sigma_BR over 300 s vs Basilisk", worst, 1e-8)
 
 
 def test_shipped_pointing_system_nadir_scenario_points_body_minus_z_at_nadir(ssp_paths):

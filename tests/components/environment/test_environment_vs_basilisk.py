@@ -12,17 +12,12 @@ import math
 import numpy as np
 import pytest
 
+from basilisk_oracle import CASES, record_worst, require_basilisk
+
 from components.attitude import disturbances
 from components.core import rotations
 from components.core.constants import MU_EARTH, OMEGA_EARTH_WGS84
 from components.environment import gravity, igrf, magnetic_field
-
-CASES = 25
-
-
-def _basilisk():
-    return pytest.importorskip("Basilisk", reason="Basilisk is not installed (pip install bsk, a test extra): "
-                                                  "the comparisons with its modules are skipped")
 
 
 def _random_facets(rng, n):
@@ -122,17 +117,12 @@ def _basilisk_effectors(r, v, q, J, facets, density, r_sun, dipole_B=None, b_N=N
     return out
 
 
-def _worst(record_property, what, worst, bound):
-    record_property("worst difference", f"{what}: {worst:.2e} (bound {bound:.0e})")
-    assert worst < bound, f"{what}: worst difference {worst:.3e} over {CASES} cases, bound {bound:.0e}"
-
-
 def test_disturbances_equal_basilisks_effectors(record_property):
     """Gravity gradient, facet drag (the flow relative to the co-rotating atmosphere given to
     Basilisk as the hub's velocity), facet SRP (its 1368 W/m2, full Sun) and the residual dipole
     (Basilisk's torque bars with the dipole as their command): 25 random bodies, attitudes and
     positions. Relative to each case's largest term, all four agree to round-off."""
-    _basilisk()
+    require_basilisk()
     rng = np.random.default_rng(56)
     worst = dict.fromkeys(("gravity gradient", "drag force", "drag torque", "SRP force", "SRP torque",
                            "dipole torque"), 0.0)
@@ -158,13 +148,13 @@ def test_disturbances_equal_basilisks_effectors(record_property):
                 continue
             worst[name] = max(worst[name], float(np.max(np.abs(a - b))) / scale)
     for name, value in worst.items():
-        _worst(record_property, f"{name} vs Basilisk (relative)", value, 1e-12)
+        record_worst(record_property, f"{name} vs Basilisk (relative)", value, 1e-12)
 
 
 def test_spherical_harmonic_gravity_equals_basilisks_with_the_same_file(record_property):
     """GGM03S to a random degree 2..36 at 25 random Earth-fixed positions (200-2000 km): our V/W
     recursion (Montenbruck and Gill) and Basilisk's Pines formulation of the same vendored file."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.simulation import gravityEffector
     from Basilisk.utilities import simIncludeGravBody
 
@@ -180,13 +170,14 @@ def test_spherical_harmonic_gravity_equals_basilisks_with_the_same_file(record_p
         theirs = np.array(model.computeField(r.tolist(), degree, False)).ravel()
         ours = gravity.acceleration_harmonics(r, degree)
         worst = max(worst, float(np.max(np.abs(ours - theirs)) / np.linalg.norm(theirs)))
-    _worst(record_property, "GGM03S spherical harmonics vs Basilisk (relative to the non-central part)", worst, 1e-13)
+    record_worst(record_property, "GGM03S spherical harmonics vs Basilisk (relative to the non-central part)", worst,
+                 1e-13)
 
 
 def test_tilted_dipole_equals_basilisks_centred_dipole(record_property):
     """Our dipole with the IGRF-13 2020 coefficients and Basilisk's magneticFieldCenteredDipole
     given the same coefficients and our GMST Earth rotation as the planet's orientation."""
-    _basilisk()
+    require_basilisk()
     from Basilisk.architecture import messaging
     from Basilisk.simulation import magneticFieldCenteredDipole
     from Basilisk.utilities import SimulationBaseClass, macros
@@ -219,7 +210,7 @@ def test_tilted_dipole_equals_basilisks_centred_dipole(record_property):
         field.UpdateState(0)
         theirs = np.array(field.envOutMsgs[0].read().magField_N)
         worst = max(worst, float(np.max(np.abs(np.array(ours.field_N(r)) - theirs)) / np.linalg.norm(theirs)))
-    _worst(record_property, "tilted dipole vs Basilisk's centred dipole (relative)", worst, 1e-13)
+    record_worst(record_property, "tilted dipole vs Basilisk's centred dipole (relative)", worst, 1e-13)
 
 
 def test_igrf14_equals_ppigrf(record_property):
@@ -240,4 +231,4 @@ def test_igrf14_equals_ppigrf(record_property):
         theirs = [float(np.ravel(x)[0]) for x in ppigrf.igrf_gc(r / 1e3, math.degrees(theta), math.degrees(phi),
                                                                  date)]
         worst = max(worst, float(np.max(np.abs(np.array(ours) - theirs))))
-    _worst(record_property, "IGRF-14 vs ppigrf (nT)", worst, 1e-6)
+    record_worst(record_property, "IGRF-14 vs ppigrf (nT)", worst, 1e-6)
