@@ -161,7 +161,7 @@ def location_error(r_TN_N, r_BN_N, sigma_BN, boresight_B, small_angle=DEFAULT_SM
 
 class PointingGuidance:
     """The guidance of every mode with one set of parameters; the target mode's finite difference
-    keeps the previous error (commit() at the end of each step)."""
+    keeps the error at the start of the last step (step())."""
 
     def __init__(self, sigma_R0N=(0.0, 0.0, 0.0), sigma_R0R=(0.0, 0.0, 0.0), mu=MU_EARTH,
                  sun_axis_B=(0.0, 0.0, 1.0), sun_spin_rate=0.0, search_rate_B=(0.0, 0.0, 0.0),
