@@ -185,7 +185,7 @@ class ReactionWheelArray:
         mechanical = u * speeds
         power = self.base_power + np.where(mechanical > 0.0, mechanical / self.motor_efficiency,
                                            self.regen_efficiency * mechanical)
-        return speeds, u, applied, self.G.T @ applied, self.G.T @ self.H, power
+        return speeds, u, applied, self.G.T @ applied, self.momentum_B(), power
 
     def step(self, commands, h, omega_BN_B_end, enabled=True, available=None):
         """Advance h seconds with the torques of the step start held; the wheel speeds then refer

@@ -31,7 +31,8 @@ class Spacecraft:
 @dataclass(frozen=True)
 class Wheels:
     """Four wheels of the 10 mN.m.s, 1 mN.m, 6000 rpm class (J = 1.5e-5 kg.m2) in a pyramid about
-    +z: each spin axis 35.26 deg above the xy plane, at azimuths 45, 135, 225, 315 deg."""
+    +z: each spin axis 35.26 deg above the xy plane, at azimuths 45, 135, 225, 315 deg (the spin
+    axes: components.acs.reaction_wheel_array.pyramid_axes(elevation, count, azimuth0))."""
     count: int = 4
     elevation: float = PYRAMID_ELEVATION  # rad
     azimuth0: float = math.radians(45.0)  # rad
@@ -40,11 +41,7 @@ class Wheels:
     max_speed: float = 6000.0 * RPM  # rad/s
     speed0: Tuple[float, ...] = (100.0, -150.0, 200.0, 50.0)  # rad/s at the start of the pointing systems
 
-    @property
-    def axes_B(self):
-        c, s = math.cos(self.elevation), math.sin(self.elevation)
-        return tuple((c * math.cos(self.azimuth0 + 2.0 * math.pi * k / self.count),
-                      c * math.sin(self.azimuth0 + 2.0 * math.pi * k / self.count), s) for k in range(self.count))
+
 
 
 @dataclass(frozen=True)

@@ -36,6 +36,7 @@ from ...ssp.writer import vec
 from .from_spec import write_system
 
 SLOTS = rwa.MAX_WHEELS
+WHEEL_AXES = rwa.pyramid_axes(mission.WHEELS.elevation, mission.WHEELS.count, mission.WHEELS.azimuth0)
 
 
 def _matrix(name, M):
@@ -43,7 +44,7 @@ def _matrix(name, M):
 
 
 def _axes():
-    axes = list(mission.WHEELS.axes_B) + rwa.default_axes()[mission.WHEELS.count:]
+    axes = WHEEL_AXES + rwa.default_axes()[mission.WHEELS.count:]
     return {element: float(axes[i][j]) for i, row in enumerate(matrix_names("spin_axis_B", SLOTS, 3))
             for j, element in enumerate(row)}
 
@@ -55,7 +56,7 @@ def _per_wheel(name, value):
 
 def body_inertia():
     w = mission.WHEELS
-    return rwa.body_inertia(mission.SPACECRAFT.inertia_B, w.axes_B, [w.J_s] * w.count)
+    return rwa.body_inertia(mission.SPACECRAFT.inertia_B, WHEEL_AXES, [w.J_s] * w.count)
 
 
 SPACECRAFT = {"mass": mission.SPACECRAFT.mass, "inertia_from_box": False, **_matrix("inertia_B", body_inertia()),

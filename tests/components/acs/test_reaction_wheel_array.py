@@ -13,8 +13,9 @@ from components.attitude.mrp_feedback import MrpFeedback
 from components.attitude.rigid_body import RigidBody
 from components.core import rotations
 from components.mission import cubesat_3u
+from system_ssp.systems.generators import cubesat_3u as cubesat_3u_system
 
-AXES = np.array(cubesat_3u.WHEELS.axes_B)
+AXES = np.array(cubesat_3u_system.WHEEL_AXES)  # the shipped system's
 J = [cubesat_3u.WHEELS.J_s] * 4
 SPACECRAFT = np.array(cubesat_3u.SPACECRAFT.inertia_B)
 

@@ -23,6 +23,7 @@ from components.attitude.mrp_feedback import MrpFeedback
 from components.attitude.rigid_body import RigidBody
 from components.core import mrp, rotations
 from components.mission import cubesat_3u
+from system_ssp.systems.generators import cubesat_3u as cubesat_3u_system
 
 NANO = 1_000_000_000
 
@@ -375,7 +376,7 @@ DURATION = 300.0
 SPACECRAFT_INERTIA = np.array(cubesat_3u.SPACECRAFT.inertia_B)
 WHEEL_J, WHEEL_MAX_TORQUE = cubesat_3u.WHEELS.J_s, cubesat_3u.WHEELS.max_torque
 WHEEL_MAX_RPM = cubesat_3u.WHEELS.max_speed / rwa.RPM
-WHEEL_AXES = np.array(cubesat_3u.WHEELS.axes_B)
+WHEEL_AXES = np.array(cubesat_3u_system.WHEEL_AXES)  # the shipped system's
 GAINS = dict(K=cubesat_3u.POINTING.K, P=cubesat_3u.POINTING.P)
 Q0 = cubesat_3u.INITIAL_ATTITUDE
 OMEGA0 = cubesat_3u.INITIAL_RATE
