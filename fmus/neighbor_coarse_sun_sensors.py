@@ -41,7 +41,7 @@ class CoarseSunSensors(NeighborSlave):
         self.parameter("seed", 0, None, "Seed of the noise generator numpy.random.default_rng(seed), >= 0", int)
         inputs = (self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
                   + self.input_array("r_BN_N", [6878137.0, 0.0, 0.0], "m", "Spacecraft position in N")
-                  + self.input_array("r_SN_N", [149597870700.0, 0.0, 0.0], "m", "Sun position in N")
+                  + self.input_array("r_SN_N", [adcs_sensors.AU, 0.0, 0.0], "m", "Sun position in N")
                   + (self.input("sunlit_fraction", 1.0, "1", "Fraction of the Sun's disc seen (EarthShadow)"),))
         out = lambda: self.feedthrough(self._output)  # noqa: E731
         self.output_array("css_signal", N, lambda: out()[0], "1", "Signal of each sensor", depends_on=inputs)

@@ -21,7 +21,7 @@ class EarthShadow(NeighborSlave):
                        "orbit_day is true when sunlit_fraction exceeds this value, in [0, 1)")
         position = self.input_array("r_BN_N", [constants.WGS84_A + 420e3, 0.0, 0.0], "m",
                                     "Spacecraft position relative to Earth's centre in N")
-        sun = self.input_array("r_SN_N", [149597870700.0, 0.0, 0.0], "m",
+        sun = self.input_array("r_SN_N", [constants.ASTRONOMICAL_UNIT, 0.0, 0.0], "m",
                                "Sun position relative to Earth's centre in N")
         deps = position + sun
         f = lambda: self.feedthrough(self._evaluate)  # noqa: E731

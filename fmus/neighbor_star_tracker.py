@@ -17,6 +17,7 @@ import numpy as np
 from neighbor_fmu_support import NeighborSlave
 
 from components.core import rotations
+from components.core.constants import ASTRONOMICAL_UNIT
 from components.sensing import adcs_sensors
 
 REASONS = {"rate": 1, "sun": 2, "earth": 4, "moon": 8}
@@ -46,7 +47,7 @@ class StarTracker(NeighborSlave):
         inputs = (self.input_array("q_BN", [0.0, 0.0, 0.0, 1.0], "1", "True attitude quaternion q_BN, scalar last")
                   + self.input_array("omega_BN_B", [0.0, 0.0, 0.0], "rad/s", "True body rate in B")
                   + self.input_array("r_BN_N", [6878137.0, 0.0, 0.0], "m", "Spacecraft position in N")
-                  + self.input_array("r_SN_N", [149597870700.0, 0.0, 0.0], "m", "Sun position in N")
+                  + self.input_array("r_SN_N", [ASTRONOMICAL_UNIT, 0.0, 0.0], "m", "Sun position in N")
                   + self.input_array("r_MN_N", [0.0, 0.0, 0.0], "m", "Moon position in N (zero: not checked)"))
         out = lambda: self.feedthrough(self._output)  # noqa: E731
         self.output_array("q_CN", 4, lambda: list(out()[0]), "1", "Measured case attitude q_CN, scalar last",

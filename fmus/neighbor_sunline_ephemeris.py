@@ -6,9 +6,8 @@ outputs are direct feedthrough of the inputs.
 """
 from neighbor_fmu_support import NeighborSlave
 
+from components.core.constants import ASTRONOMICAL_UNIT as AU
 from components.sensing import sunline
-
-AU = 149597870700.0  # m (IAU 2012)
 
 
 class SunlineEphemeris(NeighborSlave):

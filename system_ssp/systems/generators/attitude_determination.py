@@ -30,7 +30,7 @@ from ...ssp.writer import vec
 from .from_spec import write_system
 
 NAME = "attitude_determination"
-AU = 1.495978707e11  # m
+AU = constants.ASTRONOMICAL_UNIT  # m
 R_BN_N = [constants.WGS84_A + 420e3, 0.0, 0.0]  # 420 km, the thesis' first de-orbit altitude
 
 

@@ -18,11 +18,11 @@ Parameter files (system_ssp/systems/parameters/):
 
 
 from components.core import rotations
+from components.core.constants import ASTRONOMICAL_UNIT as AU
 
 from ...ssp.writer import vec
 from .from_spec import write_system
 
-AU = 149597870700.0  # m
 # Sun about 1 au away, off every axis; spacecraft in a low Earth orbit position.
 R_SUN_N = [0.8 * AU, -0.55 * AU, 0.24 * AU]
 R_SC_N = [4.2e6, 5.1e6, 1.9e6]
