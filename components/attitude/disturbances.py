@@ -37,11 +37,10 @@ import math
 
 import numpy as np
 
-from ..core.constants import ASTRONOMICAL_UNIT, MU_EARTH, OMEGA_EARTH_WGS84
+from ..core.constants import ASTRONOMICAL_UNIT, MU_EARTH, OMEGA_EARTH_WGS84, SOLAR_FLUX_1AU
 from ..core.jit import njit
 
 SPEED_OF_LIGHT = 299792458.0  # m/s (exact)
-SOLAR_FLUX_1AU = 1361.0  # W/m2, total solar irradiance at 1 AU (IAU 2015 Resolution B3 nominal)
 MAX_FACETS = 16
 
 # what `evaluate` writes, in order (3 each)

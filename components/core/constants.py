@@ -21,6 +21,7 @@ OMEGA_EARTH_WGS84 = 7.292115e-5  # rad/s, WGS-84 nominal Earth rotation rate
 OMEGA_EARTH = 7.292115146706979e-5  # rad/s, Earth rotation rate (IERS conventions, as GMAT)
 
 ASTRONOMICAL_UNIT = 149597870700.0  # m (IAU 2012 Resolution B2, exact)
+SOLAR_FLUX_1AU = 1361.0  # W/m2, total solar irradiance at 1 AU (IAU 2015 Resolution B3 nominal)
 
 DAY = 86400.0  # s
 DAYS_PER_JULIAN_YEAR = 365.25
