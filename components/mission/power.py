@@ -24,8 +24,11 @@ that produced Figure 46, for how they combine):
   4.21 on "Microprocessor Quiescent State"). We follow Appendix I; which switches are on in
   each mode is the mission manager's business, this model only sums what is on.
 
-Integration: over a step the switches and `solar_power` are held, so the net power
-P = solar_power - load_power is constant and the stored energy E(t) = E0 + P t is exact until
+Another spacecraft's loads that are not on NEIGHBOR's switch list (its avionics, its reaction
+wheels' electrical power) come in as `other_load_power` (W), added to the switched loads.
+
+Integration: over a step the switches, `solar_power` and `other_load_power` are held, so the net
+power P = solar_power - load_power is constant and the stored energy E(t) = E0 + P t is exact until
 it reaches 0 or the capacity, where it is clamped (the instant is computed inside the step, so
 the result does not depend on the step size). `energy_used` is the energy delivered to the
 loads: the full load while the battery can supply it; with the battery empty the loads get only
@@ -90,11 +93,12 @@ class PowerSystem:
     def empty(self):
         return self.energy <= 0.0
 
-    def step(self, on, dt, solar_power=0.0):
-        """Advance by dt seconds with the switches `on` and `solar_power` (W) held."""
+    def step(self, on, dt, solar_power=0.0, other_load_power=0.0):
+        """Advance by dt seconds with the switches `on`, `solar_power` (W) and the loads outside the
+        switch list, `other_load_power` (W), held."""
         dt = _number("step size", dt, "s")
         solar = _number("solar_power", solar_power, "W")
-        load = self.load_power(on)
+        load = self.load_power(on) + _number("other_load_power", other_load_power, "W")
         net = solar - load
         e0 = self.energy
         if net < 0.0:

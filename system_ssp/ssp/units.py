@@ -52,7 +52,7 @@ BUILTIN = {u.name: u for u in [
     make_unit("K", K=1), make_unit("degC", 1.0, 273.15, K=1),
     make_unit("A", A=1), make_unit("V", kg=1, m=2, s=-3, A=-1), make_unit("T", kg=1, s=-2, A=-1),
     make_unit("nT", 1e-9, kg=1, s=-2, A=-1), make_unit("A.m2", A=1, m=2),
-    make_unit("Hz", s=-1), make_unit("1/s", s=-1), make_unit("m3/s2", m=3, s=-2),
+    make_unit("Hz", s=-1), make_unit("1/s", s=-1), make_unit("1/K", K=-1), make_unit("m3/s2", m=3, s=-2),
 ]}
 
 

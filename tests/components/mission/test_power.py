@@ -197,7 +197,7 @@ def test_state_round_trip():
 def test_power_fmu(build_one, tmp_path):
     path = build_one("neighbor_power.py")
     deps = check_declarations(path)
-    assert deps["load_power"] == sorted(LOAD_NAMES)
+    assert deps["load_power"] == sorted(LOAD_NAMES + ("other_load_power",))
     assert {k: v for k, v in deps.items() if k != "load_power"} == {
         "energy": [], "state_of_charge": [], "energy_used": [], "empty": []}
     md = fmpy.read_model_description(str(path))
@@ -224,6 +224,10 @@ def test_power_fmu(build_one, tmp_path):
         fmu.setFMUstate(saved)
         assert fmu.getReal(reals) == [e, soc, load, used] and fmu.getBoolean([vr["empty"]]) == [False]
         fmu.freeFMUstate(saved)
+        fmu.setReal([vr["other_load_power"]], [1.5])  # another spacecraft's loads, off the switch list
+        assert fmu.getReal([vr["load_power"]])[0] == pytest.approx(2.171176 + 1.5, rel=1e-12)
+        fmu.doStep(600.0, 100.0)
+        assert fmu.getReal([vr["energy_used"]])[0] == pytest.approx(used + 100.0 * (2.171176 + 1.5), rel=1e-12)
     finally:
         fmu.terminate()
         fmu.freeInstance()
