@@ -29,8 +29,10 @@ Parameter files:
 import math
 
 from components.acs import reaction_wheel_array as rwa
+from components.attitude import disturbances
 from components.core.names import matrix_names
 from components.mission import cubesat_3u as mission
+from components.mission import solar_arrays
 
 from ...ssp.writer import vec
 from .from_spec import write_system
@@ -75,6 +77,57 @@ GUIDANCE = vec("sigma_R0N", list(mission.POINTING.sigma_R0N))
 NADIR = {"guidance.mode": 1, **vec("guidance.sigma_R0R", [0.0, -math.tan(math.radians(90.0) / 4.0), 0.0])}
 
 
+# ---- the detumble and the day ---------------------------------------------------------------
+COILS = vec("max_dipole", [mission.COILS.max_dipole] * 3)
+BDOT = {"gain": mission.COILS.detumble_gain, "use_field_difference": True}
+# the detumble flies the whole spacecraft (wheels at rest and not modelled: their spin inertia is
+# the body's), rk4 at 0.5 s sub-steps (10 deg/s turns 5 deg per sub-step)
+DETUMBLE_SPACECRAFT = {"mass": mission.SPACECRAFT.mass, "inertia_from_box": False,
+                       **_matrix("inertia_B", mission.SPACECRAFT.inertia_B), "integrator": "rk4", "max_substep": 0.5}
+TUMBLE = {**vec("q0", list(mission.INITIAL_ATTITUDE)), **vec("omega0", list(mission.DETUMBLE_RATE)),
+          "euler0_from_q0": True}
+DAY_SPACECRAFT = {**SPACECRAFT, "max_substep": mission.DAY.step}
+DAY_GAINS = {"K": mission.DAY.K, "P": mission.DAY.P}
+NADIR_GUIDANCE = {name.split(".", 1)[1]: value for name, value in NADIR.items()}
+DUMPING = {**_per_wheel("J_s", mission.WHEELS.J_s), "gain": mission.COILS.dumping_gain, **COILS}
+WHEEL_POWER = {**_per_wheel("base_power", mission.POWER.wheel_base_power),
+               "motor_efficiency": mission.POWER.wheel_motor_efficiency}
+BATTERY = {"capacity": mission.POWER.capacity, "initial_state_of_charge": mission.POWER.initial_state_of_charge,
+           "base_load": mission.POWER.base_load}
+
+
+def disturbance_values():
+    """DisturbanceTorques' parameters: the 3U's facets, residual dipole and inertia (unused facet
+    slots at area 0)."""
+    values = {source: True for source in disturbances.SOURCES}
+    values.update({"mass": mission.SPACECRAFT.mass, "inertia_from_box": False,
+                   **_matrix("inertia_B", mission.SPACECRAFT.inertia_B)})
+    values.update(vec("residual_dipole_B", list(mission.RESIDUAL_DIPOLE_B)))
+    for i in range(1, disturbances.MAX_FACETS + 1):
+        f = mission.FACETS[i - 1] if i <= len(mission.FACETS) else None
+        values[f"facet_area[{i}]"] = f.area if f else 0.0
+        for j in range(3):
+            values[f"facet_normal_B[{i},{j + 1}]"] = f.normal_B[j] if f else (1.0 if j == 0 else 0.0)
+            values[f"facet_centre_B[{i},{j + 1}]"] = f.centre_B[j] if f else 0.0
+        values[f"facet_specular[{i}]"] = f.specular if f else 0.0
+        values[f"facet_diffuse[{i}]"] = f.diffuse if f else 0.0
+    return values
+
+
+def solar_array_values():
+    """SolarArrays' parameters: the facets that carry cells (unused slots at area 0)."""
+    panels = [f for f in mission.FACETS if f.cell_area > 0.0]
+    n = solar_arrays.MAX_PANELS
+    values = {"panel_count": len(panels)}
+    for i in range(1, n + 1):
+        f = panels[i - 1] if i <= len(panels) else None
+        for j in range(3):
+            values[f"normal_B[{i},{j + 1}]"] = f.normal_B[j] if f else (1.0 if j == 0 else 0.0)
+        values[f"area[{i}]"] = f.cell_area if f else 0.0
+        values[f"efficiency[{i}]"] = f.cell_efficiency if f else 0.0
+    return values
+
+
 def generate(writer):
     writer.ssv("cubesat_3u_spacecraft", "3U body without the wheels' spin-axis inertia (kg.m2), rk4 at one "
                "sub-step per 0.1 s step", SPACECRAFT)
@@ -87,3 +140,21 @@ def generate(writer):
     writer.ssv("cubesat_3u_orbit", "Circular orbit 500 km, 97.4 deg (SI units)", dict(mission.ORBIT))
     writer.ssv("cubesat_3u_pointing_nadir", "Scenario: nadir pointing with body -z to nadir", NADIR)
     write_system(writer, "cubesat_3u_pointing")
+    writer.ssv("cubesat_3u_coils", "Three 0.2 A.m2 torque rods on the body axes", COILS)
+    writer.ssv("cubesat_3u_bdot", "Three-axis B-dot from the magnetometer alone (field difference)", BDOT)
+    writer.ssv("cubesat_3u_detumble_spacecraft", "The whole 3U's inertia (kg.m2), rk4 at 0.5 s sub-steps",
+               DETUMBLE_SPACECRAFT)
+    writer.ssv("cubesat_3u_tumble", "10 deg/s after the deployer", TUMBLE)
+    write_system(writer, "cubesat_3u_detumble")
+    writer.ssv("cubesat_3u_sunline", "The Sun heading from the quaternion attitude", {"attitude_input": "quaternion"})
+    writer.ssv("cubesat_3u_disturbances", "The 3U's facets, residual dipole and inertia", disturbance_values())
+    writer.ssv("cubesat_3u_nadir", "Nadir pointing with body -z to nadir", NADIR_GUIDANCE)
+    writer.ssv("cubesat_3u_day_gains", "MRP gains at 1 Hz", DAY_GAINS)
+    writer.ssv("cubesat_3u_dumping", "Momentum dumping through the rods: gain, rods, wheel inertias", DUMPING)
+    writer.ssv("cubesat_3u_wheel_power", "The wheels' electronics and motor efficiency", WHEEL_POWER)
+    writer.ssv("cubesat_3u_day_spacecraft", "3U body without the wheels' spin-axis inertia (kg.m2), rk4 at one "
+               "sub-step per 1 s step", DAY_SPACECRAFT)
+    writer.ssv("cubesat_3u_solar_arrays", "Cells on the four long faces and two deployed wings facing +z",
+               solar_array_values())
+    writer.ssv("cubesat_3u_battery", "Two 18650 cells (21.6 Wh), 80 % charged, 2 W always on", BATTERY)
+    write_system(writer, "cubesat_3u_nadir_day")
