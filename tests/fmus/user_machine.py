@@ -8,6 +8,7 @@ from pathlib import Path
 import shutil
 import subprocess
 import sys
+import tempfile
 
 import pytest
 
@@ -24,7 +25,26 @@ def can_unshare():
     if os.geteuid() != 0 or shutil.which("unshare") is None:
         return "needs root and unshare (util-linux) for a private mount namespace"
     proc = subprocess.run(["unshare", "-m", "--propagation", "private", "true"], capture_output=True, text=True)
-    return None if proc.returncode == 0 else f"mount namespaces not allowed here: {proc.stderr.strip()}"
+    if proc.returncode != 0:
+        return f"mount namespaces not allowed here: {proc.stderr.strip()}"
+    return _mounts_leak()
+
+
+def _mounts_leak():
+    """Whether a tmpfs mounted in a private namespace shows in this one (a sandbox whose mount
+    namespaces do not isolate): then hiding the checkout would hide it from every test, as it
+    did on one CI machine (the rest of the suite failed with its working directory gone)."""
+    probe = Path(tempfile.mkdtemp(prefix="neighbor-unshare-probe-"))
+    (probe / "marker").write_text("seen from this namespace\n")
+    try:
+        subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c",
+                        f"mount --make-rprivate / && mount -t tmpfs none {probe}"], capture_output=True, timeout=60)
+        if os.path.ismount(probe) or not (probe / "marker").is_file():
+            subprocess.run(["umount", "-l", str(probe)], capture_output=True)
+            return "mounts made in a private mount namespace show outside it here (no isolation)"
+        return None
+    finally:
+        shutil.rmtree(probe, ignore_errors=True)
 
 
 def hidden():
@@ -93,6 +113,17 @@ def on_user_machine(command, path_dirs, pythonpath=None, hide_all_python=False, 
     env = ["env", "-i", "PATH=" + ":".join(path_dirs + ["/usr/bin", "/bin"]), "HOME=/tmp"]
     if pythonpath:
         env.append(f"PYTHONPATH={pythonpath}")
-    script = " && ".join(mounts + ['exec "$@"'])
-    return subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c", script, "sh", *env, *command],
-                          capture_output=True, text=True, timeout=600)
+    # private again from inside (a failure stops the script before any mount)
+    script = " && ".join(["mount --make-rprivate /", *mounts, 'exec "$@"'])
+    folders = [*hidden(), *also_hidden] + ([str(PYENV_VERSIONS.parent)] if hide_all_python else [])
+    covered = [f for f in folders if not os.path.ismount(f)]
+    try:
+        return subprocess.run(["unshare", "-m", "--propagation", "private", "sh", "-c", script, "sh", *env,
+                               *command], capture_output=True, text=True, timeout=600)
+    finally:
+        leaked = [f for f in covered if os.path.ismount(f)]
+        for folder in leaked:  # the checkout must not stay hidden from the rest of the session
+            subprocess.run(["umount", "-l", folder], capture_output=True)
+        if leaked:
+            raise RuntimeError(f"the user machine's mounts leaked out of their namespace over {leaked} "
+                               "(unmounted again)")
