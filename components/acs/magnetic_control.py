@@ -28,21 +28,13 @@ command before the wheel distribution (Basilisk's mtbFeedforward): the wheels th
 coils' torque, so the attitude holds while the coils change the wheels' momentum at -k_dump h_w
 (less the part along B). The field is the magnetometer's (or the field model's) B in B.
 """
-import math
 
 import numpy as np
 
-from ..core.checks import finite_vector
+from ..core.checks import finite_vector, non_negative
 from .reaction_wheel_array import _unit_axes
 
 B_MIN = 1.0e-9  # T: below it the field is taken as absent (no coil command)
-
-
-def _gain(name, value, unit):
-    v = float(value)
-    if not (math.isfinite(v) and v >= 0.0):
-        raise ValueError(f"{name} = {value!r} must be a finite number >= 0 {unit}")
-    return v
 
 
 def _max_dipole(max_dipole):
@@ -73,7 +65,7 @@ class BdotDetumble:
     uses it (Gauss-Seidel)."""
 
     def __init__(self, gain=2.0e-3, use_field_difference=False):
-        self.gain = _gain("gain", gain, "N.m.s")
+        self.gain = non_negative("gain", gain, "N.m.s")
         self.use_field_difference = bool(use_field_difference)
         self.previous_field = None  # the last sample (field-difference mode)
         self.interval = 0.0  # s, from that sample to the next
@@ -121,7 +113,7 @@ class MomentumDumping:
         self.J_s = np.array(finite_vector(J_s, self.count, "J_s", "kg.m2"))
         if np.any(self.J_s <= 0.0):
             raise ValueError(f"J_s {self.J_s.tolist()} must be > 0 kg.m2 for every wheel")
-        self.gain = _gain("gain", gain, "1/s")
+        self.gain = non_negative("gain", gain, "1/s")
         self.max_dipole = _max_dipole(max_dipole)
 
     def wheel_momentum(self, speeds):

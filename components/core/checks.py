@@ -45,3 +45,18 @@ def positive(name, value, unit=""):
     if not (math.isfinite(x) and x > 0.0):
         raise ValueError(text)
     return x
+
+
+def non_negative(name, value, unit=""):
+    """value as a float >= 0; ValueError naming `name` (and its unit) for anything else, a Boolean
+    or a non-number included."""
+    text = f"{name} = {value!r}{' ' + unit if unit else ''} must be a finite number >= 0"
+    if isinstance(value, bool):
+        raise ValueError(text)
+    try:
+        x = float(value)
+    except (TypeError, ValueError):
+        raise ValueError(text) from None
+    if not (math.isfinite(x) and x >= 0.0):
+        raise ValueError(text)
+    return x

@@ -86,7 +86,7 @@ def test_dumping_takes_momentum_out_of_the_wheels_and_feeds_the_coil_torque_forw
 
 
 @pytest.mark.parametrize("kwargs, message", [
-    (dict(gain=-1.0), "gain = -1.0 must be a finite number >= 0 1/s"),
+    (dict(gain=-1.0), "gain = -1.0 1/s must be a finite number >= 0"),
     (dict(J_s=[1e-5, 0.0, 1e-5]), "J_s [1e-05, 0.0, 1e-05] must be > 0 kg.m2 for every wheel"),
     (dict(max_dipole=[0.2, -0.1, 0.2]), "max_dipole [0.2, -0.1, 0.2] must be >= 0 A.m2 on every axis"),
 ])
