@@ -290,6 +290,17 @@ class NeighborSlave(Fmi2Slave):
         }
         return var
 
+    def add_dependencies(self, outputs: Iterable[str], inputs: Iterable[str]) -> None:
+        """Outputs (scalars or arrays by name) declared earlier also depend directly on `inputs`
+        (an input appended after them, so that the earlier value references stay)."""
+        inputs = list(inputs)
+        for out in outputs:
+            names = [n for n in self.fmu_meta if n == out or n.startswith(out + "[")]
+            if not names or any(self.fmu_meta[n]["causality"] != "output" for n in names):
+                raise ValueError(f"add_dependencies: {out!r} is not a declared output")
+            for n in names:
+                self.fmu_meta[n]["depends_on"].extend(inputs)
+
     def parameter(self, name: str, start: Scalar, unit: Optional[str], description: str, kind: type = float) -> str:
         self.values[name] = kind(start)
 

@@ -5,8 +5,10 @@ Wraps components.attitude.mrp_feedback.MrpFeedback: gains K, P, the optional int
 integral_limit), the spacecraft's inertia (wheels included) and the wheels' spin momentum for the
 gyroscopic term. torque_cmd_B is the torque the body is to feel (for WheelTorqueDistribution, or
 for magnetorquers); it depends directly on the tracking error and the wheel momentum. The integral
-is the law's state, updated at each step's end.
+is the law's state, updated at each step's end. `enabled` (a mode manager's switch, e.g.
+AdcsModeSequence) false: zero torque, and the integral restarts from zero.
 """
+import numpy as np
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import mrp_feedback, rigid_body
@@ -39,6 +41,10 @@ class MrpFeedback(NeighborSlave):
                           "Commanded torque on the body in B (-Lr)", depends_on=error + wheels)
         self.output_array("integral_torque_B", 3, lambda: out()[1].tolist(), "N.m",
                           "The integral term's part of torque_cmd_B (-P Ki z)", depends_on=error)
+        # appended last (existing systems keep their value references); a mode manager's switch
+        enabled = self.input("enabled", True, None, "Law enabled; when false the command is zero and the integral "
+                             "restarts from zero", bool)
+        self.add_dependencies(("torque_cmd_B", "integral_torque_B"), (enabled,))
 
     def build_model(self):
         v = self.values
@@ -46,11 +52,16 @@ class MrpFeedback(NeighborSlave):
                                         v["integral_limit"], v["control_law"], self.vector("known_torque_B", 3))
 
     def _evaluate(self):
+        if not self.values["enabled"]:
+            return np.zeros(3), np.zeros(3)
         return self.model.torque(self.vector("sigma_BR", 3), self.vector("omega_BR_B", 3),
                                  self.vector("omega_RN_B", 3), self.vector("domega_RN_B", 3),
                                  self.vector("wheel_momentum_B", 3))
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.vector("sigma_BR", 3), step_size)
+        if self.values["enabled"]:
+            self.model.step(self.vector("sigma_BR", 3), step_size)
+        else:
+            self.model.reset()
         self._input_version += 1  # the integral changed
         return True

@@ -70,6 +70,11 @@ class MrpFeedback:
             self.int_sigma = self._integral(np.asarray(sigma_BR, dtype=float))
         self.dt = float(h)
 
+    def reset(self):
+        """The law off: the integral restarts from zero (Basilisk's Reset), the next update's dt is 0."""
+        self.int_sigma = np.zeros(3)
+        self.dt = 0.0
+
     def get_state(self):
         return {"int_sigma": self.int_sigma.tolist(), "dt": self.dt}
 

@@ -159,6 +159,23 @@ def location_error(r_TN_N, r_BN_N, sigma_BN, boresight_B, small_angle=DEFAULT_SM
     return -math.tan(phi / 4.0) * e / np.linalg.norm(e), los
 
 
+def nadir_axis_error(q_BN, r_BN_N, axis_B=(0.0, 0.0, -1.0)):
+    """The angle (rad) between the body axis axis_B and the nadir, -r_BN_N / |r_BN_N|: the true
+    pointing error of a nadir-pointing spacecraft whatever its rotation about the nadir. Takes one
+    attitude and position or arrays of them (rows, quaternions scalar last)."""
+    q = np.atleast_2d(np.asarray(q_BN, float))
+    r = np.atleast_2d(np.asarray(r_BN_N, float))
+    q = q / np.linalg.norm(q, axis=1, keepdims=True)
+    a = _unit(axis_B, "axis_B")
+    # the axis in N: [NB] a = [BN]^T a, [BN] = (q4^2 - |v|^2) I + 2 v v^T - 2 q4 [v x]
+    v, s = q[:, :3], q[:, 3:]
+    axis_N = (s * s - np.sum(v * v, axis=1, keepdims=True)) * a + 2.0 * v * (v @ a)[:, None] \
+        + 2.0 * s * np.cross(v, a)
+    nadir = -r / np.linalg.norm(r, axis=1, keepdims=True)
+    angle = np.arctan2(np.linalg.norm(np.cross(axis_N, nadir), axis=1), np.sum(axis_N * nadir, axis=1))
+    return angle if np.ndim(q_BN) > 1 else float(angle[0])
+
+
 class PointingGuidance:
     """The guidance of every mode with one set of parameters; the target mode's finite difference
     keeps the error at the start of the last step (step())."""
