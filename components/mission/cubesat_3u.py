@@ -123,6 +123,35 @@ class DayPointing:
     duration: float = 86400.0  # s
 
 
+@dataclass(frozen=True)
+class Sensors:
+    """The ADCS sensors of the day after separation: a MEMS gyro sampled at 1 Hz (white noise
+    1e-4 rad/s per sample, a 10 deg/h bias on each axis), a horizon sensor (0.25 deg), six coarse
+    Sun sensors on the faces (0.5 % signal noise, 80 deg field of view; the estimator takes their
+    heading as good to 3 deg) and the magnetometer. The pointing mode flies on the estimate while
+    the filter's largest 1-sigma is within 5 deg: in the eclipses (the nadir alone) it grows to
+    about 2 deg, so a 2 deg limit dropped the spacecraft into Sun-safe at every eclipse."""
+    gyro_sigma: float = 1.0e-4  # rad/s per 1 s sample
+    gyro_bias: Tuple[float, float, float] = tuple(math.radians(10.0) / 3600.0 * s for s in (1.0, -1.0, 0.6))
+    horizon_sigma: float = math.radians(0.25)  # rad
+    coarse_sun_sigma: float = math.radians(3.0)  # rad, as the estimator weighs the coarse heading
+    attitude_valid_sigma: float = math.radians(5.0)  # rad: the estimate the pointing mode flies on
+
+
+@dataclass(frozen=True)
+class ModeSequence:
+    """Detumble until the gyro reads below 1.5 deg/s for a minute (the wheels absorb the rest:
+    0.042 kg.m2 at 1.5 deg/s is 1.1 mN.m.s of their 10 each), Sun-safe with +z (the wings) at the
+    Sun until the Sun stays within 10 deg and the estimate is valid for a minute, then nadir;
+    back to detumble above 5 deg/s."""
+    detumble_exit_rate: float = math.radians(1.5)  # rad/s
+    detumble_entry_rate: float = math.radians(5.0)  # rad/s
+    sun_safe_exit_angle: float = math.radians(10.0)  # rad
+    hold_time: float = 60.0  # s
+    sun_axis_B: Tuple[float, float, float] = (0.0, 0.0, 1.0)
+    duration: float = 86400.0  # s
+
+
 SPACECRAFT = Spacecraft()
 WHEELS = Wheels()
 COILS = Coils()
@@ -131,6 +160,8 @@ FACETS = _facets()
 RESIDUAL_DIPOLE_B = (0.002, -0.001, 0.003)  # A.m2: assumed, the class measured on 3U CubeSats
 POWER = Power()
 DAY = DayPointing()
+SENSORS = Sensors()
+MODES = ModeSequence()
 _TUMBLE_AXIS = (0.6, -0.5, 0.62)
 # rad/s: 10 deg/s after the deployer, about an axis off all three principal ones
 DETUMBLE_RATE = tuple(math.radians(10.0) * x / math.sqrt(sum(y * y for y in _TUMBLE_AXIS)) for x in _TUMBLE_AXIS)

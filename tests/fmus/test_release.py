@@ -128,12 +128,12 @@ def test_export_bundle(built, c_host, tmp_path, capsys):
     fmu_paths, ssp_paths = built
     assert cli.main(["export", "--out", str(tmp_path / "release")]) == 0
     target = tmp_path / "release" / f"neighbor-cosim-{system_ssp.__version__}-fmi.zip"
-    assert f"{target}: 51 FMUs (and 51 as FMI 3.0), 16 systems" in capsys.readouterr().out
+    assert f"{target}: 52 FMUs (and 52 as FMI 3.0), 17 systems" in capsys.readouterr().out
     top = f"neighbor-cosim-{system_ssp.__version__}-fmi/"
     with zipfile.ZipFile(target) as z:
         files = {name[len(top):]: z.read(name) for name in z.namelist()}
         assert all(name.startswith(top) for name in z.namelist())
-    assert len(fmu_paths) == 51
+    assert len(fmu_paths) == 52
     for name, path in fmu_paths.items():
         assert files[f"fmus/{name}/{name}.fmu"] == path.read_bytes(), name
         assert {f"fmus/{name}/{name}_ref.csv", f"fmus/{name}/{name}_ref.opt", f"fmus/{name}/README.md",

@@ -96,6 +96,27 @@ BATTERY = {"capacity": mission.POWER.capacity, "initial_state_of_charge": missio
            "base_load": mission.POWER.base_load}
 
 
+# ---- the first day: detumble, Sun-safe, nadir on the estimator ----------------------------------
+# rk4 at 0.5 s sub-steps of the 1 s step (10 deg/s turns 5 deg per sub-step), the wheels at rest
+MISSION_SPACECRAFT = {**SPACECRAFT, "max_substep": 0.5}
+WHEELS_AT_REST = _per_wheel("Omega0", 0.0)
+GYRO = {**vec("bias", list(mission.SENSORS.gyro_bias)), "sigma": mission.SENSORS.gyro_sigma, "seed": 11}
+HORIZON = {"sigma": mission.SENSORS.horizon_sigma, "seed": 12}
+COARSE_SUN = {"seed": 13}
+ESTIMATOR = {"nadir_sigma": mission.SENSORS.horizon_sigma, "gyro_sigma": mission.SENSORS.gyro_sigma,
+             "gyro_sample_time": mission.DAY.step, "use_coarse_sun": True,
+             "coarse_sun_sigma": mission.SENSORS.coarse_sun_sigma, "valid_sigma": mission.SENSORS.attitude_valid_sigma,
+             "mass": mission.SPACECRAFT.mass, "inertia_from_box": False,
+             **_matrix("inertia_B", mission.SPACECRAFT.inertia_B)}
+MODES = {"detumble_exit_rate": mission.MODES.detumble_exit_rate,
+         "detumble_entry_rate": mission.MODES.detumble_entry_rate,
+         "sun_safe_exit_angle": mission.MODES.sun_safe_exit_angle, "hold_time": mission.MODES.hold_time,
+         **vec("sun_axis_B", list(mission.MODES.sun_axis_B)), "pointing_mode": 1}
+# the guidance's parameters there: its mode is the mode sequence's output
+GUIDANCE_MODES = {**vec("sun_axis_B", list(mission.MODES.sun_axis_B)),
+                  **{name: value for name, value in NADIR_GUIDANCE.items() if name != "mode"}}
+
+
 def disturbance_values():
     """DisturbanceTorques' parameters: the 3U's facets, residual dipole and inertia (unused facet
     slots at area 0)."""
@@ -158,3 +179,16 @@ def generate(writer):
                solar_array_values())
     writer.ssv("cubesat_3u_battery", "Two 18650 cells (21.6 Wh), 80 % charged, 2 W always on", BATTERY)
     write_system(writer, "cubesat_3u_nadir_day")
+    writer.ssv("cubesat_3u_mission_spacecraft", "3U body without the wheels' spin-axis inertia (kg.m2), rk4 at 0.5 s "
+               "sub-steps", MISSION_SPACECRAFT)
+    writer.ssv("cubesat_3u_wheels_at_rest", "The wheels at rest after separation", WHEELS_AT_REST)
+    writer.ssv("cubesat_3u_gyro", "MEMS gyro at 1 Hz: 1e-4 rad/s noise, 10 deg/h bias", GYRO)
+    writer.ssv("cubesat_3u_horizon", "Horizon sensor, 0.25 deg", HORIZON)
+    writer.ssv("cubesat_3u_coarse_sun", "Six coarse Sun sensors on the faces (the FMU's defaults), own seed",
+               COARSE_SUN)
+    writer.ssv("cubesat_3u_estimator", "MEKF on the gyro with the horizon sensor and the coarse Sun heading; valid "
+               "within 5 deg", ESTIMATOR)
+    writer.ssv("cubesat_3u_modes", "Detumble below 1.5 deg/s, Sun-safe to 10 deg, then nadir (holds of 60 s)", MODES)
+    writer.ssv("cubesat_3u_guidance_modes", "Sun-safe points +z (the wings) at the Sun; nadir with body -z to nadir",
+               GUIDANCE_MODES)
+    write_system(writer, "cubesat_3u_mission")
