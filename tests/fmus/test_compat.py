@@ -44,8 +44,11 @@ def bundle(fmu_paths, tmp_path_factory):
             return built
         return compat.write_bundle(fmu_paths[model], out)
 
-    with ThreadPoolExecutor(2) as pool:
-        folders = list(pool.map(folder, sorted(fmu_paths)))
+    # one at a time: write_bundle runs FMPy in this process, and FMPy's FMU loading changes the
+    # working directory to the binary's folder and back; two threads interleaving that left the
+    # worker in a deleted extraction folder (os.getcwd() failing in every later test of it: the
+    # 254 failures of two CI runs)
+    folders = [folder(model) for model in sorted(fmu_paths)]
     return {f.name: f for f in folders}
 
 
