@@ -32,31 +32,28 @@ def finite_vector(v, n, what, note=None):
     return t
 
 
-def positive(name, value, unit=""):
-    """value as a float > 0; ValueError naming `name` (and its unit) for anything else, a Boolean
-    or a non-number included."""
-    text = f"{name} = {value!r}{' ' + unit if unit else ''} must be a finite positive number"
+def _finite_number(name, value, unit, requirement, accepts):
+    """value as a float for which accepts(x) holds; ValueError '<name> = <value> <unit> must be
+    <requirement>' for anything else, a Boolean or a non-number included."""
+    text = f"{name} = {value!r}{' ' + unit if unit else ''} must be {requirement}"
     if isinstance(value, bool):
         raise ValueError(text)
     try:
         x = float(value)
     except (TypeError, ValueError):
         raise ValueError(text) from None
-    if not (math.isfinite(x) and x > 0.0):
+    if not (math.isfinite(x) and accepts(x)):
         raise ValueError(text)
     return x
+
+
+def positive(name, value, unit=""):
+    """value as a float > 0; ValueError naming `name` (and its unit) for anything else, a Boolean
+    or a non-number included."""
+    return _finite_number(name, value, unit, "a finite positive number", lambda x: x > 0.0)
 
 
 def non_negative(name, value, unit=""):
     """value as a float >= 0; ValueError naming `name` (and its unit) for anything else, a Boolean
     or a non-number included."""
-    text = f"{name} = {value!r}{' ' + unit if unit else ''} must be a finite number >= 0"
-    if isinstance(value, bool):
-        raise ValueError(text)
-    try:
-        x = float(value)
-    except (TypeError, ValueError):
-        raise ValueError(text) from None
-    if not (math.isfinite(x) and x >= 0.0):
-        raise ValueError(text)
-    return x
+    return _finite_number(name, value, unit, "a finite number >= 0", lambda x: x >= 0.0)
