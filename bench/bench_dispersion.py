@@ -61,13 +61,14 @@ def main():
     summary = run_campaign(spec, args.out, workers=args.workers, progress=True)
     wall = time.perf_counter() - t0
     rows = sorted(_read_rows(Path(args.out)), key=lambda r: r["run"])
-    ok = [r for r in rows if r["status"] == "ok"]
+    ok = [r for r in rows if r["status"] in ("ok", "incomplete")]  # incomplete: never re-entered
     safe = [r for r in ok if r["safe_reason"]]  # the de-orbit abandoned for the safe state (no attitude)
     ok = [r for r in ok if not r["safe_reason"]]  # the runs that flew the de-orbit
     good = [r for r in ok if r["budget_spent"] and r["reentered"] and not r["detumble_timeouts"]
-            and not r["slew_timeouts"] and (r["end_s"] - r["burn_start_s"]) < 5 * YEAR]
+            and not r["slew_timeouts"] and r["end_s"] is not None and (r["end_s"] - r["burn_start_s"]) < 5 * YEAR]
     lo, hi = wilson(len(good), len(rows))
-    print(f"{len(rows)} runs: {summary['ok']} ran, {summary['failed']} failed, {summary['timeout']} timed out")
+    print(f"{len(rows)} runs: {summary['ok']} ran, {summary['incomplete']} never re-entered, {summary['failed']} "
+          f"failed, {summary['timeout']} timed out")
     print(f"de-orbit success (burned the budget, no phase timeout, re-entry < 5 years after the burn): "
           f"{len(good)}/{len(rows)} = {len(good) / len(rows):.1%} (95 % interval {lo:.1%} - {hi:.1%}); "
           f"{len(safe)} in the safe state (no attitude, no burn)")

@@ -9,7 +9,7 @@ from .algorithms import Algorithm, FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
 from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallClockLimit
 from .observers import Observer, ProgressBar, Profiler, Recorder, RunView, StepInfo, StopConditions
-from .result import Result
+from .result import REACHED_STOP_TIME, Result
 
 DISCARD = 2  # fmi2Discard: a co-simulation FMU that could not complete the step (or ended the simulation)
 
@@ -101,7 +101,7 @@ class _Run:
             if bar is not None:
                 bar.close()  # also when a step failed
         algorithm.finish(info)
-        reason = f"stop condition {info.fired} at t={info.t:g} s" if info.fired is not None else "reached stop time"
+        reason = f"stop condition {info.fired} at t={info.t:g} s" if info.fired is not None else REACHED_STOP_TIME
         return self.result(recorder.data(), info.t, reason, final=table.final(), modes=algorithm.statistics(),
                            profile=profiler.report() if profiler else None)
 
@@ -140,7 +140,8 @@ class _Run:
                       step_size=None if plan.schedule is not None else plan.step_size, algorithm=plan.algorithm,
                       order=[self.system.comps[i].name for i in plan.order], messages=self.table.messages(),
                       units=self.units(), step_size_source=None if plan.schedule is not None
-                      else plan.step_size_source, **extra)
+                      else plan.step_size_source,
+                      stop_conditions=[f"{self.system.comps[ci].name}.{var}" for ci, var in plan.stops], **extra)
 
     def units(self):
         comps = self.system.comps

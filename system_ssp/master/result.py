@@ -12,6 +12,7 @@ from ..errors import SSPError
 from .plotting import default_signals, drawable, plot, select, units_path
 
 Units = Dict[str, Optional[str]]  # {column: unit or None}
+REACHED_STOP_TIME = "reached stop time"  # the stop reason of a run that ran to its stop time
 
 
 class Result:
@@ -31,13 +32,17 @@ class Result:
     partial:     True for the rows of a run that failed or was interrupted (err.result).
     step_size_source: where step_size came from ("as requested", "nc:Master stepSize, file:line",
                  OSP's baseStepSize, the FMUs' DefaultExperiment); None for a scheduled run.
+    stop_conditions: the stop conditions the run watched ('component.variable' names).
+    incomplete:  True when the run watched stop conditions and reached its stop time without one
+                 holding (a detumble that never settled, an orbit that never re-entered).
     """
 
     def __init__(self, data: np.ndarray, stop_time: float, stop_reason: str, steps: int, final: Dict[str, Any],
                  wall_time: float, start_time: float, step_size: Optional[float], algorithm: str, order: List[str],
                  messages: Dict[str, List[str]], modes: Optional[Dict[str, Dict[str, float]]] = None,
                  profile: Optional[Dict[str, Any]] = None, units: Optional[Units] = None,
-                 partial: bool = False, step_size_source: Optional[str] = None) -> None:
+                 partial: bool = False, step_size_source: Optional[str] = None,
+                 stop_conditions: Sequence[str] = ()) -> None:
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -54,6 +59,11 @@ class Result:
         self.units = units or {}
         self.partial = partial
         self.step_size_source = step_size_source
+        self.stop_conditions = tuple(stop_conditions)
+
+    @property
+    def incomplete(self) -> bool:
+        return bool(self.stop_conditions) and not self.partial and self.stop_reason == REACHED_STOP_TIME
 
     @property
     def names(self) -> List[str]:

@@ -132,9 +132,11 @@ def test_one_and_two_workers_give_the_same_rows_and_resume_skips(ssp_paths, tmp_
     assert [r["run"] for r in rows] == list(range(6))
     failed = [r for r in rows if r["detumble.Kp[1]"] == -1.0]
     assert failed and all(r["status"] == "failed" and "component 'detumble'" in r["error"] for r in failed)
-    assert all(r["status"] == "ok" and r["end_s"] == 1.0 for r in rows if r["detumble.Kp[1]"] != -1.0)
+    # 1 s is too short for the detumble to settle: incomplete, without an end time
+    assert all(r["status"] == "incomplete" and r["end_s"] is None for r in rows if r["detumble.Kp[1]"] != -1.0)
     assert s1["failed"] == s2["failed"] == len(failed) and s1["metrics"] == s2["metrics"]
-    assert json.loads((tmp_path / "one" / "summary.json").read_text())["probabilities"]["slow_x"]["n"] == s1["ok"]
+    probability = json.loads((tmp_path / "one" / "summary.json").read_text())["probabilities"]["slow_x"]
+    assert probability["n"] == s1["incomplete"]
     assert (tmp_path / "one" / "figures" / "scatter.png").stat().st_size > 5000
     dom, console = open_page(tmp_path / "one" / "report.html")  # one file, drawn by a real browser
     assert console == [] and dom.count('class="main-svg"') >= 2 and "success rate" in dom
@@ -199,6 +201,64 @@ def test_cli_exit_codes_say_how_the_campaign_went(ssp_paths, tmp_path, capsys):
     assert "6 of 6 runs already recorded there are kept, 0 to run" in capsys.readouterr().err
 
 
+SETTLING = """
+[campaign]
+system = "{system}"
+parameter_sets = ["parameters/detumble_case1.ssv"]
+runs = 8
+seed = 3
+min_success = 0.8
+[dispersions."dynamics.omega0[1]"]
+distribution = "uniform"
+low = -0.17
+high = 0.17
+[dispersions."dynamics.omega0[2]"]
+distribution = "uniform"
+low = -0.17
+high = 0.17
+[dispersions."dynamics.omega0[3]"]
+distribution = "uniform"
+low = -0.17
+high = 0.17
+[metrics]
+t_done = "stop_time"
+done = "final:detumble.done"
+reason = "stop_reason"
+[probabilities]
+done_in_10s = "t_done <= 10"
+"""
+
+
+def test_a_run_whose_stop_condition_never_held_is_incomplete(ssp_paths, tmp_path, capsys):
+    """Random tumbles up to 10 deg/s per axis with the shipped detumble law over its 20 s: the runs
+    whose rates limit-cycle outside the band never raise detumble.done and reach the stop time.
+    They are "incomplete", counted apart, without an end time, not successes for min_success, and
+    in the probabilities as runs that did not detumble (not left out)."""
+    from system_ssp.cli import main
+
+    spec_path = tmp_path / "settling.toml"
+    spec_path.write_text(SETTLING.format(system=ssp_paths["detumble"]))
+    assert main(["campaign", str(spec_path), "--out", str(tmp_path / "out"), "--workers", "1"]) == 1
+    out = capsys.readouterr()
+    assert "6 ok, 2 incomplete (stop time reached before a stop condition held), 0 failed" in out.out
+    assert "success rate 75.0 % is below campaign.min_success 0.8" in out.err
+    rows = _rows(tmp_path / "out")
+    incomplete = [r for r in rows if r["status"] == "incomplete"]
+    assert [r["run"] for r in incomplete] == [2, 7]
+    for r in incomplete:
+        assert r["t_done"] is None and r["done"] is False and r["reason"] == "reached stop time" and r["error"] == ""
+    for r in rows:
+        if r["status"] == "ok":
+            assert r["done"] is True and 0.0 <= r["t_done"] < 20.0 and r["reason"].startswith("stop condition")
+    s = json.loads((tmp_path / "out" / "summary.json").read_text())
+    assert (s["ok"], s["incomplete"], s["failed"], s["timeout"], s["success_rate"]) == (6, 2, 0, 0, 0.75)
+    assert s["metrics"]["t_done"]["n"] == 6  # the end times there are
+    p = s["probabilities"]["done_in_10s"]
+    assert (p["k"], p["n"]) == (6, 8)  # the two that never settled count against it
+    dom, console = open_page(tmp_path / "out" / "report.html")
+    assert console == [] and "2 incomplete (stop time reached before a stop condition held)" in dom
+
+
 DEORBIT = """
 [campaign]
 system = "{system}"
@@ -226,7 +286,7 @@ def test_durations_units_kept_series_and_rerun(ssp_paths, tmp_path, capsys):
 
     spec = _spec(tmp_path, DEORBIT.format(system=ssp_paths["deorbit_lifetime"]))
     s = run_campaign(spec, tmp_path / "out", workers=1)
-    assert s["ok"] == 3
+    assert s["incomplete"] == 3  # 30 days of a 420 km orbit: no re-entry (the system's stop condition)
     rows = _rows(tmp_path / "out")
     for r in rows:
         assert r["burn_s"] == pytest.approx(38.74 * 60.0, abs=60.0)  # the thesis' 38.74 min burn

@@ -14,6 +14,8 @@ thread each); with --scheduler any running Dask cluster (dask-jobqueue on SLURM/
 - runs.parquet: all rows in run order, summary.json (success rate, per metric mean, std and
   percentiles, probabilities with 95 % Wilson intervals; also printed) and figures/.
 
+A run that reaches the stop time while none of the system's stop conditions held (a detumble
+that never settled) is "incomplete": counted apart, not a success, its stop_time metrics missing.
 A run that fails or passes timeout_s is a row with its status and error; a worker process that
 dies (an FMU that crashes it) is restarted by its nanny and its run recorded as failed.
 """
@@ -296,12 +298,11 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
 def campaign_report(spec, rows, s, series_dir=None):
     """report.html of a campaign: the summary table, the metrics' distributions (interactive),
     the commonest errors, the spec and the versions; one file."""
-    ok = [r for r in rows if r["status"] == "ok"]
+    ok = finished(rows)
     stats = [(name, m.get("unit") or "", m["n"], *(f"{m[k]:.6g}" for k in ("mean", "std", "min", "p5", "p50", "p95",
                                                                              "max")))
              for name, m in s["metrics"].items() if "mean" in m]
-    summary = [f"<p>{s['runs']} runs: {s['ok']} ok, {s['failed']} failed, {s['timeout']} timed out (success rate "
-               f"{100 * s['success_rate']:.1f} %)</p>",
+    summary = [f"<p>{escape(counts(s))}</p>",
                report.table(("metric", "unit", "n", "mean", "std", "min", "p5", "p50", "p95", "max"), stats)]
     if s["probabilities"]:
         summary.append(report.table(("probability", "condition", "p", "95 % interval", "runs"), [
@@ -309,11 +310,11 @@ def campaign_report(spec, rows, s, series_dir=None):
             for name, p in s["probabilities"].items()]))
     sections = [("Summary", "\n".join(summary))]
     numeric = {m.name: [float(r[m.name]) for r in ok if isinstance(r[m.name], (int, float))
-                        and math.isfinite(float(r[m.name]))] for m in spec.metrics}
+                        and math.isfinite(float(r[m.name]))] for m in spec.metrics}  # None: an incomplete run's
     numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
     if numeric:
         units = {name: m.get("unit") for name, m in s["metrics"].items()}
-        sections.append(("Distributions over the successful runs", report.histograms(numeric, units)))
+        sections.append(("Distributions over the finished runs (ok and incomplete)", report.histograms(numeric, units)))
     if spec.keep_timeseries and series_dir is not None:
         kept = envelopes(spec, ok, series_dir)
         if kept:
@@ -426,11 +427,16 @@ def wilson(k, n, z=1.959963984540054):
 
 
 def summarize(spec, rows, units=None):
-    """Success rate, per-metric statistics over the successful runs (with their unit), probabilities."""
-    ok = [r for r in rows if r["status"] == "ok"]
-    s = {"campaign": str(spec.path), "system": str(spec.system), "runs": len(rows), "ok": len(ok),
+    """Success rate (the ok runs' share: an incomplete one is not a success), per-metric statistics
+    over the finished runs (ok and incomplete, with their unit), probabilities over the same runs (a
+    metric an incomplete run lacks, such as its end time, counts as the condition not holding: a
+    run that never re-entered does not re-enter within five years)."""
+    ok = finished(rows)
+    s = {"campaign": str(spec.path), "system": str(spec.system), "runs": len(rows),
+         "ok": sum(r["status"] == "ok" for r in rows), "incomplete": sum(r["status"] == "incomplete" for r in rows),
          "failed": sum(r["status"] == "failed" for r in rows), "timeout": sum(r["status"] == "timeout" for r in rows),
-         "success_rate": len(ok) / len(rows) if rows else math.nan, "metrics": {}, "probabilities": {}}
+         "metrics": {}, "probabilities": {}}
+    s["success_rate"] = s["ok"] / len(rows) if rows else math.nan
     for m in spec.metrics:
         vals = np.array([r[m.name] for r in ok if isinstance(r[m.name], (int, float))], dtype=float)
         vals = vals[np.isfinite(vals)] if vals.size else vals
@@ -443,24 +449,40 @@ def summarize(spec, rows, units=None):
         else:
             values = sorted({str(r[m.name]) for r in ok})
             s["metrics"][m.name] = {"n": len(ok), "values": values[:20]}
-    errors = Counter(r["error"] for r in rows if r["status"] != "ok" and r.get("error"))
+    errors = Counter(r["error"] for r in rows if r["status"] not in FINISHED and r.get("error"))
     s["errors"] = [{"error": e, "runs": n} for e, n in errors.most_common(3)]
     if spec.faults:  # runs per fault case ("none": no fault)
         s["faults"] = dict(sorted(Counter(r.get(FAULT, "none") for r in rows).items()))
     s["min_success"] = spec.min_success
     ops = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal}
     for name, metric, op, threshold in spec.probabilities:
-        vals = [r[metric] for r in ok if r[metric] is not None]
-        k = int(sum(bool(ops[op](v, threshold)) for v in vals))
+        vals = [r[metric] for r in ok if r[metric] is not None or r["status"] == "incomplete"]
+        k = int(sum(v is not None and bool(ops[op](v, threshold)) for v in vals))
         lo, hi = wilson(k, len(vals))
         s["probabilities"][name] = {"condition": f"{metric} {op} {threshold}", "k": k, "n": len(vals),
                                     "p": k / len(vals) if vals else math.nan, "ci95": [lo, hi]}
     return s
 
 
+FINISHED = ("ok", "incomplete")  # the runs that ran to their end (the others failed or timed out)
+
+
+def finished(rows):
+    """The rows of the runs that ran to their end: ok, or incomplete (the stop time reached before
+    any of the system's stop conditions held)."""
+    return [r for r in rows if r["status"] in FINISHED]
+
+
+def counts(s):
+    """'N runs: a ok, b incomplete, c failed, d timed out (success rate x %)' of a summary."""
+    incomplete = (f"{s['incomplete']} incomplete (stop time reached before a stop condition held), "
+                  if s.get("incomplete") else "")
+    return (f"{s['runs']} runs: {s['ok']} ok, {incomplete}{s['failed']} failed, {s['timeout']} timed out "
+            f"(success rate {100 * s['success_rate']:.1f} %)")
+
+
 def table(s):
-    lines = [f"{s['runs']} runs: {s['ok']} ok, {s['failed']} failed, {s['timeout']} timed out "
-             f"(success rate {100 * s['success_rate']:.1f} %)"]
+    lines = [counts(s)]
     for name, m in s["metrics"].items():
         if "mean" in m:
             unit = f" ({m['unit']})" if m.get("unit") else ""
@@ -481,7 +503,7 @@ def table(s):
 def failed_campaign(s):
     """Why a finished campaign is a failure (exit 1), or None: no run succeeded, or fewer than
     campaign.min_success."""
-    if s["runs"] and s["ok"] == 0:
+    if s["runs"] and s["ok"] == 0 and not s.get("incomplete"):  # incomplete runs: min_success decides
         return "no run succeeded"
     if s.get("min_success") is not None and s["success_rate"] < s["min_success"]:
         return f"success rate {100 * s['success_rate']:.1f} % is below campaign.min_success {s['min_success']:g}"
@@ -499,13 +521,15 @@ def figures(spec, rows, folder, units=None):
     from matplotlib.ticker import MaxNLocator
 
     units = units or {}
-    ok = [r for r in rows if r["status"] == "ok"]
-    metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) for r in ok)]
+    ok = finished(rows)
+    # None: a metric an incomplete run lacks (drawn as missing)
+    metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) or r[m.name] is None
+                                                          for r in ok) and any(r[m.name] is not None for r in ok)]
     inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
     inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)
               and len({float(r[n]) for r in ok}) > 1]
     # a metric that is the same in every run (a budget always spent) has nothing to show
-    metrics = [m for m in metrics if len({float(r[m]) for r in ok if math.isfinite(float(r[m]))}) > 1]
+    metrics = [m for m in metrics if len({_number(r[m]) for r in ok if math.isfinite(_number(r[m]))}) > 1]
     if not metrics:
         return
     thresholds = {}
@@ -516,7 +540,7 @@ def figures(spec, rows, folder, units=None):
     for name in metrics:
         unit = units.get(name)
         if unit == "s":
-            span = max(abs(float(r[name])) for r in ok if math.isfinite(float(r[name])))
+            span = max(abs(_number(r[name])) for r in ok if math.isfinite(_number(r[name])))
             unit, factor = next((u, f) for u, f in TIME_UNITS if span >= 2 * f or u == "s")
             scale[name] = (factor, unit)
         else:
@@ -527,11 +551,11 @@ def figures(spec, rows, folder, units=None):
         return f"{name} ({unit})" if unit else name
 
     def value(r, name):
-        return float(r[name]) / scale.get(name, (1.0, None))[0]
+        return _number(r[name]) / scale.get(name, (1.0, None))[0]
 
     folder.mkdir(exist_ok=True)
     for name in metrics:
-        vals = [value(r, name) for r in ok if math.isfinite(float(r[name]))]
+        vals = [value(r, name) for r in ok if math.isfinite(_number(r[name]))]
         if not vals:
             continue
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -544,14 +568,14 @@ def figures(spec, rows, folder, units=None):
         ax.ticklabel_format(axis="x", useOffset=False)
         ax.set_xlabel(label(name))
         ax.set_ylabel("runs")
-        ax.set_title(f"{name}: {len(ok)} successful runs")
+        ax.set_title(f"{name}: {len(vals)} finished runs")
         ax.grid(alpha=0.3)
         _save(fig, folder / f"hist_{_safe(name)}.png")
     if not inputs:
         return
     panels = {}
     for m in metrics:
-        y = np.array([float(r[m]) for r in ok])
+        y = np.array([_number(r[m]) for r in ok])
         score = []
         for x_name in inputs:
             x = np.array([float(r[x_name]) for r in ok])
@@ -578,6 +602,11 @@ def figures(spec, rows, folder, units=None):
     _save(fig, folder / "scatter.png")
 
 
+def _number(value):
+    """A metric's value as a float, NaN where a run lacks it (None)."""
+    return math.nan if value is None else float(value)
+
+
 def _safe(name):
     return "".join(c if c.isalnum() or c in "._-" else "_" for c in name)
 
@@ -602,9 +631,11 @@ def rerun(spec, index, out):
     row = run_one(spec, index, str(folder))
     for key, value in row.items():
         print(f"  {key} = {value!r}")
-    if row["status"] != "ok":
+    if row["status"] not in FINISHED:
         print(f"run {index} {row['status']}: {row['error']}", file=sys.stderr)
         return 1
+    if row["status"] == "incomplete":
+        print(f"run {index} incomplete: the stop time was reached before any stop condition held", file=sys.stderr)
     print(f"series: {folder / f'run-{index:06d}.parquet'}")
     return 0
 

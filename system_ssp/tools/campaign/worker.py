@@ -69,12 +69,13 @@ HELPERS = {"solar_activity": _solar_activity}
 
 
 def metric_values(spec, result):
-    """{metric name: value} of a finished run."""
+    """{metric name: value} of a finished run; an incomplete run (its stop conditions never held)
+    has no stop_time metric (None): the time it ran to is the campaign's, not the system's."""
     out = {}
     data = result.data
     for m in spec.metrics:
         if m.kind == "stop_time":
-            out[m.name] = float(result.stop_time)
+            out[m.name] = None if result.incomplete else float(result.stop_time)
         elif m.kind == "stop_reason":
             out[m.name] = result.stop_reason
         elif m.kind == "steps":
@@ -101,7 +102,9 @@ def metric_values(spec, result):
 
 def run_one(spec, index, series_dir=None):
     """The result row of run `index`: run, seed, the swept and dispersed values (one column each),
-    every metric, status ("ok", "failed", "timeout"), error, wall_s."""
+    every metric, status, error, wall_s. Status: "ok"; "incomplete" (the run reached the stop time
+    while none of the system's stop conditions held: metrics kept, its stop_time metrics missing);
+    "failed"; "timeout"."""
     seed, values = spec.inputs(index)
     row = {"run": index, "seed": seed}
     row.update({name: (v.item() if isinstance(v, np.generic) else v) for name, v in values.items()})
@@ -120,7 +123,7 @@ def run_one(spec, index, series_dir=None):
                             parameters=params,
                             outputs=record, timeout=spec.timeout_s)
         row.update(metric_values(spec, result))
-        row.update(status="ok", error="")
+        row.update(status="incomplete" if result.incomplete else "ok", error="")
         if series_dir is not None:  # keep_timeseries, or a rerun
             write_result(result.data, Path(series_dir) / f"run-{index:06d}.parquet", result.units)
     except RunTimedOut as exc:
