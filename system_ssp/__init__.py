@@ -15,7 +15,7 @@ import importlib
 import logging
 from typing import TYPE_CHECKING, Any
 
-from .errors import RunInterrupted, SimulationError, SSPError
+from .errors import RealTimeOverrun, RunInterrupted, SimulationError, SSPError
 from .version import __version__
 
 if TYPE_CHECKING:
@@ -39,4 +39,4 @@ def __getattr__(name: str) -> Any:
 logging.getLogger("system_ssp").addHandler(logging.NullHandler())
 
 __all__ = ["simulate", "System", "RunOptions", "Result", "Observer", "RunView", "StepInfo", "SSPError",
-           "SimulationError", "RunInterrupted", "write_csv_atomic", "write_result", "__version__"]
+           "SimulationError", "RunInterrupted", "RealTimeOverrun", "write_csv_atomic", "write_result", "__version__"]

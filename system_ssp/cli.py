@@ -3,7 +3,8 @@
 `deorbit-study`, `mission`, `propulsion`, `validation`, `build` and `export`, and `--version`.
 
 Exit codes: 0 done; 1 an application's result is incomplete (mission or de-orbit study without
-re-entry, a thesis number out of tolerance); 2 bad input or a failed FMU (one line naming the
+re-entry, a thesis number out of tolerance), or a run paced with --real-time and
+--stop-on-overrun fell behind; 2 bad input or a failed FMU (one line naming the
 file and line, component or variable); 3 an unexpected error; 130 interrupted by Ctrl-C (SIGINT),
 143 by SIGTERM, 129 by SIGHUP. A run that fails or is interrupted writes what it had recorded to
 <output>.partial.csv (the mission and the de-orbit study: <out>.partial/) and says where.
@@ -24,7 +25,7 @@ from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, compose, convert, export_fmu, flatten, plot, release, replace
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
                             add_console_arguments, console_settings, parse_sets, system_path)
-from .errors import RunInterrupted, SimulationError, SSPError
+from .errors import RealTimeOverrun, RunInterrupted, SimulationError, SSPError
 from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.report import run_report
@@ -77,6 +78,11 @@ def _parser():
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
+    r.add_argument("--real-time", type=positive_float, metavar="FACTOR",
+                   help="pace the communication points to wall time: 1 real time, 100 a hundred times faster; "
+                   "prints the overruns (points a whole step behind) and the worst lateness")
+    r.add_argument("--stop-on-overrun", action="store_true",
+                   help="with --real-time: stop at the first overrun (exit 1, rows so far kept as with a failure)")
     r.add_argument("--profile", action="store_true",
                    help="with an nc:Schedule: print wall time per component and for the master itself")
     add_console_arguments(r)
@@ -161,6 +167,10 @@ def main(argv=None):
         print(one_line(exc), file=sys.stderr)
         _say_partial(exc)
         return 128 + exc.signal
+    except RealTimeOverrun as exc:  # the run is sound, it did not keep the pace asked for
+        print(f"stopped: {one_line(exc)}", file=sys.stderr)
+        _say_partial(exc)
+        return 1
     except SSPError as exc:
         print(f"error: {one_line(exc)}", file=sys.stderr)
         if isinstance(exc, SimulationError):
@@ -259,6 +269,8 @@ def _run_or_info(argv):
 
 
 def _run(args, path):
+    if args.command == "run" and args.stop_on_overrun and args.real_time is None:
+        raise SSPError("--stop-on-overrun paces nothing without --real-time FACTOR")
     with System(path, validate=not args.no_validate) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
@@ -269,7 +281,8 @@ def _run(args, path):
             parameters=parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
             algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
             stop_when=args.stop_when, output_file=args.output, progress=progress,
-            record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile)
+            record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile,
+            real_time=args.real_time, stop_on_overrun=args.stop_on_overrun)
     print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
     h = f"h = {result.step_size:g} s" if result.step_size is not None else "steps per nc:Schedule mode"
     print(f"steps:       {result.steps} ({h}, {result.algorithm}, order {' '.join(result.order)})")
@@ -285,6 +298,12 @@ def _run(args, path):
             print(f"  {name:<16} {sec:8.3f} s")
         print(f"  {'(master)':<16} {prof['master']:8.3f} s")
     print(f"wall time:   {result.wall_time:.3f} s")
+    if result.pacing:
+        p = result.pacing
+        worst = f", worst lateness {p['worst_lateness_s'] * 1e3:.3g} ms at t = {p['worst_at_s']:g} s" \
+            if p["late_points"] else ""
+        print(f"real time:   x{p['factor']:g}: {p['overruns']} overruns (points a whole step behind) of "
+              f"{p['points']}, {p['late_points']} late{worst}")
     if args.output:
         print(f"results:     {args.output}")
     items = sorted(result.final.items())

@@ -42,3 +42,8 @@ class RunInterrupted(_Stopped):
 class RunTimedOut(_Stopped):
     """The run passed its wall-clock limit (`System.run(timeout=...)`) and was stopped at a
     communication point."""
+
+
+class RealTimeOverrun(_Stopped):
+    """A run paced to wall time with `stop_on_overrun` fell a whole communication step behind
+    (`System.run(real_time=..., stop_on_overrun=True)`) and was stopped there."""

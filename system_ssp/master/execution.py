@@ -4,20 +4,22 @@ interrupted raises with the rows recorded so far (`err.result`)."""
 import signal
 from typing import List, Optional, Sequence
 
-from ..errors import RunInterrupted, RunTimedOut, SimulationError
+from ..errors import RealTimeOverrun, RunInterrupted, RunTimedOut, SimulationError
 from .algorithms import Algorithm, FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
 from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallClockLimit
 from .observers import Observer, ProgressBar, Profiler, Recorder, RunView, StepInfo, StopConditions
+from .pacing import RealTimePacer
 from .result import REACHED_STOP_TIME, Result
 
 DISCARD = 2  # fmi2Discard: a co-simulation FMU that could not complete the step (or ended the simulation)
 
 
-def execute(system, plan, progress=False, timeout=None, observers=()):
+def execute(system, plan, progress=False, timeout=None, observers=(), real_time=None, stop_on_overrun=False):
     """Run `plan` on `system` with fresh FMU instances; returns a Result (wall_time 0: the
     caller measures it). `timeout`: seconds of wall time from the first step, or None;
-    `observers`: the caller's, after the master's own."""
+    `observers`: the caller's, after the master's own; `real_time`: pace the communication
+    points to wall time at this factor (see pacing), `stop_on_overrun`: stop at the first overrun."""
     table = InstanceTable(system, plan)
     run = _Run(system, plan, table)
     with SignalWatch() as watch:
@@ -25,7 +27,7 @@ def execute(system, plan, progress=False, timeout=None, observers=()):
             table.instantiate()
             table.prepare()
             table.initialize()
-            return run.loop(progress, watch, timeout, observers)
+            return run.loop(progress, watch, timeout, observers, real_time, stop_on_overrun)
         except StepFailed as f:
             ended = table.terminated_at(f.ci) if (f.call, f.status) == ("fmi2DoStep", DISCARD) else None
             if ended is not None:
@@ -35,6 +37,10 @@ def execute(system, plan, progress=False, timeout=None, observers=()):
             raise err from None
         except SimulationError as err:
             err.result = run.partial(f"failed at t={table.t:g} s")
+            raise
+        except RealTimeOverrun as err:
+            run.record_last()
+            err.result = run.partial(f"real-time overrun at t={run.info.t:g} s")
             raise
         except TimedOut:
             run.record_last()
@@ -60,7 +66,8 @@ class _Run:
         self.recorder = self.info = self.algorithm = None
 
     def loop(self, progress: bool, watch: SignalWatch, timeout: Optional[float] = None,
-             callers: Sequence[Observer] = ()) -> Result:
+             callers: Sequence[Observer] = (), real_time: Optional[float] = None,
+             stop_on_overrun: bool = False) -> Result:
         system, plan, table = self.system, self.plan, self.table
         algorithm: Algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
@@ -83,10 +90,14 @@ class _Run:
         # the profiler and a caller's step() watch every step: the Python loop. Before the
         # wall-clock limit starts: the compiled loop loads its code here (about a second in a
         # new process), which is not the run's time
-        if profiler is None and all(type(obs).step is Observer.step for obs in callers):
+        pacer = RealTimePacer(real_time, stop_on_overrun, watch) if real_time is not None else None
+        # pacing sleeps between the points: the Python loop (the compiled one runs many steps a call)
+        if profiler is None and pacer is None and all(type(obs).step is Observer.step for obs in callers):
             algorithm.compile(stops.ops if stops is not None else [], recorder)
         if timeout is not None:
             observers.append(WallClockLimit(timeout))
+        if pacer is not None:  # after the recorder: a row is taken when the point is reached, not after the wait
+            observers.append(pacer)
         observers.append(Interruption(watch))  # last: the row of this step is recorded first
         info = StepInfo(plan.start, plan.record_every)
         self.recorder, self.info, self.algorithm = recorder, info, algorithm
@@ -103,7 +114,8 @@ class _Run:
         algorithm.finish(info)
         reason = f"stop condition {info.fired} at t={info.t:g} s" if info.fired is not None else REACHED_STOP_TIME
         return self.result(recorder.data(), info.t, reason, final=table.final(), modes=algorithm.statistics(),
-                           profile=profiler.report() if profiler else None)
+                           profile=profiler.report() if profiler else None,
+                           pacing=pacer.report() if pacer else None)
 
     def ended_by(self, ci, t_end):
         """The run as a component ended it (fmi2Discard, then fmi2Terminated): a last row at the

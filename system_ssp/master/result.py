@@ -32,6 +32,9 @@ class Result:
     partial:     True for the rows of a run that failed or was interrupted (err.result).
     step_size_source: where step_size came from ("as requested", "nc:Master stepSize, file:line",
                  OSP's baseStepSize, the FMUs' DefaultExperiment); None for a scheduled run.
+    pacing:      a run paced to wall time (`real_time=`): {"factor", "points", "late_points",
+                 "overruns", "worst_lateness_s", "worst_at_s", "slept_s", "wall_s" (from the first step to the
+                 last point)}, else None.
     stop_conditions: the stop conditions the run watched ('component.variable' names).
     incomplete:  True when the run watched stop conditions and reached its stop time without one
                  holding (a detumble that never settled, an orbit that never re-entered).
@@ -42,7 +45,7 @@ class Result:
                  messages: Dict[str, List[str]], modes: Optional[Dict[str, Dict[str, float]]] = None,
                  profile: Optional[Dict[str, Any]] = None, units: Optional[Units] = None,
                  partial: bool = False, step_size_source: Optional[str] = None,
-                 stop_conditions: Sequence[str] = ()) -> None:
+                 stop_conditions: Sequence[str] = (), pacing: Optional[Dict[str, Any]] = None) -> None:
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -60,6 +63,7 @@ class Result:
         self.partial = partial
         self.step_size_source = step_size_source
         self.stop_conditions = tuple(stop_conditions)
+        self.pacing = pacing
 
     @property
     def incomplete(self) -> bool:

@@ -9,7 +9,7 @@ import time
 from typing import Any, Dict, List, Mapping, Optional, Sequence, Tuple, Union
 
 from .. import archive, builder
-from ..errors import RunInterrupted, RunTimedOut, SimulationError, SSPError
+from ..errors import RealTimeOverrun, RunInterrupted, RunTimedOut, SimulationError, SSPError
 from ..ssp import reader
 from .components import load_components
 from .connections import (FeedthroughGraph, UnitTable, check_connector_units, parameter_connections,
@@ -114,7 +114,7 @@ class System:
     # ---- running ------------------------------------------------------------------------
     def run(self, options: Optional[RunOptions] = None, *, observers: Sequence[Observer] = (),
             output_file: Optional[PathLike] = None, progress: bool = False, timeout: Optional[float] = None,
-            **settings: Any) -> Result:
+            real_time: Optional[float] = None, stop_on_overrun: bool = False, **settings: Any) -> Result:
         """Run one simulation with fresh FMU instances and return its `Result`.
 
         `options` (`RunOptions`) says what to run; keyword `settings` are a shorthand for its
@@ -124,7 +124,13 @@ class System:
         after the master's own (see `Observer`); `output_file` (.csv or .parquet) is checked
         before the first step and written at the end, or with the rows so far when the run
         stops early; `progress` shows a progress bar on stderr; `timeout` (s of wall time) stops
-        the run with RunTimedOut (rows so far in err.result)."""
+        the run with RunTimedOut (rows so far in err.result); `real_time` paces the communication
+        points to wall time at that factor (1: real time; the overruns in `Result.pacing`) and
+        `stop_on_overrun` ends the run with RealTimeOverrun at the first (see master.pacing)."""
+        if real_time is not None and not (isinstance(real_time, (int, float)) and not isinstance(real_time, bool)
+                                          and 0 < real_time < float("inf")):
+            raise SSPError(f"real_time = {real_time!r}: expected a factor > 0 (1: real time, 100: a hundred "
+                           "times faster)")
         wall0 = time.perf_counter()
         plan = make_plan(self, run_options(options, settings))
         if output_file is not None:
@@ -133,8 +139,8 @@ class System:
                  plan.start, plan.stop, f", {plan.n_steps} steps of {plan.step_size:g} s" if plan.schedule is None
                  else ", nc:Schedule")
         try:
-            result: Result = execute(self, plan, progress, timeout, observers)
-        except (SimulationError, RunInterrupted, RunTimedOut) as err:
+            result: Result = execute(self, plan, progress, timeout, observers, real_time, stop_on_overrun)
+        except (SimulationError, RunInterrupted, RunTimedOut, RealTimeOverrun) as err:
             if err.result is not None:
                 err.result.wall_time = time.perf_counter() - wall0
                 if output_file is not None:
@@ -178,16 +184,18 @@ def run_options(options: Optional[RunOptions], settings: Mapping[str, Any]) -> R
     unknown = sorted(set(settings) - set(RunOptions.field_names()))
     if unknown:
         raise TypeError(f"unknown run setting(s) {', '.join(unknown)} (RunOptions fields: "
-                        f"{', '.join(RunOptions.field_names())}; also observers, output_file, progress, timeout)")
+                        f"{', '.join(RunOptions.field_names())}; also observers, output_file, progress, timeout, "
+                        "real_time, stop_on_overrun)")
     base = options if options is not None else RunOptions()
     return dataclasses.replace(base, **settings) if settings else base
 
 
 def simulate(path: PathLike, options: Optional[RunOptions] = None, *, validate: bool = True,
              observers: Sequence[Observer] = (), output_file: Optional[PathLike] = None, progress: bool = False,
-             timeout: Optional[float] = None, **settings: Any) -> Result:
+             timeout: Optional[float] = None, real_time: Optional[float] = None, stop_on_overrun: bool = False,
+             **settings: Any) -> Result:
     """Load and run an SSP system; returns a `Result`. `validate` checks the files against the
     SSP schemas; the rest as `System.run` (keyword settings: the fields of `RunOptions`)."""
     with System(path, validate=validate) as system:
         return system.run(options, observers=observers, output_file=output_file, progress=progress, timeout=timeout,
-                          **settings)
+                          real_time=real_time, stop_on_overrun=stop_on_overrun, **settings)
