@@ -23,6 +23,7 @@ import fmpy
 from . import __version__, archive
 from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, compose, convert, export_fmu, flatten, plot, release, replace
+from .tools import requirements as req
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
                             add_console_arguments, console_settings, parse_sets, system_path)
 from .errors import RealTimeOverrun, RunInterrupted, SimulationError, SSPError
@@ -83,6 +84,10 @@ def _parser():
                    "prints the overruns (points a whole step behind) and the worst lateness")
     r.add_argument("--stop-on-overrun", action="store_true",
                    help="with --real-time: stop at the first overrun (exit 1, rows so far kept as with a failure)")
+    r.add_argument("--requirements", metavar="FILE", help="a requirements file (TOML): each check judged "
+                   "PASS/FAIL/INCONCLUSIVE/ERROR on the run and printed; exit 1 unless all pass "
+                   "(docs/requirements.md)")
+    r.add_argument("--junit", metavar="FILE.xml", help="with --requirements: also write the verdicts as JUnit XML")
     r.add_argument("--profile", action="store_true",
                    help="with an nc:Schedule: print wall time per component and for the master itself")
     add_console_arguments(r)
@@ -271,11 +276,20 @@ def _run_or_info(argv):
 def _run(args, path):
     if args.command == "run" and args.stop_on_overrun and args.real_time is None:
         raise SSPError("--stop-on-overrun paces nothing without --real-time FACTOR")
+    requirements = None
+    if args.command == "run" and args.junit and not args.requirements:
+        raise SSPError("--junit writes the verdicts of --requirements FILE: pass it too")
+    if args.command == "run" and args.requirements:
+        requirements = req.load(args.requirements)
+        if args.junit:
+            check_output_place(args.junit, "--junit")
     with System(path, validate=not args.no_validate) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
             return 0
         progress = console_settings(args)
+        if requirements is not None:
+            args.outputs = _requirement_outputs(system, requirements, args.outputs)
         result = system.run(
             stop_time=args.stop_time, step_size=args.step_size, start_time=args.start_time,
             parameters=parse_sets(args.set), parameter_sets=args.ssv or None, outputs=args.outputs,
@@ -315,8 +329,37 @@ def _run(args, path):
         print(f"  {k} = {v!r}" + (f" {unit}" if unit and unit != "1" else ""))
     if args.plot:
         print(f"plot:        {result.plot(out=args.plot, title=args.path)}")
+    verdicts = None
+    if requirements is not None:
+        verdicts = req.summary(requirements, req.judge_result(requirements, result), False)
+        print(req.table(verdicts))
+        if args.junit:
+            write_text_atomic(args.junit, req.junit(verdicts, f"run {Path(args.path).name}"))
+            print(f"junit:       {args.junit}")
     if args.report:
         settings = {k: v for k, v in vars(args).items() if v not in (None, [], False) and k != "command"}
-        write_text_atomic(args.report, run_report(result, f"{Path(args.path).name}: {result.stop_reason}", settings))
+        write_text_atomic(args.report, run_report(result, f"{Path(args.path).name}: {result.stop_reason}", settings,
+                                                  first=[("Requirements", req.html(verdicts))] if verdicts else ()))
         print(f"report:      {args.report}")
+    if verdicts is not None and not verdicts["all_passed"]:
+        c = verdicts["counts"]
+        print("requirements not met: " + ", ".join(f"{c[v]} {v}" for v in req.VERDICTS[1:] if c[v]), file=sys.stderr)
+        return 1
     return 0
+
+
+def _requirement_outputs(system, requirements, outputs):
+    """--outputs with the signals the requirements read through max/min/...; a name the system
+    has not, or a check reading one of the run's names it lacks, refused before the run."""
+    def known(fn, name):
+        try:
+            system.split_name(name, "signal")
+        except SSPError as exc:
+            return str(exc)
+        return None
+
+    req.check_names(requirements, False, req.RUN_NAMES, known)
+    if outputs is None:
+        return None
+    listed = [o.strip() for o in outputs.split(",") if o.strip()]
+    return ",".join(listed + [n for n in req.signals_read(requirements) if n not in listed])

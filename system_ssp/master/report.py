@@ -134,9 +134,11 @@ def versions() -> Dict[str, str]:
             "fmpy": fmpy.__version__, "platform": platform.platform()}
 
 
-def run_report(result: Any, title: str, settings: Mapping[str, Any], signals: Sequence[str] = ()) -> str:
+def run_report(result: Any, title: str, settings: Mapping[str, Any], signals: Sequence[str] = (),
+               first: Sequence[Tuple[str, str]] = ()) -> str:
     """The report of one run: outcome, settings, versions and a figure of its recorded signals
-    (`signals`: names or globs; none: as many units' worth as fit)."""
+    (`signals`: names or globs; none: as many units' worth as fit); `first`: (title, HTML)
+    sections before them (the requirements' verdicts)."""
     names = list(result.data.dtype.names or ())
     chosen = select(names, list(signals)) if signals else default_signals(drawable(result.data, names),
                                                                           result.units)[0]
@@ -146,7 +148,7 @@ def run_report(result: Any, title: str, settings: Mapping[str, Any], signals: Se
     if result.modes:
         outcome += [(f"mode {m}", f"{v['steps']} steps, {v['simulated_time']:g} s simulated")
                     for m, v in result.modes.items()]
-    sections = [("Outcome", table(("quantity", "value"), outcome))]
+    sections = [*first, ("Outcome", table(("quantity", "value"), outcome))]
     if chosen:
         sections.append(("Signals", figure({n: result.data[n] for n in names}, result.units, chosen)))
     sections.append(("Settings", table(("setting", "value"), [(k, v) for k, v in settings.items()])))

@@ -33,9 +33,11 @@ import numpy as np
 
 from components.core.constants import DAY, MU_EARTH, R_EQ, YEAR
 from components.attitude.thruster_set import thesis_layout
+from components.mission.power import CELL_CAPACITY
 from components.mission.modes import DeorbitPhase, MissionMode
-from components.mission.neighbor import (DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS, MISSION_RECORD, MISSION_SYSTEMS,
-                                         SCENARIOS as DEFINED_SCENARIOS, SPACECRAFT, scenario_set)
+from components.mission.neighbor import (DATA_STORAGE_LIMIT_B, DEFAULT_GNC, DEFAULT_SCENARIO, GNC_SETS,
+                                         MISSION_RECORD, MISSION_SYSTEMS, SCENARIOS as DEFINED_SCENARIOS, SPACECRAFT,
+                                         scenario_set)
 
 from ..atomic import atomic_write, check_output_place, write_text_atomic
 from ..builder import resolve_system
@@ -45,6 +47,7 @@ from ..master import System, report, write_result
 from ..systems import PARAMETERS_DIR
 from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
                              positive_float, staged_results)
+from ..tools import requirements as req
 from . import budgets, deorbit_study, propulsion_report, thesis
 
 # the RCS thrusters' names, bit by bit of the thruster set's disabled_mask
@@ -76,12 +79,56 @@ RECORD = list(MISSION_RECORD)  # components.mission.neighbor
 
 
 TIMESERIES_FORMATS = ("parquet", "csv")
+JUNIT = "requirements.junit.xml"  # --requirements: the verdicts for CI systems
+# The names a requirement's check may read of a mission (summarize's figures; a figure a run did
+# not reach is missing there, and the requirement INCONCLUSIVE), with requirement_values' own
+SUMMARY_FIGURES = (
+    "steps", "wall_time_s", "simulated_years", "reentered", "safe_state", "bias_resets", "fixed_without_sun",
+    "thruster_fault_after_deorbit_start_s", "deorbit_start_days", "altitude_at_deorbit_km",
+    "attitude_determination_s", "detumble_time_s", "slew_time_s", "burn_time_min", "detumble_propellant_g",
+    "slew_propellant_g", "tracking_propellant_g", "axial_off_percent", "burn_pointing_error_deg",
+    "burn_thrust_axis_error_deg", "burn_thrust_axis_error_rms_deg", "burn_knowledge_error_deg",
+    "burn_knowledge_error_rms_deg", "burn_rate_error_rms_deg_s", "nees_mean", "nees_over_fraction_percent",
+    "disturbance_torque_max_Nm", "burn_propellant_kg", "total_propellant_kg", "soc_after_burn_percent",
+    "energy_used_Wh", "energy_left_Wh", "battery_empty_days_after_burn", "max_storage_MB", "bytes_lost",
+    "contacts_to_downlink", "lifetime_with_burn_years")
+SCENARIO_LIMITS = ("tank_kg", "rcs_allowance_kg", "battery_capacity_Wh", "data_storage_limit_MB")
+REQUIREMENT_NAMES = SUMMARY_FIGURES + ("rcs_propellant_kg", "stop_time") + SCENARIO_LIMITS
+
+
+def requirement_values(s):
+    """{name: value} a requirement's check reads of a mission summary: its figures (None where
+    the run did not reach them), the RCS propellant, the stop time, and the
+    scenario's limits (its tank and RCS allowance, section 3.3.9's rule; the cell, 3.5; the
+    storage, 3.6), which replace a requirements file's [values] of the same names."""
+    a = budgets.allowance(s["scenario"])
+    out = {name: s.get(name) for name in SUMMARY_FIGURES}
+    total, burn = s.get("total_propellant_kg"), s.get("burn_propellant_kg")
+    out["rcs_propellant_kg"] = None if total is None or burn is None else total - burn
+    out["stop_time"] = s["simulated_years"] * YEAR
+    out.update(tank_kg=a.tank_kg, rcs_allowance_kg=a.rcs_g / 1e3, battery_capacity_Wh=CELL_CAPACITY / WH,
+               data_storage_limit_MB=DATA_STORAGE_LIMIT_B / 1e6)
+    return out
+
+
+def _recorded_signal(fn, name):
+    """Why a requirement cannot read signal `name` of a mission (None: it can)."""
+    if name not in RECORD:
+        return f"not one of the mission's {len(RECORD)} recorded signals (components.mission.neighbor.MISSION_RECORD)"
+    return None
+
+
+def _signal_value(r, fn, name):
+    return req.signal_statistic(fn, np.asarray(r.data[name], dtype=float).tolist())
 
 
 def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
                 parameters=None, profile=False, progress=False, parameter_sets=(), gnc=DEFAULT_GNC,
-                timeseries="parquet"):
+                timeseries="parquet", requirements=None):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
+    `requirements` (a requirements file or its loaded Requirements, checked before the run):
+    each judged on the run, in the summary ("requirements"), report.html and
+    requirements.junit.xml.
     `gnc` (GNC) picks the guidance and control parameter set, applied after the scenario's;
     `parameter_sets` (files, names component.variable) apply after it and `parameters`
     ({component.variable: value}) after them. `timeseries`: the recorded signals' format, "parquet"
@@ -101,6 +148,10 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         raise SSPError(f"unknown guidance and control set {gnc!r} (expected one of: {', '.join(GNC)})")
     ssv = [PARAMETERS_DIR / f"{scenario_set(SYSTEMS['cowell'], scenario)}.ssv"] + (
         [PARAMETERS_DIR / f"{GNC[gnc]}.ssv"] if GNC[gnc] else [])
+    if requirements is not None and not isinstance(requirements, req.Requirements):
+        requirements = req.load(requirements)
+    if requirements is not None:  # before the run: a name the mission has not is the file's mistake
+        req.check_names(requirements, False, REQUIREMENT_NAMES, _recorded_signal)
     with staged_results(out, lambda err: series) as staged:
         with System(ssp) as system:
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
@@ -108,7 +159,12 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
                            outputs=RECORD, profile=profile, progress=progress)
         s = summarize(r, scenario, orbit, gnc)
         s["gnc"] = gnc
+        if requirements is not None:
+            s["requirements"] = req.summary(requirements, req.judge_run(
+                requirements, requirement_values(s), lambda fn, name: _signal_value(r, fn, name)), False)
         if staged is not None:
+            if requirements is not None:
+                write_text_atomic(staged.path / JUNIT, req.junit(s["requirements"], f"mission {scenario} {gnc}"))
             write_result(r.data, staged.path / series, r.units)
             settings = {"scenario": scenario, "orbit": orbit, "gnc": gnc, "system": ssp.name,
                         "parameter sets": ", ".join(map(str, [*ssv, *parameter_sets])),
@@ -132,7 +188,8 @@ def report_html(r, s, settings):
     phases = {int(p): p.name.lower().replace("_", " ") for p in DeorbitPhase}
     whole = ["orbit.altitude", "orbit.perigee_altitude", "power.state_of_charge", "data.storage_used",
              "propulsion.propellant_used"]
-    sections = [("Summary", report.markdown(table(s), far_beyond=10.0)),
+    sections = [("Requirements", req.html(s["requirements"]))] if s.get("requirements") else []
+    sections += [("Summary", report.markdown(table(s), far_beyond=10.0)),
                 ("The mission", report.figure(
                     columns, r.units, [n for n in whole if n in columns],
                     bands=report.bands(t, data["mission.mode"], modes, (t[-1] - t[0]) / 300)))]
@@ -196,6 +253,7 @@ def summarize(r, scenario, orbit, gnc=DEFAULT_GNC):
     timeouts = {"detumble": int(d["mission.detumble_timeouts"][-1]), "slew": int(d["mission.slew_timeouts"][-1])}
     s["phase_timeouts"] = timeouts
     safe = int(d["mission.safe_reason"][-1])
+    s["safe_state"] = bool(safe)  # the de-orbit abandoned without a valid attitude
     then = "the safe state (no valid attitude)" if safe else "the mission went on with the next phase"
     faults = [f"the {name} timed out {n} time(s): retried, then {then}" for name, n in timeouts.items() if n]
     if int(d["mission.determination_timeouts"][-1]):
@@ -588,12 +646,16 @@ def main(argv=None):
                     help="extra parameter set after the scenario's, names component.variable (repeatable)")
     ap.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
                     help="override a parameter or start value, after every parameter set (repeatable)")
+    ap.add_argument("--requirements", metavar="FILE", help="a requirements file (TOML; NEIGHBOR's: "
+                    "system_ssp/neighbor/requirements.toml): each judged PASS/FAIL/INCONCLUSIVE/ERROR on the run, "
+                    f"printed, in summary.json, report.html and {JUNIT}; exit 1 unless all pass")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)
+    requirements = req.load(args.requirements) if args.requirements else None
     s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years,
                        parameters=parse_sets(args.set), profile=args.profile, progress=progress,
-                       parameter_sets=args.ssv, gnc=args.gnc, timeseries=args.timeseries)
+                       parameter_sets=args.ssv, gnc=args.gnc, timeseries=args.timeseries, requirements=requirements)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:
@@ -601,9 +663,15 @@ def main(argv=None):
         for name, sec in sorted(prof["components"].items(), key=lambda kv: -kv[1]):
             print(f"  {name:<12} {sec:8.2f} s")
         print(f"  {'(master)':<12} {prof['master']:8.2f} s")
+    if requirements is not None:
+        print(req.table(s["requirements"]))
     print(f"results in {args.out}")
     if "error" in s:
         print(f"mission incomplete: {s['error']} within --max-years {args.max_years:g}", file=sys.stderr)
+        return 1
+    if requirements is not None and not s["requirements"]["all_passed"]:
+        c = s["requirements"]["counts"]
+        print("requirements not met: " + ", ".join(f"{c[v]} {v}" for v in req.VERDICTS[1:] if c[v]), file=sys.stderr)
         return 1
     return 0
 

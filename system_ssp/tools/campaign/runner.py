@@ -40,6 +40,7 @@ import numpy as np
 from ... import __version__
 from ...atomic import atomic_write, check_output_folder, write_text_atomic
 from ...errors import SSPError
+from .. import requirements as req
 from ...master import System, report
 from ...master.plan import RunOptions
 from ...master.names import near, split_name
@@ -53,6 +54,7 @@ from .worker import run_batch, run_one
 FLUSH_SECONDS = 2.0
 SCATTER_INPUTS = 6  # inputs drawn against each metric in scatter.png
 SERIES = "series"  # keep_timeseries: <out>/series/run-<i>.parquet
+JUNIT = "requirements.junit.xml"  # --requirements: the verdicts for CI systems
 
 
 def _read_rows(out):
@@ -245,10 +247,12 @@ def check_against_system(spec):
     return units
 
 
-def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=1):
+def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=1, requirements=None):
     """Run (or resume) campaign `spec` (a CampaignSpec or a spec path) into folder `out`, `batch`
     runs per Dask task (more for short runs: each task costs a round trip of about 10 ms);
-    returns the summary dict."""
+    returns the summary dict. `requirements` (a requirements file or its loaded Requirements):
+    the probabilities judged over the runs, in the summary ("requirements"), the report and
+    requirements.junit.xml."""
     if isinstance(batch, bool) or not isinstance(batch, int) or batch < 1:
         raise SSPError(f"--batch {batch!r}: expected an integer >= 1")
     from dask.distributed import as_completed
@@ -256,6 +260,10 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     if not hasattr(spec, "inputs"):
         spec = load_spec(spec)
     units = check_against_system(spec)  # before the folder is touched and before any run
+    if requirements is not None and not isinstance(requirements, req.Requirements):
+        requirements = req.load(requirements)
+    if requirements is not None:
+        req.check_names(requirements, True, [m.name for m in spec.metrics])
     out = check_output_folder(out, "--out")
     done = {r["run"] for r in _read_rows(out)} if (out / "runs").is_dir() else set()
     todo = [i for i in range(spec.total_runs) if i not in done]
@@ -289,6 +297,9 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
     _write_rows(out / "runs.parquet", rows, columns)
     summary = summarize(spec, rows, units)
     summary["resumed_from"] = len(done)
+    if requirements is not None:
+        summary["requirements"] = req.summary(requirements, req.judge_campaign(requirements, rows, FINISHED), True)
+        write_text_atomic(out / JUNIT, req.junit(summary["requirements"], f"campaign {spec.path.name}"))
     write_text_atomic(out / "summary.json", json.dumps(summary, indent=1, default=_json) + "\n")
     figures(spec, rows, out / "figures", units)
     write_text_atomic(out / "report.html", campaign_report(spec, rows, summary, out / SERIES))
@@ -309,6 +320,8 @@ def campaign_report(spec, rows, s, series_dir=None):
             (name, p["condition"], f"{p['p']:.3f}", f"[{p['ci95'][0]:.3f}, {p['ci95'][1]:.3f}]", f"{p['k']}/{p['n']}")
             for name, p in s["probabilities"].items()]))
     sections = [("Summary", "\n".join(summary))]
+    if s.get("requirements"):
+        sections.insert(0, ("Requirements", req.html(s["requirements"])))
     numeric = {m.name: [float(r[m.name]) for r in ok if isinstance(r[m.name], (int, float))
                         and math.isfinite(float(r[m.name]))] for m in spec.metrics}  # None: an incomplete run's
     numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
@@ -646,6 +659,9 @@ def main(argv=None):
     ap.add_argument("spec", help="the campaign spec (TOML)")
     ap.add_argument("--out", required=True, help="results folder (the same spec into the same folder resumes)")
     ap.add_argument("--workers", type=positive_int, help="local worker processes (default: the machine's cores)")
+    ap.add_argument("--requirements", metavar="FILE", help="a requirements file (TOML): each probability judged "
+                    "PASS/FAIL/INCONCLUSIVE/ERROR over the runs, printed, in summary.json, report.html and "
+                    f"{JUNIT}; exit 1 unless all pass (docs/requirements.md)")
     ap.add_argument("--scheduler", help="address of a running Dask scheduler (tcp://host:8786) instead")
     ap.add_argument("--batch", type=positive_int, default=1,
                     help="runs per Dask task (default 1; more for runs shorter than a second)")
@@ -660,11 +676,19 @@ def main(argv=None):
     spec = load_spec(args.spec)
     if args.rerun is not None:
         return rerun(spec, args.rerun, Path(args.out))
-    s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch)
+    requirements = req.load(args.requirements) if args.requirements else None
+    s = run_campaign(spec, args.out, args.workers, args.scheduler, progress, args.batch, requirements)
     print(table(s))
-    print(f"results in {args.out} (runs.parquet, summary.json, report.html, figures/)")
+    if requirements is not None:
+        print(req.table(s["requirements"]))
+    print(f"results in {args.out} (runs.parquet, summary.json, report.html, figures/"
+          f"{', ' + JUNIT if requirements is not None else ''})")
     failure = failed_campaign(s)
     if failure:
         print(f"campaign failed: {failure}", file=sys.stderr)
+        return 1
+    if requirements is not None and not s["requirements"]["all_passed"]:
+        c = s["requirements"]["counts"]
+        print("requirements not met: " + ", ".join(f"{c[v]} {v}" for v in req.VERDICTS[1:] if c[v]), file=sys.stderr)
         return 1
     return 0
