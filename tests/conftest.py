@@ -88,7 +88,7 @@ def mission_420km(ssp_paths, tmp_path_factory):
 
     out = tmp_path_factory.mktemp("mission")
     summary, result = mission.run_mission("420km", "averaged", ssp_dir=ssp_paths["neighbor_mission"].parent, out=out,
-                                          gnc="thesis")
+                                          gnc="thesis", requirements=mission.REQUIREMENTS)
     return summary, result, out
 
 

@@ -80,6 +80,7 @@ RECORD = list(MISSION_RECORD)  # components.mission.neighbor
 
 TIMESERIES_FORMATS = ("parquet", "csv")
 JUNIT = "requirements.junit.xml"  # --requirements: the verdicts for CI systems
+REQUIREMENTS = Path(__file__).with_name("requirements.toml")  # NEIGHBOR's, from the thesis
 # The names a requirement's check may read of a mission (summarize's figures; a figure a run did
 # not reach is missing there, and the requirement INCONCLUSIVE), with requirement_values' own
 SUMMARY_FIGURES = (
@@ -646,9 +647,10 @@ def main(argv=None):
                     help="extra parameter set after the scenario's, names component.variable (repeatable)")
     ap.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
                     help="override a parameter or start value, after every parameter set (repeatable)")
-    ap.add_argument("--requirements", metavar="FILE", help="a requirements file (TOML; NEIGHBOR's: "
-                    "system_ssp/neighbor/requirements.toml): each judged PASS/FAIL/INCONCLUSIVE/ERROR on the run, "
-                    f"printed, in summary.json, report.html and {JUNIT}; exit 1 unless all pass")
+    ap.add_argument("--requirements", metavar="FILE", nargs="?", const=str(REQUIREMENTS),
+                    help="a requirements file (TOML; without FILE NEIGHBOR's, system_ssp/neighbor/requirements.toml): "
+                    "each check judged PASS/FAIL/INCONCLUSIVE/ERROR on the run, printed, in summary.json, "
+                    f"report.html and {JUNIT}; exit 1 unless all pass")
     add_console_arguments(ap)
     args = ap.parse_args(argv)
     progress = console_settings(args)

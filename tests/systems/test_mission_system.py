@@ -110,6 +110,47 @@ def test_report_opens_in_a_browser(run, tmp_path):
     assert "burn time (min)" in dom and "monitoring" in dom and "detumble" in dom
 
 
+def test_requirements_judged_on_the_run(run, tmp_path):
+    """The shipped NEIGHBOR requirements on the thesis run: verdicts with evidence in the summary,
+    the report (drawn by Chromium) and JUnit XML. The thesis set thrusts along -v whatever the
+    attitude, so the thrust axis' error is not measured: that one is INCONCLUSIVE, saying why."""
+    import xml.etree.ElementTree as ET
+
+    s, _, out = run
+    verdicts = {v["id"]: v for v in s["requirements"]["verdicts"]}
+    assert {k: v["verdict"] for k, v in verdicts.items()} == {
+        "NBR-DEO-1": "PASS", "NBR-DEO-2": "PASS", "NBR-PRO-1": "PASS", "NBR-PRO-2": "PASS", "NBR-PWR-1": "PASS",
+        "NBR-DAT-1": "PASS", "NBR-ACS-1": "INCONCLUSIVE"}
+    deo = verdicts["NBR-DEO-1"]
+    assert deo["evidence"].startswith(f"lifetime_with_burn_years = {s['lifetime_with_burn_years']:.6g} < 5")
+    assert deo["margin"] == pytest.approx(5.0 - s["lifetime_with_burn_years"])
+    assert verdicts["NBR-PRO-1"]["comparisons"][0]["right_value"] == pytest.approx(0.5871, abs=1e-4)  # the tank
+    assert verdicts["NBR-ACS-1"]["evidence"] == "no value of burn_thrust_axis_error_deg in this run"
+    assert json.loads((out / "summary.json").read_text())["requirements"]["counts"] == {
+        "PASS": 6, "FAIL": 0, "INCONCLUSIVE": 1, "ERROR": 0}
+    suite = ET.parse(out / "requirements.junit.xml").getroot().find("testsuite")
+    assert (suite.get("tests"), suite.get("failures"), suite.get("skipped")) == ("7", "0", "1")
+    dom, console = open_page(out / "report.html")
+    assert console == [] and "NBR-DEO-1" in dom and "INCONCLUSIVE" in dom and "thesis section 3.3.9" in dom
+
+
+def test_mission_requirements_refused_before_the_run_or_judged_on_a_short_one(ssp_paths, tmp_path, capsys):
+    bad = tmp_path / "bad.toml"
+    bad.write_text(mission.REQUIREMENTS.read_text().replace("total_propellant_kg <=", "total_propellant <="))
+    base = ["mission", "--ssp-dir", str(ssp_paths["neighbor_mission"].parent), "--out", str(tmp_path / "m"), "--quiet"]
+    assert cli.main(base + ["--requirements", str(bad)]) == 2
+    err = capsys.readouterr().err
+    assert "bad.toml:" in err and "requirement 'NBR-PRO-1': check: unknown name 'total_propellant'" in err
+    assert not (tmp_path / "m").exists()
+    # an hour of the mission: nothing of the de-orbit yet, so no verdict but INCONCLUSIVE ones
+    assert cli.main(base + ["--max-years", "0.0001", "--requirements"]) == 1  # the shipped file
+    out = capsys.readouterr().out
+    assert "requirements (" in out and "NBR-DEO-1  INCONCLUSIVE" not in out  # not re-entered: FAIL, not unknown
+    verdicts = {v["id"]: v["verdict"] for v in json.loads((tmp_path / "m" / "summary.json").read_text())[
+        "requirements"]["verdicts"]}
+    assert verdicts["NBR-DEO-1"] == "FAIL" and verdicts["NBR-PRO-1"] == "INCONCLUSIVE"
+
+
 @pytest.mark.parametrize("params, pattern", [
     ({"mission.grace_period": -1.0}, "grace_period"),
     ({"power.capacity": -1.0}, "capacity"),
