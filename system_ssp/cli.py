@@ -79,6 +79,9 @@ def _parser():
     r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
+    r.add_argument("--events", metavar="FILE", help="a scenario file (TOML [[event]] tables): at a time or when a "
+                   "condition holds, set an input, fault an output (stuck, bias, scale, noise, dropout) or release "
+                   "it (docs/master.md, Scenario events)")
     r.add_argument("--real-time", type=positive_float, metavar="FACTOR",
                    help="pace the communication points to wall time: 1 real time, 100 a hundred times faster; "
                    "prints the overruns (points a whole step behind) and the worst lateness")
@@ -276,13 +279,7 @@ def _run_or_info(argv):
 def _run(args, path):
     if args.command == "run" and args.stop_on_overrun and args.real_time is None:
         raise SSPError("--stop-on-overrun paces nothing without --real-time FACTOR")
-    requirements = None
-    if args.command == "run" and args.junit and not args.requirements:
-        raise SSPError("--junit writes the verdicts of --requirements FILE: pass it too")
-    if args.command == "run" and args.requirements:
-        requirements = req.load(args.requirements)
-        if args.junit:
-            check_output_place(args.junit, "--junit")
+    requirements = _requirements(args) if args.command == "run" else None
     with System(path, validate=not args.no_validate) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
@@ -296,7 +293,7 @@ def _run(args, path):
             algorithm=args.algorithm, order=args.order, step_multiples=_parse_multiples(args.step_multiple),
             stop_when=args.stop_when, output_file=args.output, progress=progress,
             record_every=args.record_every, schedule=not args.no_schedule, profile=args.profile,
-            real_time=args.real_time, stop_on_overrun=args.stop_on_overrun)
+            real_time=args.real_time, stop_on_overrun=args.stop_on_overrun, events=args.events)
     print(f"stop time:   {result.stop_time:g} s ({result.stop_reason})")
     h = f"h = {result.step_size:g} s" if result.step_size is not None else "steps per nc:Schedule mode"
     print(f"steps:       {result.steps} ({h}, {result.algorithm}, order {' '.join(result.order)})")
@@ -312,6 +309,9 @@ def _run(args, path):
             print(f"  {name:<16} {sec:8.3f} s")
         print(f"  {'(master)':<16} {prof['master']:8.3f} s")
     print(f"wall time:   {result.wall_time:.3f} s")
+    for e in result.events:
+        print(f"event {e['event']}:     t = {e['t']:g} s: {e['action']}" + (f" ({e['description']})"
+                                                                          if e["description"] else ""))
     if result.pacing:
         p = result.pacing
         worst = f", worst lateness {p['worst_lateness_s'] * 1e3:.3g} ms at t = {p['worst_at_s']:g} s" \
@@ -346,6 +346,18 @@ def _run(args, path):
         print("requirements not met: " + ", ".join(f"{c[v]} {v}" for v in req.VERDICTS[1:] if c[v]), file=sys.stderr)
         return 1
     return 0
+
+
+def _requirements(args):
+    """run --requirements FILE [--junit FILE.xml], read and checked before the system is loaded."""
+    if args.junit and not args.requirements:
+        raise SSPError("--junit writes the verdicts of --requirements FILE: pass it too")
+    if not args.requirements:
+        return None
+    requirements = req.load(args.requirements)
+    if args.junit:
+        check_output_place(args.junit, "--junit")
+    return requirements
 
 
 def _requirement_outputs(system, requirements, outputs):

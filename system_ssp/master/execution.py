@@ -9,6 +9,7 @@ from .algorithms import Algorithm, FixedStepAlgorithm, ScheduledAlgorithm
 from .instances import InstanceTable, StepFailed
 from .interrupts import Interrupted, Interruption, SignalWatch, TimedOut, WallClockLimit
 from .observers import Observer, ProgressBar, Profiler, Recorder, RunView, StepInfo, StopConditions
+from .events import ScenarioEvents
 from .pacing import RealTimePacer
 from .result import REACHED_STOP_TIME, Result
 
@@ -63,12 +64,15 @@ class _Run:
 
     def __init__(self, system, plan, table):
         self.system, self.plan, self.table = system, plan, table
-        self.recorder = self.info = self.algorithm = None
+        self.recorder = self.info = self.algorithm = self.events = None
 
     def loop(self, progress: bool, watch: SignalWatch, timeout: Optional[float] = None,
              callers: Sequence[Observer] = (), real_time: Optional[float] = None,
              stop_on_overrun: bool = False) -> Result:
         system, plan, table = self.system, self.plan, self.table
+        # before the algorithm, which takes the table's steppers: the events wrap those they fault
+        events = ScenarioEvents(table, plan.events) if plan.events else None
+        self.events = events
         algorithm: Algorithm = (ScheduledAlgorithm if plan.schedule is not None else FixedStepAlgorithm)(table, plan)
         expected = plan.n_steps // plan.record_every + 2 if plan.schedule is None else 1024
         recorder = Recorder(table, plan.record, algorithm.refresh_for_record, capacity=min(expected, 1 << 16))
@@ -76,6 +80,8 @@ class _Run:
         stops = StopConditions(table, plan.stops) if plan.stops else None
         if stops is not None:  # first: the recorder records a row where a stop condition fires
             observers.insert(0, stops)
+        if events is not None:  # before the stop conditions: what an event sets is seen at its point
+            observers.insert(0, events)
         bar = ProgressBar(plan) if progress else None
         if bar is not None:
             observers.append(bar)
@@ -92,7 +98,8 @@ class _Run:
         # new process), which is not the run's time
         pacer = RealTimePacer(real_time, stop_on_overrun, watch) if real_time is not None else None
         # pacing sleeps between the points: the Python loop (the compiled one runs many steps a call)
-        if profiler is None and pacer is None and all(type(obs).step is Observer.step for obs in callers):
+        python_loop = profiler is not None or pacer is not None or events is not None
+        if not python_loop and all(type(obs).step is Observer.step for obs in callers):
             algorithm.compile(stops.ops if stops is not None else [], recorder)
         if timeout is not None:
             observers.append(WallClockLimit(timeout))
@@ -116,6 +123,9 @@ class _Run:
         return self.result(recorder.data(), info.t, reason, final=table.final(), modes=algorithm.statistics(),
                            profile=profiler.report() if profiler else None,
                            pacing=pacer.report() if pacer else None)
+
+    def event_log(self):
+        return list(self.events.log) if getattr(self, "events", None) is not None else []
 
     def ended_by(self, ci, t_end):
         """The run as a component ended it (fmi2Discard, then fmi2Terminated): a last row at the
@@ -153,7 +163,8 @@ class _Run:
                       order=[self.system.comps[i].name for i in plan.order], messages=self.table.messages(),
                       units=self.units(), step_size_source=None if plan.schedule is not None
                       else plan.step_size_source,
-                      stop_conditions=[f"{self.system.comps[ci].name}.{var}" for ci, var in plan.stops], **extra)
+                      stop_conditions=[f"{self.system.comps[ci].name}.{var}" for ci, var in plan.stops],
+                      events=self.event_log(), **extra)
 
     def units(self):
         comps = self.system.comps

@@ -30,7 +30,9 @@ class RunOptions:
     - `step_multiples`: {component: k}, stepped every k-th communication step;
     - `stop_when`: Boolean outputs that end the run at the first communication point one is true;
     - `record_every`: record a row every this many steps; `schedule`: False runs a system with an
-      nc:Schedule at its fixed step; `profile`: wall time per component in `Result.profile`."""
+      nc:Schedule at its fixed step; `profile`: wall time per component in `Result.profile`;
+    - `events`: scenario events (a scenario file's path or a list of event tables, see
+      system_ssp.master.events): values set and outputs faulted during the run."""
     stop_time: Optional[float] = None
     step_size: Optional[float] = None
     start_time: Optional[float] = None
@@ -44,6 +46,7 @@ class RunOptions:
     record_every: int = 1
     schedule: bool = True
     profile: bool = False
+    events: Any = None
 
     @classmethod
     def field_names(cls) -> Tuple[str, ...]:
@@ -83,6 +86,7 @@ class RunPlan:
     profile: bool = False
     schedule: Optional[SchedulePlan] = None
     step_size_source: str = "as requested"  # where step_size comes from (the caller, a file and line, the FMUs)
+    events: Tuple[Any, ...] = ()  # PlannedEvent (system_ssp.master.events), in file order
 
     def __post_init__(self) -> None:
         object.__setattr__(self, "params", MappingProxyType(dict(self.params)))

@@ -9,6 +9,7 @@ from .connections import KIND, RECORDABLE
 from .graph import toposort
 from .names import near, split_name
 from .parameters import collect_parameters
+from .events import plan_events
 from .plan import ALGORITHMS, PlannedMode, RunOptions, RunPlan, SchedulePlan
 
 
@@ -179,7 +180,8 @@ def make_plan(system: Any, options: Optional[RunOptions] = None) -> RunPlan:
                        "step): use a larger step size or a shorter run")
     return RunPlan(start=start, stop=stop, step_size=h, step_size_source=h_source, n_steps=n_steps, algorithm=algo,
                    order=tuple(order_idx), multiples=tuple(mult), stops=tuple(stops), record=tuple(rec), params=params,
-                   record_every=int(o.record_every), profile=bool(o.profile), schedule=sched)
+                   record_every=int(o.record_every), profile=bool(o.profile), schedule=sched,
+                   events=plan_events(system, o.events) if o.events is not None else ())
 
 
 def _schedule(system, algorithm, multiples):

@@ -149,6 +149,9 @@ def run_report(result: Any, title: str, settings: Mapping[str, Any], signals: Se
         outcome += [(f"mode {m}", f"{v['steps']} steps, {v['simulated_time']:g} s simulated")
                     for m, v in result.modes.items()]
     sections = [*first, ("Outcome", table(("quantity", "value"), outcome))]
+    if getattr(result, "events", None):
+        sections.append(("Events", table(("time (s)", "event", "action", "description"), [
+            (f"{e['t']:g}", e["event"], e["action"], e["description"]) for e in result.events])))
     if chosen:
         sections.append(("Signals", figure({n: result.data[n] for n in names}, result.units, chosen)))
     sections.append(("Settings", table(("setting", "value"), [(k, v) for k, v in settings.items()])))

@@ -35,6 +35,7 @@ class Result:
     pacing:      a run paced to wall time (`real_time=`): {"factor", "points", "late_points",
                  "overruns", "worst_lateness_s", "worst_at_s", "slept_s", "wall_s" (from the first step to the
                  last point)}, else None.
+    events:      the scenario events that acted: [{"t", "event" (its number), "action", "description"}].
     stop_conditions: the stop conditions the run watched ('component.variable' names).
     incomplete:  True when the run watched stop conditions and reached its stop time without one
                  holding (a detumble that never settled, an orbit that never re-entered).
@@ -45,7 +46,8 @@ class Result:
                  messages: Dict[str, List[str]], modes: Optional[Dict[str, Dict[str, float]]] = None,
                  profile: Optional[Dict[str, Any]] = None, units: Optional[Units] = None,
                  partial: bool = False, step_size_source: Optional[str] = None,
-                 stop_conditions: Sequence[str] = (), pacing: Optional[Dict[str, Any]] = None) -> None:
+                 stop_conditions: Sequence[str] = (), pacing: Optional[Dict[str, Any]] = None,
+                 events: Sequence[Dict[str, Any]] = ()) -> None:
         self.data = data
         self.stop_time = stop_time
         self.stop_reason = stop_reason
@@ -64,6 +66,7 @@ class Result:
         self.step_size_source = step_size_source
         self.stop_conditions = tuple(stop_conditions)
         self.pacing = pacing
+        self.events = list(events)
 
     @property
     def incomplete(self) -> bool:

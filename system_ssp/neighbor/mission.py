@@ -125,11 +125,12 @@ def _signal_value(r, fn, name):
 
 def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP_DIR, out=None, max_years=40.0,
                 parameters=None, profile=False, progress=False, parameter_sets=(), gnc=DEFAULT_GNC,
-                timeseries="parquet", requirements=None):
+                timeseries="parquet", requirements=None, events=None):
     """Run the mission; returns (summary dict, Result). Writes the results folder if `out`.
     `requirements` (a requirements file or its loaded Requirements, checked before the run):
     each judged on the run, in the summary ("requirements"), report.html and
-    requirements.junit.xml.
+    requirements.junit.xml. `events`: scenario events (a scenario file or a list of event tables,
+    system_ssp.master.events), what they did in the summary ("events").
     `gnc` (GNC) picks the guidance and control parameter set, applied after the scenario's;
     `parameter_sets` (files, names component.variable) apply after it and `parameters`
     ({component.variable: value}) after them. `timeseries`: the recorded signals' format, "parquet"
@@ -157,9 +158,11 @@ def run_mission(scenario=DEFAULT_SCENARIO, orbit="averaged", ssp_dir=DEFAULT_SSP
         with System(ssp) as system:
             r = system.run(stop_time=max_years * YEAR, parameter_sets=[*map(str, ssv), *parameter_sets],
                            parameters=parameters or {},
-                           outputs=RECORD, profile=profile, progress=progress)
+                           outputs=RECORD, profile=profile, progress=progress, events=events)
         s = summarize(r, scenario, orbit, gnc)
         s["gnc"] = gnc
+        if r.events:
+            s["events"] = r.events
         if requirements is not None:
             s["requirements"] = req.summary(requirements, req.judge_run(
                 requirements, requirement_values(s), lambda fn, name: _signal_value(r, fn, name)), False)
@@ -190,6 +193,9 @@ def report_html(r, s, settings):
     whole = ["orbit.altitude", "orbit.perigee_altitude", "power.state_of_charge", "data.storage_used",
              "propulsion.propellant_used"]
     sections = [("Requirements", req.html(s["requirements"]))] if s.get("requirements") else []
+    if s.get("events"):
+        sections.append(("Events", report.table(("time (s)", "event", "action", "description"), [
+            (f"{e['t']:g}", e["event"], e["action"], e["description"]) for e in s["events"]])))
     sections += [("Summary", report.markdown(table(s), far_beyond=10.0)),
                 ("The mission", report.figure(
                     columns, r.units, [n for n in whole if n in columns],
@@ -647,6 +653,8 @@ def main(argv=None):
                     help="extra parameter set after the scenario's, names component.variable (repeatable)")
     ap.add_argument("--set", action="append", default=[], metavar="COMP.VAR=VALUE",
                     help="override a parameter or start value, after every parameter set (repeatable)")
+    ap.add_argument("--events", metavar="FILE", help="a scenario file (TOML [[event]] tables): values set and "
+                    "outputs faulted during the mission (docs/master.md, Scenario events)")
     ap.add_argument("--requirements", metavar="FILE", nargs="?", const=str(REQUIREMENTS),
                     help="a requirements file (TOML; without FILE NEIGHBOR's, system_ssp/neighbor/requirements.toml): "
                     "each check judged PASS/FAIL/INCONCLUSIVE/ERROR on the run, printed, in summary.json, "
@@ -657,7 +665,8 @@ def main(argv=None):
     requirements = req.load(args.requirements) if args.requirements else None
     s, r = run_mission(args.scenario, args.orbit, args.ssp_dir, args.out, args.max_years,
                        parameters=parse_sets(args.set), profile=args.profile, progress=progress,
-                       parameter_sets=args.ssv, gnc=args.gnc, timeseries=args.timeseries, requirements=requirements)
+                       parameter_sets=args.ssv, gnc=args.gnc, timeseries=args.timeseries, requirements=requirements,
+                       events=args.events)
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:

@@ -311,6 +311,29 @@ def test_without_sun_sensors_or_a_fix_from_the_horizon_history_the_mission_ends_
     assert int(d["mission.mode"][-1]) == MissionMode.END and s["reentered"]  # decayed, as without NEIGHBOR
 
 
+def test_sun_sensors_killed_by_a_scenario_file_are_the_models_own_fault(ssp_paths):
+    """examples/scenarios/sun_sensors_dead_at_300s.toml faults every Sun sensor's outputs 300 s
+    into the default mission (dropout: zeros, not valid, as the inputs they feed see them). The
+    run equals the one with the models' own fault parameters (sun_sensor.failed, coarse_sun.failed)
+    bit for bit: every recorded signal and every figure of the summary. The sensors do not
+    operate before the de-orbit, so dead from 300 s is dead from the start."""
+    scenario = REPO / "examples" / "scenarios" / "sun_sensors_dead_at_300s.toml"
+    ssp_dir = ssp_paths["neighbor_mission"].parent
+    s_events, r_events = mission.run_mission("420km", ssp_dir=ssp_dir, events=str(scenario))
+    s_model, r_model = mission.run_mission("420km", ssp_dir=ssp_dir,
+                                           parameters={"sun_sensor.failed": True, "coarse_sun.failed": True})
+    assert [e["event"] for e in s_events["events"]] == list(range(1, 9))
+    # at the first communication point from 300 s: the idle mode's 6 h steps (with the daily 5 s wake)
+    (when,) = {e["t"] for e in s_events["events"]}
+    assert 300.0 <= when <= 6 * 3600.0 + 5.0
+    assert s_events["events"][0]["action"] == "fault sun_sensor.valid: dropout"
+    for name in r_model.data.dtype.names:
+        assert np.array_equal(r_events.data[name], r_model.data[name]), name
+    skip = {"wall_time_s", "events"}
+    assert {k: v for k, v in s_events.items() if k not in skip} == {k: v for k, v in s_model.items() if k not in skip}
+    assert s_events["fixed_without_sun"] and s_events["reentered"]  # the horizon history's fix, the de-orbit flown
+
+
 def test_the_true_thrust_axis_error_is_the_angle_between_body_x_axes():
     """The summary's true thrust-axis error (the rigid body's x against the guidance's, closed
     loop only: the thesis set thrusts along -v whatever the attitude) from recorded quaternions."""

@@ -225,7 +225,7 @@ def check_against_system(spec):
                 values[FAULT] = fault
             options = RunOptions(stop_time=spec.stop_time, step_size=spec.step_size,
                                  parameter_sets=tuple(spec.parameter_sets), parameters=spec.overrides(values),
-                                 outputs=record)
+                                 outputs=record, events=spec.run_events(values))
             try:
                 make_plan(system, options)
             except SSPError as exc:

@@ -35,7 +35,8 @@ CAMPAIGN_KEYS = {"system", "parameter_sets", "runs", "seed", "stop_time", "step_
                  "keep_timeseries", "extends",
                  "min_success",
                  "description"}
-TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities", "faults"}
+TOP_KEYS = {"campaign", "parameters", "dispersions", "sweep", "metrics", "probabilities", "faults", "events"}
+EVENT_FIELD = re.compile(r"^events\[(\d+)\]\.(at|value)$")  # a dispersed or swept field of [[events]] i (1-based)
 FAULT = "fault"  # the result column naming a run's fault case ("none" without one)
 FAULT_STREAM = 1  # the fault draw's random stream: adding [faults] leaves every other draw as it was
 
@@ -110,6 +111,7 @@ class CampaignSpec:
     metrics: list = field(default_factory=list)  # [Metric]
     probabilities: list = field(default_factory=list)  # [(name, metric, op, threshold)]
     faults: Optional[Faults] = None
+    events: list = field(default_factory=list)  # [[events]] tables (system_ssp.master.events), as read
     text: str = ""  # the spec file as read (stored beside the results)
 
     @property
@@ -141,6 +143,17 @@ class CampaignSpec:
         """The signals each run records: the metrics' and, with keep_timeseries, the kept ones."""
         return tuple(sorted({m.variable for m in self.metrics if m.variable} | set(self.keep_signals)))
 
+    def run_events(self, values):
+        """The [[events]] of a run, with its drawn `events[i].at` / `events[i].value` (None: none)."""
+        if not self.events:
+            return None
+        events = [dict(e) for e in self.events]
+        for name, value in values.items():
+            m = EVENT_FIELD.match(name)
+            if m:
+                events[int(m.group(1)) - 1][m.group(2)] = value
+        return events
+
     def overrides(self, values):
         """The system parameters for a run's drawn values: fixed parameters, then the values (and
         the names that share them); helper inputs (@name) are left to the helper."""
@@ -148,7 +161,8 @@ class CampaignSpec:
         for d in self.dispersions:
             for other in d.also:
                 out[other] = values[d.name]
-        out.update({k: v for k, v in values.items() if not k.startswith("@") and k != FAULT})
+        out.update({k: v for k, v in values.items() if not k.startswith("@") and k != FAULT
+                    and not EVENT_FIELD.match(k)})
         if values.get(FAULT, "none") != "none":
             out.update(self.faults.cases[values[FAULT]])
         return out
@@ -238,6 +252,7 @@ def load_spec(path):
     refuse_over("max_runs", spec.runs * math.prod(len(v) for _, v in spec.sweeps),
                 f"{path}: campaign.runs" + (" times the sweep points" if spec.sweeps else ""))
     names = [d.name for d in spec.dispersions] + [n for n, _ in spec.sweeps]
+    spec.events = _events(path, doc, names)
     twice = sorted({n for n in names if names.count(n) > 1} | (set(names) & set(spec.parameters)))
     if twice:
         raise SSPError(f"{path}: {', '.join(twice)}: set more than once (parameters, dispersions, sweeps)")
@@ -266,6 +281,26 @@ def load_spec(path):
         spec.probabilities.append((name, match.group(1), match.group(2),
                                    threshold == "true" if threshold in ("true", "false") else threshold))
     return spec
+
+
+def _events(path, doc, names):
+    """The [[events]] tables (checked as scenario events), and the events' fields that `names`
+    (dispersed or swept) draw: events[i].at or events[i].value."""
+    events = doc.get("events", [])
+    if "events" in doc:
+        from ...master.events import parse_events
+
+        if not isinstance(events, list) or not events:
+            raise SSPError(f"{path}: [[events]]: expected event tables (at or when, and set, fault or release)")
+        parse_events(events, [f"{path}: events[{i + 1}]" for i in range(len(events))])
+    for name in names:
+        m = EVENT_FIELD.match(name)
+        if name.startswith("events[") and (m is None or not 1 <= int(m.group(1)) <= len(events)):
+            raise SSPError(f"{path}: {name}: an event's field is events[i].at or events[i].value, i from 1 to "
+                           f"{len(events)} (the [[events]] in order)")
+        if m and m.group(2) == "at" and "at" not in events[int(m.group(1)) - 1]:
+            raise SSPError(f"{path}: {name}: events[{m.group(1)}] has no `at` to disperse (it has `when`)")
+    return list(events)
 
 
 def _campaign_table(path, c, text):

@@ -120,7 +120,7 @@ def run_one(spec, index, series_dir=None):
             params.update(extra)
         record = list(spec.recorded())
         result = system.run(stop_time=spec.stop_time, step_size=spec.step_size, parameter_sets=spec.parameter_sets,
-                            parameters=params,
+                            parameters=params, events=spec.run_events(values),
                             outputs=record, timeout=spec.timeout_s)
         row.update(metric_values(spec, result))
         row.update(status="incomplete" if result.incomplete else "ok", error="")
