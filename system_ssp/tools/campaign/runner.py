@@ -77,7 +77,8 @@ def _write_rows(path, rows, columns):
 
 
 def _columns(spec):
-    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions] + ([FAULT] if spec.faults else [])
+    inputs = [n for n, _ in spec.sweeps] + [c for d in spec.dispersions for c in d.columns] + (
+        [FAULT] if spec.faults else [])
     return ["run", "seed"] + inputs + [m.name for m in spec.metrics] + ["status", "error", "wall_s"]
 
 
@@ -190,8 +191,9 @@ def _spec_key(spec, name):
     metrics.<metric>."""
     if name in spec.parameters:
         return f"parameters.{name}"
-    if any(d.name == name or name in d.also for d in spec.dispersions):
-        return f"dispersions.{next(d.name for d in spec.dispersions if d.name == name or name in d.also)}"
+    owner = next((d.name for d in spec.dispersions if name in d.columns or name in d.also), None)
+    if owner is not None:
+        return f"dispersions.{owner}"
     if any(n == name for n, _ in spec.sweeps):
         return f"sweep.{name}"
     case = next((c for c, values in (spec.faults.cases.items() if spec.faults else ()) if name in values), None)
@@ -538,7 +540,7 @@ def figures(spec, rows, folder, units=None):
     # None: a metric an incomplete run lacks (drawn as missing)
     metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) or r[m.name] is None
                                                           for r in ok) and any(r[m.name] is not None for r in ok)]
-    inputs = [n for n, _ in spec.sweeps] + [d.name for d in spec.dispersions]
+    inputs = [n for n, _ in spec.sweeps] + [c for d in spec.dispersions for c in d.columns]
     inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)
               and len({float(r[n]) for r in ok}) > 1]
     # a metric that is the same in every run (a budget always spent) has nothing to show

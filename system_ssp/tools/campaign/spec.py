@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
+from .spacecraft import KINDS as SPACECRAFT_KINDS, SpacecraftDispersion, spacecraft_dispersion
 from ...limits import read_text_input, refuse_over
 from ... import builder
 from ...locations import system_names
@@ -47,6 +48,11 @@ class Dispersion:
     kind: str
     args: dict
     also: tuple = ()  # other parameters that get the same drawn value
+
+    @property
+    def columns(self):
+        """The parameters it draws (one; a spacecraft dispersion draws several)."""
+        return (self.name,)
 
     def draw(self, rng):
         a = self.args
@@ -133,7 +139,10 @@ class CampaignSpec:
         ss = np.random.SeedSequence(self.seed, spawn_key=(index,))
         rng = np.random.default_rng(ss)
         for d in self.dispersions:
-            values[d.name] = d.draw(rng)
+            if isinstance(d, SpacecraftDispersion):
+                values.update(d.draw(rng))
+            else:
+                values[d.name] = d.draw(rng)
         if self.faults is not None:
             values[FAULT] = self.faults.draw(np.random.default_rng(
                 np.random.SeedSequence(self.seed, spawn_key=(index, FAULT_STREAM))))
@@ -251,7 +260,7 @@ def load_spec(path):
         spec.sweeps.append((name, list(s["values"])))
     refuse_over("max_runs", spec.runs * math.prod(len(v) for _, v in spec.sweeps),
                 f"{path}: campaign.runs" + (" times the sweep points" if spec.sweeps else ""))
-    names = [d.name for d in spec.dispersions] + [n for n, _ in spec.sweeps]
+    names = [c for d in spec.dispersions for c in d.columns] + [n for n, _ in spec.sweeps]
     spec.events = _events(path, doc, names)
     twice = sorted({n for n in names if names.count(n) > 1} | (set(names) & set(spec.parameters)))
     if twice:
@@ -369,7 +378,10 @@ def _faults(path, d):
 
 def _dispersions(path, name, d, helper):
     """One dispersion, or with `elements = n` one per element name[1]..name[n] of a vector
-    parameter, each drawn on its own from the same distribution (in element order)."""
+    parameter, each drawn on its own from the same distribution (in element order); a spacecraft
+    dispersion (inertia, attitude, rate, cone: spacecraft.py) draws several parameters at once."""
+    if isinstance(d, dict) and d.get("distribution") in SPACECRAFT_KINDS:
+        return [spacecraft_dispersion(path, name, d)]
     if not isinstance(d, dict) or "elements" not in d:
         return [_dispersion(path, name, d, helper)]
     n = _number(path, f"dispersions.{name!r}.elements", d["elements"], integer=True, positive=True)
@@ -396,7 +408,8 @@ def _dispersion(path, name, d, helper):
         raise SSPError(f"{path}: [{key}] needs distribution = one of {', '.join(DISTRIBUTIONS)}")
     kind = d["distribution"]
     if kind not in DISTRIBUTIONS:
-        raise SSPError(f"{path}: {key}.distribution = {kind!r}: expected one of {', '.join(DISTRIBUTIONS)}")
+        raise SSPError(f"{path}: {key}.distribution = {kind!r}: expected one of {', '.join(DISTRIBUTIONS)}, or for "
+                       f"the spacecraft {', '.join(SPACECRAFT_KINDS)}")
     need = DISTRIBUTIONS[kind]
     extra = sorted(set(d) - set(need) - {"distribution", "also"})
     missing = [k for k in need if k not in d]
