@@ -38,6 +38,8 @@ import numpy as np
 
 from ..errors import SSPError
 from ..limits import read_text_input
+from .expressions import Missing, evaluate, parse_check
+from .instances import read_ops
 from .names import split_name
 from .observers import Observer
 
@@ -170,8 +172,6 @@ def _fault_fields(e: Mapping[str, Any], where: str) -> Tuple[Optional[str], Opti
 
 
 def _when(e: Mapping[str, Any], where: str) -> Optional[str]:
-    from ..tools.requirements import parse_check  # the checks' language
-
     if "when" not in e:
         return None
     if not isinstance(e["when"], str):
@@ -212,8 +212,6 @@ def plan_events(system: Any, source: Any) -> Tuple[PlannedEvent, ...]:
     """The events of RunOptions.events checked against the system: names, causality (a set
     changes an input no connection feeds or a tunable parameter; a fault acts on an output that
     feeds an input), types. SSPError naming the event."""
-    from ..tools.requirements import parse_check
-
     events = events_of(source)
     fed = {(lk.dst, lk.dst_var) for lk in system.links}
     feeding = {(lk.src, lk.src_var) for lk in system.links}
@@ -322,7 +320,6 @@ class ScenarioEvents(Observer):
                 if pe.output not in self.by_comp[pe.output[0]]:
                     self.by_comp[pe.output[0]].append(pe.output)
         self.reads = {}
-        from .instances import read_ops
         for pe in planned:
             if pe.condition_signals:
                 self.reads[pe.event.number] = read_ops(table, list(pe.condition_signals))[0]
@@ -387,8 +384,6 @@ class ScenarioEvents(Observer):
             self._act(pe, t)
 
     def _holds(self, pe, t):
-        from ..tools.requirements import Missing, evaluate
-
         values = {}
         for op in self.reads.get(pe.event.number, ()):
             for name, value in zip(op.names, op.read().tolist()):
@@ -425,7 +420,6 @@ class ScenarioEvents(Observer):
 
     def _raw(self, key):
         """The output's own value, read from its FMU (it is faulted in the buffer)."""
-        from .instances import read_ops
         (op,), _ = read_ops(self.table, [key])
         return op.read().tolist()[0]
 

@@ -22,8 +22,6 @@ from typing import Any, Dict, List, Mapping, Tuple
 
 import numpy as np
 
-from components.core import rotations
-
 from ...errors import SSPError
 
 KINDS = {"inertia": ("nominal", "moments", "axes"), "attitude": (), "rate": ("low", "high"),
@@ -41,6 +39,12 @@ def _rotation(axis: np.ndarray, angle: float) -> np.ndarray:
     """The rotation matrix turning vectors by `angle` about `axis` (Rodrigues)."""
     k = np.array([[0.0, -axis[2], axis[1]], [axis[2], 0.0, -axis[0]], [-axis[1], axis[0], 0.0]])
     return np.eye(3) + math.sin(angle) * k + (1.0 - math.cos(angle)) * (k @ k)
+
+
+def _then(p: np.ndarray, q: np.ndarray) -> np.ndarray:
+    """The attitude q turned by p: the quaternion product p (x) q, scalar last, the models'
+    convention (components.core.rotations.circle_cross; the tools import no model)."""
+    return np.concatenate([p[3] * q[:3] + q[3] * p[:3] - np.cross(p[:3], q[:3]), [p[3] * q[3] - p[:3] @ q[:3]]])
 
 
 @dataclass(frozen=True)
@@ -106,8 +110,8 @@ class SpacecraftDispersion:
             angle = rng.uniform(low, high)
             if top == 0.0 or rng.uniform(0.0, top) <= 1.0 - math.cos(angle):
                 break
-        turn = rotations.from_axis_angle(tuple(_axis(rng)), angle)
-        q = np.array(rotations.circle_cross(turn, tuple(a.get("nominal", (0.0, 0.0, 0.0, 1.0)))))
+        turn = np.concatenate([_axis(rng) * math.sin(angle / 2.0), [math.cos(angle / 2.0)]])
+        q = _then(turn, np.asarray(a.get("nominal", (0.0, 0.0, 0.0, 1.0)), dtype=float))
         if q[3] < 0.0:
             q = -q  # the same attitude, scalar part >= 0
         if a.get("form") == "mrp":

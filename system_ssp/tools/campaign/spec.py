@@ -13,6 +13,7 @@ from typing import Optional
 import numpy as np
 
 from ...errors import SSPError
+from ...master.events import parse_events
 from .spacecraft import KINDS as SPACECRAFT_KINDS, SpacecraftDispersion, spacecraft_dispersion
 from ...limits import read_text_input, refuse_over
 from ... import builder
@@ -297,8 +298,6 @@ def _events(path, doc, names):
     (dispersed or swept) draw: events[i].at or events[i].value."""
     events = doc.get("events", [])
     if "events" in doc:
-        from ...master.events import parse_events
-
         if not isinstance(events, list) or not events:
             raise SSPError(f"{path}: [[events]]: expected event tables (at or when, and set, fault or release)")
         parse_events(events, [f"{path}: events[{i + 1}]" for i in range(len(events))])
