@@ -125,7 +125,7 @@ class _Run:
                            pacing=pacer.report() if pacer else None)
 
     def event_log(self):
-        return list(self.events.log) if getattr(self, "events", None) is not None else []
+        return list(self.events.log) if self.events is not None else []
 
     def ended_by(self, ci, t_end):
         """The run as a component ended it (fmi2Discard, then fmi2Terminated): a last row at the

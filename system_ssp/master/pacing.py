@@ -16,13 +16,11 @@ SLICE = 0.1  # s: the longest single sleep, so that Ctrl-C ends a run paced with
 
 
 class RealTimePacer(Observer):
-    """Holds each communication point to wall time at `factor` (> 0); counts overruns and the
-    worst lateness; `stop_on_overrun` ends the run at the first overrun with RealTimeOverrun
-    (rows so far in err.result). `watch` (a SignalWatch) cuts a sleep short when a signal came."""
+    """Holds each communication point to wall time at `factor` (> 0, checked by System.run);
+    counts overruns and the worst lateness; `stop_on_overrun` ends the run at the first overrun
+    with RealTimeOverrun (rows so far in err.result). `watch` (a SignalWatch) cuts a sleep short when a signal came."""
 
     def __init__(self, factor: float, stop_on_overrun: bool = False, watch=None):
-        if not factor > 0 or factor != factor or factor == float("inf"):
-            raise ValueError(f"real-time factor must be a finite number > 0, got {factor!r}")
         self.factor = float(factor)
         self.stop_on_overrun = stop_on_overrun
         self.watch = watch
