@@ -311,7 +311,7 @@ def run_campaign(spec, out, workers=None, scheduler=None, progress=False, batch=
 def campaign_report(spec, rows, s, series_dir=None):
     """report.html of a campaign: the summary table, the metrics' distributions (interactive),
     the commonest errors, the spec and the versions; one file."""
-    ok = finished(rows)
+    done = finished(rows)
     stats = [(name, m.get("unit") or "", m["n"], *(f"{m[k]:.6g}" for k in ("mean", "std", "min", "p5", "p50", "p95",
                                                                              "max")))
              for name, m in s["metrics"].items() if "mean" in m]
@@ -324,14 +324,14 @@ def campaign_report(spec, rows, s, series_dir=None):
     sections = [("Summary", "\n".join(summary))]
     if s.get("requirements"):
         sections.insert(0, ("Requirements", req.html(s["requirements"])))
-    numeric = {m.name: [float(r[m.name]) for r in ok if isinstance(r[m.name], (int, float))
+    numeric = {m.name: [float(r[m.name]) for r in done if isinstance(r[m.name], (int, float))
                         and math.isfinite(float(r[m.name]))] for m in spec.metrics}  # None: an incomplete run's
     numeric = {k: v for k, v in numeric.items() if len(set(v)) > 1}
     if numeric:
         units = {name: m.get("unit") for name, m in s["metrics"].items()}
         sections.append(("Distributions over the finished runs (ok and incomplete)", report.histograms(numeric, units)))
     if spec.keep_timeseries and series_dir is not None:
-        kept = envelopes(spec, ok, series_dir)
+        kept = envelopes(spec, done, series_dir)
         if kept:
             sections.append(("Envelopes over the runs (5th to 95th percentile, median)", kept))
     if s.get("errors"):
@@ -446,14 +446,14 @@ def summarize(spec, rows, units=None):
     over the finished runs (ok and incomplete, with their unit), probabilities over the same runs (a
     metric an incomplete run lacks, such as its end time, counts as the condition not holding: a
     run that never re-entered does not re-enter within five years)."""
-    ok = finished(rows)
+    done = finished(rows)
     s = {"campaign": str(spec.path), "system": str(spec.system), "runs": len(rows),
          "ok": sum(r["status"] == "ok" for r in rows), "incomplete": sum(r["status"] == "incomplete" for r in rows),
          "failed": sum(r["status"] == "failed" for r in rows), "timeout": sum(r["status"] == "timeout" for r in rows),
          "metrics": {}, "probabilities": {}}
     s["success_rate"] = s["ok"] / len(rows) if rows else math.nan
     for m in spec.metrics:
-        vals = np.array([r[m.name] for r in ok if isinstance(r[m.name], (int, float))], dtype=float)
+        vals = np.array([r[m.name] for r in done if isinstance(r[m.name], (int, float))], dtype=float)
         vals = vals[np.isfinite(vals)] if vals.size else vals
         if vals.size:
             p5, p50, p95 = np.percentile(vals, [5, 50, 95])
@@ -462,8 +462,8 @@ def summarize(spec, rows, units=None):
                                     "min": float(vals.min()), "p5": float(p5), "p50": float(p50), "p95": float(p95),
                                     "max": float(vals.max())}
         else:
-            values = sorted({str(r[m.name]) for r in ok})
-            s["metrics"][m.name] = {"n": len(ok), "values": values[:20]}
+            values = sorted({str(r[m.name]) for r in done})
+            s["metrics"][m.name] = {"n": len(done), "values": values[:20]}
     errors = Counter(r["error"] for r in rows if r["status"] not in FINISHED and r.get("error"))
     s["errors"] = [{"error": e, "runs": n} for e, n in errors.most_common(3)]
     if spec.faults:  # runs per fault case ("none": no fault)
@@ -471,7 +471,7 @@ def summarize(spec, rows, units=None):
     s["min_success"] = spec.min_success
     ops = {"<": np.less, "<=": np.less_equal, ">": np.greater, ">=": np.greater_equal, "==": np.equal}
     for name, metric, op, threshold in spec.probabilities:
-        vals = [r[metric] for r in ok if r[metric] is not None or r["status"] == "incomplete"]
+        vals = [r[metric] for r in done if r[metric] is not None or r["status"] == "incomplete"]
         k = int(sum(v is not None and bool(ops[op](v, threshold)) for v in vals))
         lo, hi = wilson(k, len(vals))
         s["probabilities"][name] = {"condition": f"{metric} {op} {threshold}", "k": k, "n": len(vals),
@@ -536,15 +536,15 @@ def figures(spec, rows, folder, units=None):
     from matplotlib.ticker import MaxNLocator
 
     units = units or {}
-    ok = finished(rows)
+    done = finished(rows)
     # None: a metric an incomplete run lacks (drawn as missing)
-    metrics = [m.name for m in spec.metrics if ok and all(isinstance(r[m.name], (int, float)) or r[m.name] is None
-                                                          for r in ok) and any(r[m.name] is not None for r in ok)]
+    metrics = [m.name for m in spec.metrics if done and all(isinstance(r[m.name], (int, float)) or r[m.name] is None
+                                                            for r in done) and any(r[m.name] is not None for r in done)]
     inputs = [n for n, _ in spec.sweeps] + [c for d in spec.dispersions for c in d.columns]
-    inputs = [n for n in inputs if ok and all(isinstance(r[n], (int, float)) for r in ok)
-              and len({float(r[n]) for r in ok}) > 1]
+    inputs = [n for n in inputs if done and all(isinstance(r[n], (int, float)) for r in done)
+              and len({float(r[n]) for r in done}) > 1]
     # a metric that is the same in every run (a budget always spent) has nothing to show
-    metrics = [m for m in metrics if len({_number(r[m]) for r in ok if math.isfinite(_number(r[m]))}) > 1]
+    metrics = [m for m in metrics if len({_number(r[m]) for r in done if math.isfinite(_number(r[m]))}) > 1]
     if not metrics:
         return
     thresholds = {}
@@ -555,7 +555,7 @@ def figures(spec, rows, folder, units=None):
     for name in metrics:
         unit = units.get(name)
         if unit == "s":
-            span = max(abs(_number(r[name])) for r in ok if math.isfinite(_number(r[name])))
+            span = max(abs(_number(r[name])) for r in done if math.isfinite(_number(r[name])))
             unit, factor = next((u, f) for u, f in TIME_UNITS if span >= 2 * f or u == "s")
             scale[name] = (factor, unit)
         else:
@@ -570,7 +570,7 @@ def figures(spec, rows, folder, units=None):
 
     folder.mkdir(exist_ok=True)
     for name in metrics:
-        vals = [value(r, name) for r in ok if math.isfinite(_number(r[name]))]
+        vals = [value(r, name) for r in done if math.isfinite(_number(r[name]))]
         if not vals:
             continue
         fig, ax = plt.subplots(figsize=(6, 4))
@@ -590,10 +590,10 @@ def figures(spec, rows, folder, units=None):
         return
     panels = {}
     for m in metrics:
-        y = np.array([_number(r[m]) for r in ok])
+        y = np.array([_number(r[m]) for r in done])
         score = []
         for x_name in inputs:
-            x = np.array([float(r[x_name]) for r in ok])
+            x = np.array([float(r[x_name]) for r in done])
             good = np.isfinite(x) & np.isfinite(y)
             c = np.corrcoef(x[good], y[good])[0, 1] if good.sum() > 2 and np.std(x[good]) and np.std(y[good]) else 0.0
             score.append(abs(c) if math.isfinite(c) else 0.0)
@@ -607,7 +607,7 @@ def figures(spec, rows, folder, units=None):
                 ax.set_visible(False)
                 continue
             x = panels[m][b]
-            ax.scatter([r[x] for r in ok], [value(r, m) for r in ok], s=8)
+            ax.scatter([r[x] for r in done], [value(r, m) for r in done], s=8)
             for limit, _ in thresholds.get(m, []):
                 ax.axhline(limit / scale[m][0], color="tab:red", linestyle="--", linewidth=1)
             ax.ticklabel_format(useOffset=False)
