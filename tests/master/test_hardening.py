@@ -511,7 +511,8 @@ def test_campaign_on_a_real_cluster_survives_a_killed_worker(ssp_paths, tmp_path
     summary = json.loads((out / "summary.json").read_text())
     rows = _rows(out)
     assert sorted(rows) == list(range(60)) and summary["runs"] == 60
-    assert summary["ok"] + summary["failed"] == 60 and summary["ok"] >= 58
+    done = summary["ok"] + summary["incomplete"]  # a 20 s detumble that has not settled is incomplete
+    assert done + summary["failed"] == 60 and done >= 58
 
 
 # ---- 4. non-finite numbers -------------------------------------------------------------------
