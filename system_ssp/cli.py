@@ -18,15 +18,14 @@ import sys
 import tempfile
 import traceback
 
-import fmpy
 
 from . import __version__, archive
 from .neighbor import deorbit_study, mission, thesis, validation
 from .tools import campaign, compose, convert, export_fmu, flatten, plot, release, replace
 from .tools import requirements as req
 from .tools.console import (ArgumentParser, finite_float, positive_float, positive_int,
-                            add_console_arguments, console_settings, parse_sets, system_path)
-from .errors import RealTimeOverrun, RunInterrupted, SimulationError, SSPError
+                            add_console_arguments, console_settings, parse_sets, release_console, system_path)
+from .errors import RealTimeOverrun, RunInterrupted, SimulationError, SSPError, command_line_spelling
 from .master import System
 from .master.plotting import FORMATS as PLOT_FORMATS
 from .master.report import run_report
@@ -34,6 +33,7 @@ from .master.result import check_output_file
 from .atomic import check_output_place, write_text_atomic
 from .master.components import unsupported_fmu
 from .master.info import system_info
+from .ssp import model_description
 from .ssp.interface import FmuInterface, describe_fmu
 from .ssp.writer import single_fmu_system
 
@@ -76,7 +76,10 @@ def _parser():
     r.add_argument("--plot", metavar="FILE", help="also draw the recorded signals: .png, .svg or .html (interactive)")
     r.add_argument("--report", metavar="FILE.html", help="also write a report: outcome, an interactive figure of the "
                    "recorded signals, settings and versions, in one HTML file that needs no network")
-    r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
+    r.add_argument("--no-validate", action="store_true", help="skip the XML schema checks and the FMUs' model "
+                   "description checks")
+    r.add_argument("--strict", action="store_true", help="refuse an FMU whose model description has any problem "
+                   "(by default those that do not change the run are read with a warning)")
     r.add_argument("--no-schedule", action="store_true",
                    help="ignore the system's nc:Schedule and run with the fixed step")
     r.add_argument("--events", metavar="FILE", help="a scenario file (TOML [[event]] tables): at a time or when a "
@@ -98,7 +101,10 @@ def _parser():
                        "are bound")
     i.add_argument("path", help="a system (.ssp, .ssd, or a built system's name) or an FMU (.fmu)")
     i.add_argument("--json", action="store_true", help="the same as JSON, for tools")
-    i.add_argument("--no-validate", action="store_true", help="skip the XML schema checks")
+    i.add_argument("--no-validate", action="store_true", help="skip the XML schema checks and the FMUs' model "
+                   "description checks")
+    i.add_argument("--strict", action="store_true", help="refuse an FMU whose model description has any problem")
+    add_console_arguments(i, progress=False)
     sub.add_parser("replace", add_help=False, help="replace one component's FMU in a system, checked "
                    "(replace SYSTEM COMPONENT NEW.fmu --out X.ssp)")
     sub.add_parser("compose", add_help=False, help="a system from a system spec (compose SPEC.toml --out X.ssp), or "
@@ -168,9 +174,10 @@ def main(argv=None):
                                                  for k, a in enumerate(argv))
     previous = {sig: signal.signal(sig, handler) for sig, handler in HANDLERS.items()}
     try:
-        if argv[:1] and argv[0] in APPS:
-            return APPS[argv[0]](argv[1:])
-        return _run_or_info(argv)
+        with command_line_spelling():  # messages name options as --algorithm jacobi, not algorithm='jacobi'
+            if argv[:1] and argv[0] in APPS:
+                return APPS[argv[0]](argv[1:])
+            return _run_or_info(argv)
     except RunInterrupted as exc:
         print(one_line(exc), file=sys.stderr)
         _say_partial(exc)
@@ -210,6 +217,7 @@ def main(argv=None):
     finally:
         for sig, handler in previous.items():
             signal.signal(sig, handler)
+        release_console()  # main() called from Python: its stderr handler goes with it
 
 
 def _path_limit(name, default):
@@ -263,7 +271,7 @@ def _run_or_info(argv):
         if args.command == "run" and suffix == ".fmu":  # the FMU alone, as a system of one
             archive.extract(args.path, Path(tmp) / "checked", args.path)  # refused naming the user's file
             path = str(single_fmu_system(path, tmp))
-            md = fmpy.read_model_description(args.path)
+            md = model_description.read(args.path, args.path, not args.no_validate, args.strict).md
             refusal = unsupported_fmu(md)
             if refusal:
                 raise SSPError(f"{args.path} {refusal}")
@@ -280,11 +288,11 @@ def _run(args, path):
     if args.command == "run" and args.stop_on_overrun and args.real_time is None:
         raise SSPError("--stop-on-overrun paces nothing without --real-time FACTOR")
     requirements = _requirements(args) if args.command == "run" else None
-    with System(path, validate=not args.no_validate) as system:
+    progress = console_settings(args)  # before loading: its warnings (FMUs read leniently) are shown
+    with System(path, validate=not args.no_validate, strict=args.strict) as system:
         if args.command == "info":
             print(json.dumps(system_info(system), indent=1, default=str) if args.json else system.info())
             return 0
-        progress = console_settings(args)
         if requirements is not None:
             args.outputs = _requirement_outputs(system, requirements, args.outputs)
         result = system.run(

@@ -1,4 +1,27 @@
-"""Exceptions raised by the master."""
+"""Exceptions raised by the master, and how their messages name an option."""
+from contextlib import contextmanager
+from contextvars import ContextVar
+from typing import Iterator
+
+# How a message names an option that would change the outcome: as the command line spells it
+# (`--algorithm jacobi`) while the command line runs, else as the Python API does
+# (`algorithm='jacobi'`), so that the advice is what the reader can type where they are.
+_SPELLING: ContextVar[str] = ContextVar("system_ssp_option_spelling", default="api")
+
+
+def option(command_line: str, api: str) -> str:
+    """`command_line` inside `command_line_spelling()`, else `api`."""
+    return command_line if _SPELLING.get() == "cli" else api
+
+
+@contextmanager
+def command_line_spelling() -> Iterator[None]:
+    """Messages raised inside name options as the command line spells them."""
+    token = _SPELLING.set("cli")
+    try:
+        yield
+    finally:
+        _SPELLING.reset(token)
 
 
 class SSPError(Exception):

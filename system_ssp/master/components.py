@@ -1,15 +1,20 @@
 """The static side of one component of a loaded system: its SSD declaration, its FMU's model
 description and the folder the FMU is extracted to."""
 import copy
+import logging
+import os
 
-from fmpy import read_model_description
+from lxml import etree
 
 from .. import archive
 
 from ..errors import SSPError
+from ..ssp import model_description
 from ..ssp.fmi3_view import element_view
 from ..ssp.interface import unit_definitions, variable_unit
 from .names import near
+
+LOG = logging.getLogger("system_ssp.master")
 
 
 class ComponentInfo:
@@ -35,15 +40,23 @@ class ComponentInfo:
             md.modelVariables, md.outputs = variables, outputs
             self.md_view_vars = {v.valueReference: v for v in variables}
         self.md = md
+        self.fmi1 = md.fmiVersion.startswith("1.")
         self.unzipdir = unzipdir
         self.vars = {v.name: v for v in md.modelVariables}
         self.unit_defs = unit_definitions(md)
-        # output name -> set of input names it depends on directly (None = all inputs)
-        self.deps = {}
-        for unknown in md.outputs:
-            d = unknown.dependencies
-            self.deps[unknown.variable.name] = None if d is None else {v.name for v in d}
+        # output name -> set of input names it depends on directly (None = all inputs); an output
+        # not in it depends on all inputs too (FMI 2.0 and 3.0 ModelStructure; FMI 1.0 DirectDependency)
+        if self.fmi1:
+            self.deps = fmi1_direct_dependencies(unzipdir)
+        else:
+            self.deps = {}
+            for unknown in md.outputs:
+                d = unknown.dependencies
+                self.deps[unknown.variable.name] = None if d is None else {v.name for v in d}
         self.inputs = [v.name for v in md.modelVariables if v.causality == "input"]
+        outputs = [v.name for v in md.modelVariables if v.causality == "output"]
+        # the outputs the FMU does not say the dependencies of: taken to depend on every input
+        self.undeclared = [o for o in outputs if self.deps.get(o) is None] if self.inputs else []
 
     def whole(self, name):
         """The elements of `name` connected whole: an FMI 3.0 array's, or the vector or matrix an
@@ -76,33 +89,49 @@ class ComponentInfo:
         return bool(d & connected_inputs) if connected_inputs is not None else bool(d)
 
 
+def fmi1_direct_dependencies(unzipdir):
+    """{output: set of the inputs it depends on directly} of an FMI 1.0 FMU, from the
+    DirectDependency elements of its outputs (FMPy does not read them); an output without one
+    depends on every input (FMI 1.0, section 2.10), and is left out."""
+    root = etree.parse(os.path.join(unzipdir, "modelDescription.xml")).getroot()
+    deps = {}
+    for sv in root.iterfind("ModelVariables/ScalarVariable"):
+        direct = sv.find("DirectDependency")
+        if sv.get("causality") == "output" and direct is not None:
+            deps[sv.get("name")] = {(n.text or "").strip() for n in direct.iterfind("Name")}
+    return deps
+
+
 def unsupported_fmu(md):
-    """Why this master cannot run the FMU of model description `md` (FMPy's), or None: FMI 2.0
-    and 3.0 co-simulation FMUs run (FMI 3.0 through system_ssp.master.fmi3).
+    """Why this master cannot run the FMU of model description `md` (FMPy's), or None: FMI 1.0,
+    2.0 and 3.0 co-simulation FMUs run (FMI 1.0 through system_ssp.master.fmi1, FMI 3.0 through
+    system_ssp.master.fmi3)."""
+    if not md.fmiVersion.startswith(("1.", "2.", "3.")):
+        return f"is an FMI {md.fmiVersion} FMU; this master runs FMI 1.0, 2.0 and 3.0 co-simulation FMUs"
+    if md.coSimulation is None:
+        return (f"is an FMI {md.fmiVersion} model-exchange FMU; this master runs co-simulation FMUs (export it for "
+                "co-simulation, with its own solver)")
+    return None
 
-    FMI 1.0 is refused rather than imported: it was superseded by FMI 2.0 in 2014, the tools our
-    users export from (Dymola, OpenModelica, Simulink, 20-sim) all write FMI 2.0 or 3.0, and its
-    co-simulation API differs in every call (instantiate, initialize, no state, no dependencies)."""
-    kind = "co-simulation" if md.coSimulation is not None else "model-exchange"
-    if md.fmiVersion == "2.0":
-        if md.coSimulation is None:
-            return ("is an FMI 2.0 model-exchange FMU; this master runs co-simulation FMUs (export it for "
-                    "co-simulation, with its own solver)")
+
+def undeclared_dependencies_warning(info, label):
+    """The one warning for an FMU with inputs that does not declare on which of them some of its
+    outputs depend, or None."""
+    if not info.undeclared:
         return None
-    if md.fmiVersion.startswith("3."):
-        if md.coSimulation is None:
-            return (f"is an FMI {md.fmiVersion} {kind} FMU; this master runs co-simulation FMUs (export it for "
-                    "co-simulation, with its own solver)")
-        return None
-    if md.fmiVersion.startswith("1."):
-        return (f"is an FMI {md.fmiVersion} {kind} FMU; this master runs FMI 2.0 and 3.0 co-simulation FMUs and "
-                "does not import FMI 1.0 (superseded in 2014): export it as FMI 2.0 or 3.0")
-    return (f"is an FMI {md.fmiVersion} {kind} FMU; this master runs FMI 2.0 and 3.0 co-simulation FMUs")
+    where = "DirectDependency" if info.fmi1 else ("ModelStructure/Outputs" if not info.fmi3_md else "ModelStructure")
+    some = ", ".join(info.undeclared[:4]) + (f" and {len(info.undeclared) - 4} more" if len(info.undeclared) > 4
+                                            else "")
+    return (f"{label}: declares no output dependencies ({where}) for {len(info.undeclared)} of its outputs ({some}): "
+            "each is taken to depend directly on every input, so Gauss-Seidel steps the components feeding it first "
+            "and a loop through it is an algebraic loop")
 
 
-def load_components(desc, extract_root, namer, validate):
-    """[ComponentInfo] for the SSD's components: model descriptions read (and schema-checked
-    when `validate`), FMUs extracted under `extract_root`, connectors checked against the FMUs."""
+def load_components(desc, extract_root, namer, validate, strict=False, warnings=None):
+    """[ComponentInfo] for the SSD's components: model descriptions read (and checked when
+    `validate`: leniently, a warning naming what was let through, unless `strict`; see
+    system_ssp.ssp.model_description), FMUs extracted under `extract_root`, connectors checked
+    against the FMUs. Every warning is logged and appended to `warnings`."""
     comps = []
     for i, decl in enumerate(desc.components):
         if not decl.fmu_path.is_file():
@@ -110,17 +139,19 @@ def load_components(desc, extract_root, namer, validate):
                            f"(source={decl.source!r}, tried {namer(decl.fmu_path)}); the product's "
                            "systems are packed with their FMUs into the build folder by `neighbor-cosim build` (python "
                            "build_fmus.py in a checkout); name one by its name, e.g. `detumble`")
-        unzipdir = str(archive.extract(decl.fmu_path, extract_root / f"{i}_{decl.name}",
-                                       f"component {decl.name!r}: {namer(decl.fmu_path)}"))
-        try:
-            md = read_model_description(unzipdir, validate=validate)
-        except Exception as exc:  # fmpy raises various exceptions for broken FMUs
-            raise SSPError(f"component {decl.name!r}: cannot read the model description of "
-                           f"{namer(decl.fmu_path)}: {exc}") from None
+        label = f"component {decl.name!r}: {namer(decl.fmu_path)}"
+        unzipdir = str(archive.extract(decl.fmu_path, extract_root / f"{i}_{decl.name}", label))
+        md, warning = model_description.read(unzipdir, label, validate, strict)
         refusal = unsupported_fmu(md)
         if refusal:
-            raise SSPError(f"component {decl.name!r}: {namer(decl.fmu_path)} {refusal}")
+            raise SSPError(f"{label} {refusal}")
+        _refuse_duplicate_names(md, label)
         info = ComponentInfo(i, decl, md, unzipdir)
+        for text in (warning, undeclared_dependencies_warning(info, label)):
+            if text:
+                LOG.warning("%s", text)
+                if warnings is not None:
+                    warnings.append(text)
         for cname, conn in decl.connectors.items():
             v = info.vars.get(cname)
             if v is None and info.whole(cname):  # an array connector: its elements' type is checked
@@ -134,6 +165,18 @@ def load_components(desc, extract_root, namer, validate):
                                f"FMU variable is {v.type}")
         comps.append(info)
     return comps
+
+
+def _refuse_duplicate_names(md, label):
+    """Two variables of one name: no connection, value or recorded column could say which is meant,
+    so no option runs it (FMPy's validation finds it too; this also holds without validation)."""
+    first = {}
+    for v in md.modelVariables:
+        if v.name in first and v is not first[v.name] and getattr(v, "alias", None) is None:
+            raise SSPError(f"{label}: its modelDescription.xml declares the variable {v.name!r} twice (lines "
+                           f"{first[v.name].sourceline} and {v.sourceline}): a connection, a value or a result column "
+                           "could not say which is meant")
+        first.setdefault(v.name, v)
 
 
 def _fmi3_connector_type(connector_type, info, v):

@@ -2,9 +2,10 @@
 conversion and transformation folded into one affine map (or an Integer/Boolean mapping), and
 the direct-feedthrough graph that orders Gauss-Seidel steps."""
 import dataclasses
+import logging
 from typing import NamedTuple, Optional
 
-from ..errors import SSPError
+from ..errors import SSPError, option
 from ..ssp.units import BUILTIN, conversion, describe
 from .graph import toposort
 from .names import near
@@ -13,6 +14,7 @@ NUMERIC = ("Real", "Integer", "Boolean", "Enumeration")
 # how a variable's value travels and is recorded: Enumerations as Integers
 KIND = {"Real": "Real", "Integer": "Integer", "Enumeration": "Integer", "Boolean": "Boolean", "String": "String"}
 RECORDABLE = NUMERIC + ("String",)
+LOG = logging.getLogger("system_ssp.master")
 
 
 class Link(NamedTuple):
@@ -37,17 +39,32 @@ class UnitTable:
     def __init__(self, desc, comps):
         self.desc = desc
         self.comps = comps
+        self.bracketed = set()  # "[m]"-style unit names read as their content (warned once each)
 
     def unit(self, name, comp=None, extra=None, where=""):
         if name is None:
             return None
+        found = self._lookup(name, comp, extra)
+        if found is None and len(name) > 2 and name[0] == "[" and name[-1] == "]":
+            # CAD tools write a parameter's unit in brackets ("[m]" beside an ssc:Unit "m" in the same
+            # file, as a parameter set of OMSimulator's test suite has it): read as the unit inside
+            found = self._lookup(name[1:-1], comp, extra)
+            if found is not None and name not in self.bracketed:
+                self.bracketed.add(name)
+                LOG.warning("%s: unit %r has no definition; read as %r (the unit in brackets, as CAD tools write it)",
+                            where, name, name[1:-1])
+        if found is None:
+            raise SSPError(f"{where}: unit {name!r} has no definition (add it to ssd:Units)")
+        return found
+
+    def _lookup(self, name, comp, extra):
         for table in (extra or {}, self.desc.units, comp.unit_defs if comp else {}, BUILTIN):
             if name in table:
                 return table[name]
         for c in self.comps:
             if name in c.unit_defs:
                 return c.unit_defs[name]
-        raise SSPError(f"{where}: unit {name!r} has no definition (add it to ssd:Units)")
+        return None
 
     def convert(self, a, b, comp_a, comp_b, where):
         """(factor, offset) from unit name a to unit name b; identity if either is unknown."""
@@ -365,7 +382,17 @@ class FeedthroughGraph:
         components of an algebraic loop."""
         order, cycle = toposort(len(self.comps), self.edges)
         if cycle:
-            names = " -> ".join(self.comps[i].name for i in cycle)
-            raise SSPError(f"algebraic loop (direct feedthrough cycle) between components: {names}; "
-                           "Gauss-Seidel needs an acyclic order: break the loop or use algorithm='jacobi'")
+            raise SSPError(f"algebraic loop (direct feedthrough cycle) between components: {self.describe(cycle)}; "
+                           "Gauss-Seidel needs an acyclic order: break the loop or use "
+                           f"{option('--algorithm jacobi', 'algorithm=' + repr('jacobi'))}")
         return order
+
+    def describe(self, cycle):
+        """The components of a feedthrough cycle, and those of them whose FMUs declare no output
+        dependencies (which may be all that makes it a loop)."""
+        names = " -> ".join(self.comps[i].name for i in cycle)
+        silent = [self.comps[i].name for i in dict.fromkeys(cycle) if self.comps[i].undeclared]
+        if silent:
+            names += (f" ({', '.join(silent)} declare{'s' if len(silent) == 1 else ''} no output dependencies, so each "
+                      "output is taken to depend on every input)")
+        return names

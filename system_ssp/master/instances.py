@@ -24,6 +24,7 @@ import numpy as np
 
 from ..errors import SimulationError, SSPError
 from .connections import KIND
+from .fmi1 import Fmi1Calls
 from .fmi3 import Fmi3Calls
 from .graph import toposort
 
@@ -34,6 +35,8 @@ SET = {"Real": "fmi2SetReal", "Integer": "fmi2SetInteger", "Boolean": "fmi2SetBo
 FMI3_CALLS = {"fmi2GetReal": "fmi3GetFloat64", "fmi2SetReal": "fmi3SetFloat64", "fmi2GetInteger": "fmi3GetInt32",
               "fmi2SetInteger": "fmi3SetInt32", "fmi2Instantiate": "fmi3InstantiateCoSimulation",
               "fmi2SetupExperiment": "fmi3EnterInitializationMode"}
+FMI1_CALLS = {"fmi2Instantiate": "fmiInstantiateSlave", "fmi2ExitInitializationMode": "fmiInitializeSlave",
+              "fmi2Terminate": "fmiTerminateSlave"}
 STATUS = ["ok", "warning", "discard", "error", "fatal", "pending"]
 # FMU messages also go to Python logging ("system_ssp.fmu"), at these levels per FMI status; with
 # INFO enabled there, the FMUs are instantiated with logging on.
@@ -131,9 +134,10 @@ class FmuInstance:
         self.failed_status = None  # the FMI status of a failed call (3 error, 4 fatal), once one failed
         md = info.md
         self.fmi3 = info.fmi3_md is not None
-        if self.fmi3:  # FMI 3.0 behind the FMI 2.0 calls the table makes (system_ssp.master.fmi3)
+        self.fmi1 = info.fmi1
+        if self.fmi3 or self.fmi1:  # behind the FMI 2.0 calls the table makes (system_ssp.master.fmi3, .fmi1)
             self.callbacks = (_MESSAGES, _MESSAGES.register(self))
-            self.fmu = Fmi3Calls(info, info.name)
+            self.fmu = (Fmi3Calls if self.fmi3 else Fmi1Calls)(info, info.name)
             self.fn = self.fmu.fn
             return
         self.callbacks = _MESSAGES.callbacks(self)
@@ -156,7 +160,7 @@ class FmuInstance:
                 pass
         if self.instantiated and self.failed_status != 4:
             try:
-                fmu.free_instance() if self.fmi3 else fmu.fmi2FreeInstance(fmu.component)
+                fmu.free_instance() if self.fmi3 or self.fmi1 else fmu.fmi2FreeInstance(fmu.component)
             except Exception:
                 pass
         if self.failed_status != 4 and _unloadable(self.info.unzipdir):
@@ -168,7 +172,7 @@ class FmuInstance:
     def function(self, name, vr, n):
         """The FMI call `name` (by its FMI 2.0 name) for the value reference block `vr[:n]`, which
         the caller keeps: FMPy's loaded function, or for FMI 3.0 one prepared for the block."""
-        return self.fmu.specialized(name, vr, n) if self.fmi3 else self.fn[name]
+        return self.fmu.specialized(name, vr, n) if self.fmi3 or self.fmi1 else self.fn[name]
 
     def take_messages(self):
         msgs = self.messages
@@ -433,6 +437,8 @@ class InstanceTable:
         detail = f": {text}" if text else ""
         if inst.fmi3:  # the calls are made under FMI 2.0 names (system_ssp.master.fmi3): say the FMI 3.0 ones
             call = FMI3_CALLS.get(call, call.replace("fmi2", "fmi3"))
+        elif inst.fmi1:
+            call = FMI1_CALLS.get(call, call.replace("fmi2", "fmi"))
         if names:
             shown = ", ".join(names[:6]) + (f" and {len(names) - 6} more" if len(names) > 6 else "")
             call = f"{call} of {shown}"
@@ -443,6 +449,8 @@ class InstanceTable:
         ended the simulation (fmi2Terminated): the time it reached (fmi2LastSuccessfulTime, or
         the communication point the step started from when it does not say), else None."""
         fmu = self.instances[ci].fmu
+        if self.instances[ci].fmi1:  # FMI 1.0 has no fmiTerminated: a discarded step is a failed one
+            return None
         if self.instances[ci].fmi3:  # FMI 3.0 said so in fmi3DoStep (terminateSimulation)
             reached = fmu.terminated
             return None if reached is None else (reached if np.isfinite(reached) and reached >= self.t else self.t)
@@ -689,8 +697,15 @@ class InstanceTable:
         for _ in range(passes):
             for ci in order:
                 self.set(ci)
+                inst = self.instances[ci]
+                if inst.fmi1 and not inst.fmu.initialized:
+                    # FMI 1.0 has no initialization mode: fmiInitializeSlave once its inputs have
+                    # their values, so that what it gives the components after it is initialized
+                    self.call(ci, "fmi2ExitInitializationMode", inst.fmu.exitInitializationMode)
                 self.get(ci)
         for ci, inst in enumerate(self.instances):
+            if inst.fmi1:
+                continue
             self.call(ci, "fmi2ExitInitializationMode", inst.fmu.exitInitializationMode)
         for _ in range(passes):
             for ci in order:

@@ -88,6 +88,44 @@ def settable(v):
     return v.causality in ("parameter", "input") or v.initial in ("exact", "approx")
 
 
+def _convert_unit(system, value, unit, target, comp, units, where):
+    """`value` in `unit` as a value in unit `target` (either None: unchanged)."""
+    if unit is None or target is None or unit == target:
+        return value
+    su = system.units.unit(unit, comp, units, where)
+    tu = system.units.unit(target, comp, None, where)
+    conv = conversion(su, tu)
+    if conv is None:
+        raise SSPError(f"{where}: value in unit {unit!r} ({describe(su)}) cannot be converted to the "
+                       f"variable's unit {target!r} ({describe(tu)})")
+    return conv[0] * value + conv[1]
+
+
+def transformed(system, pv, target_unit, comp, where):
+    """(value, unit) of a parameter value `pv` that an .ssm entry maps with a LinearTransformation:
+    converted to `target_unit` first, then transformed (SSP 1.0 section 7), or transformed in its
+    own unit when the entry suppresses the unit conversion; pv's own (value, unit) otherwise."""
+    if pv.transform is None:
+        return pv.value, pv.unit
+    _, factor, offset = pv.transform
+    if pv.suppress:
+        return factor * pv.value + offset, target_unit
+    value = _convert_unit(system, pv.value, pv.unit, target_unit, comp, pv.units, where)
+    return factor * value + offset, target_unit if pv.unit is not None else None
+
+
+def _component_value(system, comp, var, pv):
+    """(value, unit) of a bound or file value `pv` for comp.var, transformed when its .ssm entry
+    has a LinearTransformation (to a Real or Integer variable only)."""
+    if pv.transform is None:
+        return pv.value, pv.unit
+    v = comp.vars.get(var)
+    if v is not None and v.type not in ("Real", "Integer"):
+        raise SSPError(f"{pv.origin}: {comp.name}.{var}: a LinearTransformation maps a value to a {v.type} variable")
+    return transformed(system, pv, system.units.var_unit(comp, var) if v is not None else None, comp,
+                       f"{pv.origin}: {comp.name}.{var}")
+
+
 def resolve_parameter(system, comp, var, value, vtype=None, unit=None, units=None, origin="", label=None):
     """Check one value for comp.var; returns the value converted to the FMU's type and unit."""
     label = label or f"{comp.name}.{var}"
@@ -110,15 +148,7 @@ def resolve_parameter(system, comp, var, value, vtype=None, unit=None, units=Non
             raise SSPError(f"{where}: value {value!r} of type {vtype} given, but the variable has type {v.type}")
     value = coerce(value, v.type, where)
     if unit is not None and v.type == "Real":
-        target = system.units.var_unit(comp, var)
-        if target is not None and target != unit:
-            su = system.units.unit(unit, comp, units, where)
-            tu = system.units.unit(target, comp, None, where)
-            conv = conversion(su, tu)
-            if conv is None:
-                raise SSPError(f"{where}: value in unit {unit!r} ({describe(su)}) cannot be converted to the "
-                               f"variable's unit {target!r} ({describe(tu)})")
-            value = conv[0] * value + conv[1]
+        value = _convert_unit(system, value, unit, system.units.var_unit(comp, var), comp, units, where)
     return value
 
 
@@ -143,13 +173,23 @@ def read_parameter_set(system, ps):
 
 def collect_parameters(system, parameter_sets=None, parameters=None):
     """All start values for a run: {(comp index, var): value}, later sources overriding earlier:
-    the SSD's component bindings, the root system's bindings, `parameter_sets`, `parameters`."""
+    the SSD's component bindings, the (nested, then root) systems' bindings, `parameter_sets`,
+    `parameters`. One exception, as OMSimulator has it: among the SSD's bindings, a system
+    parameter connected to a component variable wins over a value bound to that variable directly,
+    wherever either is bound (docs/master.md, "Parameters")."""
     out = {}
     fan_out = system.parameter_links
+    from_system = {}  # (comp index, var) -> the system parameter that gave its value in the SSD's bindings
+    in_ssd = [True]  # still reading the SSD's own bindings (the caller's values come after, and win)
 
     def put(comp, var, pv):
-        out[(comp.index, var)] = resolve_parameter(system, comp, var, pv.value, pv.type, pv.unit, pv.units,
-                                                   pv.origin, f"{comp.name}.{var}")
+        if in_ssd[0] and (comp.index, var) in from_system:
+            LOG.info("%s: %s.%s = %r not applied: system parameter %r is connected to it and gives its value",
+                     pv.origin, comp.name, var, pv.value, from_system[(comp.index, var)])
+            return
+        value, unit = _component_value(system, comp, var, pv)
+        out[(comp.index, var)] = resolve_parameter(system, comp, var, value, pv.type, unit, pv.units, pv.origin,
+                                                   f"{comp.name}.{var}")
 
     def put_system(name, value, vtype=None, unit=None, units=None, origin=""):
         """A system parameter (an SSD system connector of kind parameter, or of kind input that
@@ -160,6 +200,8 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
             out[(comp.index, var)] = resolve_parameter(
                 system, comp, var, value, vtype, unit if unit is not None else connector.unit, units, origin,
                 f"{name} (system parameter) -> {comp.name}.{var}")
+            if in_ssd[0]:
+                from_system[(comp.index, var)] = name
 
     def named(name, where):
         """(component, variable) of a 'component.variable' name, or None for a system parameter."""
@@ -177,8 +219,10 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
             target = named(pv.name, where)
         except SSPError as exc:
             raise SSPError(f"{pv.origin}: {exc}") from None
-        if target is None:
-            put_system(pv.name, pv.value, pv.type, pv.unit, pv.units, pv.origin)
+        if target is None:  # transformed by its .ssm entry (if any) in the connector's unit
+            value, unit = transformed(system, pv, system.desc.system_connectors[pv.name].unit, None,
+                                      f"{pv.origin}: {pv.name} (system parameter)")
+            put_system(pv.name, value, pv.type, unit, pv.units, pv.origin)
         else:
             put(*target, pv)
 
@@ -190,6 +234,7 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
             put(comp, pv.name, pv)
     for pv in system.desc.parameters:
         put_named(pv, "parameter")
+    in_ssd[0] = False
     for ps in parameter_sets or []:
         for pv in read_parameter_set(system, ps):
             put_named(pv, "parameter")
@@ -201,3 +246,31 @@ def collect_parameters(system, parameter_sets=None, parameters=None):
             comp, var = target
             out[(comp.index, var)] = resolve_parameter(system, comp, var, value, None, None, None, "", name)
     return out
+
+
+def unmapped_warnings(system):
+    """One warning per parameter binding whose mapping leaves out parameters that name something
+    in the system: SSP 1.0 section 7 has them not applied (and the master does not apply them),
+    OMSimulator applies them by their names. Parameters that name nothing (a CAD tool's set, of
+    which the mapping takes a few) are left out without a word."""
+    texts = []
+    for origin, comp_name, names in system.desc.unmapped:
+        if comp_name is not None:
+            named = [n for n in names if n in system.by_name[comp_name].vars]
+        else:
+            named = [n for n in names if n in system.parameter_links or _names_a_variable(system, n)]
+        if named:
+            shown = ", ".join(named[:5]) + (f" and {len(named) - 5} more" if len(named) > 5 else "")
+            texts.append(f"{origin}: the parameter mapping of this binding leaves out {len(named)} parameter"
+                         f"{'s' if len(named) > 1 else ''} of its set that name{'' if len(named) > 1 else 's'} "
+                         f"a variable ({shown}): not applied, as SSP 1.0 section 7 says (OMSimulator applies them by "
+                         "their names; add mapping entries to apply them)")
+    return texts
+
+
+def _names_a_variable(system, name):
+    try:
+        split_name(system.comps, name, "parameter")
+    except SSPError:
+        return False
+    return True

@@ -3,7 +3,7 @@ import math
 import numbers
 from typing import Any, Optional
 
-from ..errors import SSPError
+from ..errors import SSPError, option
 from ..ssp.reader import ANNOTATION_TYPE, CONDITION_CAUSALITIES
 from .connections import KIND, RECORDABLE
 from .graph import toposort
@@ -45,10 +45,9 @@ def _order(system, order, algo):
         if algo == "gauss-seidel":
             _, cycle = toposort(len(names), system.graph.edges)
             if cycle:  # no order of a feedthrough cycle gives every input this step's value
-                loop = " -> ".join(names[i] for i in cycle)
                 raise SSPError(f"{where} {order}: the components form an algebraic loop (direct feedthrough "
-                               f"cycle) {loop}, which no Gauss-Seidel order resolves (use algorithm jacobi, or "
-                               "break the loop)")
+                               f"cycle) {system.graph.describe(cycle)}, which no Gauss-Seidel order resolves (use "
+                               f"{option('--algorithm jacobi', 'algorithm=' + repr('jacobi'))}, or break the loop)")
         return [system.by_name[o].index for o in order]
     if algo == "gauss-seidel":
         return system.graph.order()

@@ -17,7 +17,7 @@ from .connections import (FeedthroughGraph, UnitTable, check_connector_units, pa
 from .execution import execute
 from .info import describe_system
 from .names import split_name
-from .parameters import collect_parameters
+from .parameters import collect_parameters, unmapped_warnings
 from .observers import Observer
 from .plan import RunOptions
 from .planning import make_plan
@@ -37,19 +37,25 @@ class System:
     SSD, SSV and SSM files against the SSP 1.0 schemas (`validate`), reads every FMU's model
     description, extracts the FMUs, resolves the connections with their unit conversions and
     the direct-feedthrough graph. Use as a context manager (or call `close()`) to delete the
-    extracted files."""
+    extracted files.
 
-    def __init__(self, path: PathLike, validate: bool = True, scratch: Optional[PathLike] = None):
+    A model description with problems that do not change the run (system_ssp.ssp.model_description
+    lists them) is read with one warning per FMU, logged and kept in `warnings` with the other
+    warnings of loading (FMUs that declare no output dependencies); `strict` refuses it instead."""
+
+    def __init__(self, path: PathLike, validate: bool = True, scratch: Optional[PathLike] = None,
+                 strict: bool = False):
         # scratch: the folder to extract into (default: the system's temporary folder)
         tmp = Path(tempfile.mkdtemp(prefix="system_ssp_", dir=scratch))
         self._tmp: Optional[Path] = tmp
+        self.warnings: List[str] = []
         try:
-            self._load(builder.resolve_system(str(path)), validate, tmp)
+            self._load(builder.resolve_system(str(path)), validate, strict, tmp)
         except BaseException:
             self.close()
             raise
 
-    def _load(self, path: Path, validate: bool, tmp: Path) -> None:
+    def _load(self, path: Path, validate: bool, strict: bool, tmp: Path) -> None:
         self.path = path
         self.validate = validate
         self.archive_root = None
@@ -70,7 +76,7 @@ class System:
         self.desc = reader.parse_ssd(ssd_path, self.namer, validate)
         if not self.desc.components:
             raise SSPError(f"{self.desc.display}: the system has no components")
-        self.comps = load_components(self.desc, tmp / "fmu", self.namer, validate)
+        self.comps = load_components(self.desc, tmp / "fmu", self.namer, validate, strict, self.warnings)
         self.by_name = {c.name: c for c in self.comps}
         self.units = UnitTable(self.desc, self.comps)
         check_connector_units(self.comps, self.units)
@@ -83,6 +89,9 @@ class System:
                     raise SSPError(f"{origin}: {comp.name}.{var} gets the value of system input {name!r} and is "
                                    "also connected to an output: an input is fed by one connection")
         self.graph = FeedthroughGraph(self.comps, self.links)
+        for text in unmapped_warnings(self):
+            LOG.warning("%s", text)
+            self.warnings.append(text)
 
     # ---- queries ------------------------------------------------------------------------
     def default_order(self) -> List[str]:
@@ -190,12 +199,13 @@ def run_options(options: Optional[RunOptions], settings: Mapping[str, Any]) -> R
     return dataclasses.replace(base, **settings) if settings else base
 
 
-def simulate(path: PathLike, options: Optional[RunOptions] = None, *, validate: bool = True,
+def simulate(path: PathLike, options: Optional[RunOptions] = None, *, validate: bool = True, strict: bool = False,
              observers: Sequence[Observer] = (), output_file: Optional[PathLike] = None, progress: bool = False,
              timeout: Optional[float] = None, real_time: Optional[float] = None, stop_on_overrun: bool = False,
              **settings: Any) -> Result:
     """Load and run an SSP system; returns a `Result`. `validate` checks the files against the
-    SSP schemas; the rest as `System.run` (keyword settings: the fields of `RunOptions`)."""
-    with System(path, validate=validate) as system:
+    SSP schemas and the FMUs' model descriptions, `strict` refuses an FMU whose description has any
+    problem (see `System`); the rest as `System.run` (keyword settings: the fields of `RunOptions`)."""
+    with System(path, validate=validate, strict=strict) as system:
         return system.run(options, observers=observers, output_file=output_file, progress=progress, timeout=timeout,
                           real_time=real_time, stop_on_overrun=stop_on_overrun, **settings)

@@ -86,8 +86,11 @@ def _local(el):
 
 # A parameter value from an .ssv (or the caller), before it is matched to an FMU variable.
 # type: "Real" | "Integer" | "Boolean" | "String" | "Enumeration"; unit: unit name or None;
-# units: dict of Unit defined next to the value (the .ssv's ssv:Units); origin: "file:line".
-ParamValue = namedtuple("ParamValue", "name type value unit units origin")
+# units: dict of Unit defined next to the value (the .ssv's ssv:Units); origin: "file:line";
+# transform: an .ssm entry's LinearTransformation ("linear", factor, offset), applied by the master
+# after the unit conversion to the target (SSP 1.0 section 7), or instead of it when the entry
+# says suppressUnitConversion (`suppress`).
+ParamValue = namedtuple("ParamValue", "name type value unit units origin transform suppress", defaults=(None, False))
 
 
 @dataclass
@@ -162,6 +165,9 @@ class SystemDescription:
     stop_time: Optional[float] = None
     parameters: list = field(default_factory=list)  # root-system bindings, names comp.var
     master: MasterSettings = field(default_factory=MasterSettings)
+    # the parameters of bindings with a mapping that the mapping leaves out, not applied (SSP 1.0
+    # section 7): [(binding's file:line, component name or None for a system level, [names])]
+    unmapped: list = field(default_factory=list)
 
     def component(self, name):
         for c in self.components:
@@ -323,14 +329,10 @@ def parse_ssv(root, namer):
     units = parse_units(root.find("ssv:Units", NS), namer)
     values = []
     ssp2 = (root.get("version") or "").strip().startswith("2")
-    seen = {}  # name -> line: a name twice in one set is refused (which one was meant?)
     params = root.find("ssv:Parameters", NS)
     for p in ([] if params is None else params.findall("ssv:Parameter", NS)):
         origin = f"{display}:{p.sourceline}"
         name = _required(p, "name", origin)
-        if name in seen:
-            raise SSPError(f"{origin}: parameter {name!r} is already set on line {seen[name]} of this parameter set")
-        seen[name] = p.sourceline
         tv = None
         for child in p:
             if not isinstance(child.tag, str) or etree.QName(child).namespace not in (NS_SSV, NS_SSC):
@@ -368,6 +370,19 @@ def parse_ssv(root, namer):
     return values
 
 
+def refuse_duplicates(values):
+    """A name set twice in one parameter set is refused when the set applies it (which value was
+    meant?); a CAD tool's set may repeat parameters its mapping leaves out (system_ssp.ssp
+    parse_bindings only checks what it applies)."""
+    seen = {}
+    for v in values:
+        if v.name in seen:
+            line = seen[v.name].origin.rpartition(":")[2]
+            raise SSPError(f"{v.origin}: parameter {v.name!r} is already set on line {line} of this parameter set")
+        seen[v.name] = v
+    return values
+
+
 def parse_ssm(root, namer):
     """An ssm:ParameterMapping element -> {source name: [(target name, transform, suppress, origin)]}.
 
@@ -389,15 +404,19 @@ def parse_ssm(root, namer):
     return mapping
 
 
-def _apply_transform(transform, value, kind, origin, name):
+def _mapped(v, target, transform, suppress, morigin):
+    """The value `v` of a parameter set as an .ssm entry (at `morigin`) maps it to `target`: an
+    Integer/Boolean/Enumeration mapping applied now, a LinearTransformation left to the master
+    (after the unit conversion, which needs the target's unit)."""
+    origin = f"{v.origin} (mapped by {morigin})"
     if transform is None:
-        return value
+        return v._replace(name=target, origin=origin)
     if transform[0] == "linear":
-        if kind not in ("Real", "Integer"):
-            raise SSPError(f"{origin}: LinearTransformation on {kind} parameter {name!r}")
-        return transform[1] * float(value) + transform[2]
-    mapping = transform[1]
-    return mapping.get(value, value)
+        if v.type not in ("Real", "Integer"):
+            raise SSPError(f"{morigin}: LinearTransformation on {v.type} parameter {v.name!r}")
+        return v._replace(name=target, type="Real", value=float(v.value), origin=origin, transform=transform,
+                          suppress=suppress)
+    return v._replace(name=target, value=transform[1].get(v.value, v.value), origin=origin)
 
 
 def _referenced_or_inline(el, inline_path, kind, parse, what, origin, namer, base_dir, component_dir, validate):
@@ -413,8 +432,14 @@ def _referenced_or_inline(el, inline_path, kind, parse, what, origin, namer, bas
     return None if inline is None else parse(inline, namer)
 
 
-def parse_bindings(el, namer, base_dir, validate, component_dir=None):
-    """ssd:ParameterBindings under a component or system -> [ParamValue] (prefixed, mapped)."""
+def parse_bindings(el, namer, base_dir, validate, component_dir=None, unmapped=None):
+    """ssd:ParameterBindings under a component or system -> [ParamValue] (prefixed, mapped).
+
+    A binding with a parameter mapping applies the parameters its entries map, under the names
+    they map them to, and no other (SSP 1.0 section 7: "All parameters of the parameter source
+    which are not referenced in a mapping entry will not be applied"); those left out are listed in
+    `unmapped` as (binding's file:line, [names]). An entry whose source the parameter set does not
+    have maps nothing: refused with the entry's file and line."""
     out = []
     bindings = el.find("ssd:ParameterBindings", NS)
     if bindings is None:
@@ -434,17 +459,26 @@ def parse_bindings(el, namer, base_dir, validate, component_dir=None):
         if m is not None:
             mapping = _referenced_or_inline(m, "ssm:ParameterMapping", "ssm", parse_ssm, "parameter mapping",
                                             origin, namer, base_dir, component_dir, validate)
-        mapping = mapping or {}
         prefix = b.get("prefix", "")
+        values = [v._replace(name=prefix + v.name) for v in values]
+        if mapping is None:
+            out.extend(refuse_duplicates(values))
+            continue
+        refuse_duplicates([v for v in values if v.name in mapping])
+        by_name = {v.name: v for v in values}
+        for source, entries in mapping.items():
+            if source not in by_name:
+                target, morigin = entries[0][0], entries[0][3]
+                close = difflib.get_close_matches(source, list(by_name), n=3, cutoff=0.6)
+                hint = f" (did you mean {', '.join(map(repr, close))}?)" if close else ""
+                raise SSPError(f"{morigin}: mapping entry {source!r} -> {target!r} maps nothing: the parameter set "
+                               f"bound at {origin} has no parameter {source!r}{hint}")
         for v in values:
-            name = prefix + v.name
-            if name not in mapping:
-                out.append(v._replace(name=name))
-                continue
-            for target, transform, _suppress, morigin in mapping[name]:
-                value = _apply_transform(transform, v.value, v.type, morigin, name)
-                kind = "Real" if (transform and transform[0] == "linear") else v.type
-                out.append(v._replace(name=target, value=value, type=kind, origin=f"{v.origin} (mapped by {morigin})"))
+            for target, transform, suppress, morigin in mapping.get(v.name, ()):
+                out.append(_mapped(v, target, transform, suppress, morigin))
+        left_out = [v.name for v in values if v.name not in mapping]
+        if left_out and unmapped is not None:
+            unmapped.append((origin, left_out))
     return out
 
 
@@ -676,11 +710,15 @@ def _parse_system(system, path, desc, namer, base_dir, validate):
         source = _required(el, "source", origin)
         comp = Component(name=name, source=source, fmu_path=resolve_uri(source, base_dir), type=ctype,
                          connectors=_parse_connectors(el, namer), origin=origin)
-        comp.parameters = parse_bindings(el, namer, base_dir, validate, component_dir=None)
+        left_out = []
+        comp.parameters = parse_bindings(el, namer, base_dir, validate, component_dir=None, unmapped=left_out)
+        desc.unmapped += [(origin, name, names) for origin, names in left_out]
         desc.components.append(comp)
 
+    left_out = []
     desc.parameters.extend(v._replace(name=prefix + v.name)
-                           for v in parse_bindings(system, namer, base_dir, validate))
+                           for v in parse_bindings(system, namer, base_dir, validate, unmapped=left_out))
+    desc.unmapped += [(origin, None, [prefix + n for n in names]) for origin, names in left_out]
 
     def end(element, connector, origin):
         """(element, connector) of a connection end in the flat description."""
@@ -735,5 +773,5 @@ def parse_ssd(ssd_path, namer, validate=True):
 
 def read_parameter_set_file(path, namer, validate=True):
     """A caller-supplied .ssv (names `component.variable`) -> [ParamValue]."""
-    return parse_ssv(load_xml(path, "ssv", namer, validate), namer)
+    return refuse_duplicates(parse_ssv(load_xml(path, "ssv", namer, validate), namer))
 

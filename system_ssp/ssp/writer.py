@@ -279,8 +279,8 @@ def single_fmu_system(fmu, folder):
     the FMU's model identifier; the FMU's DefaultExperiment (if any) becomes the system's.
     Returns the SSD's path."""
     fmu, folder = Path(fmu), Path(folder)
-    try:
-        md = read_model_description(str(fmu))
+    try:  # checked as a component when the system is loaded (leniently, or strictly)
+        md = read_model_description(str(fmu), validate=False)
     except Exception as exc:  # fmpy raises several kinds for a file that is not an FMU
         raise SSPError(f"{fmu}: not an FMU that can be read ({exc})") from None
     if md.coSimulation is None:

@@ -85,13 +85,20 @@ def add_console_arguments(ap, progress=True):
                     "FMUs run with logging on) or debug (also the traceback of an unexpected error)")
 
 
+def release_console():
+    """Remove the stderr handler `console_settings` added (the stream it holds may be gone after
+    the command: a caller's captured stderr)."""
+    log = logging.getLogger("system_ssp")
+    for handler in [h for h in log.handlers if getattr(h, "_neighbor_console", False)]:
+        log.removeHandler(handler)
+
+
 def console_settings(args):
     """Apply --log-level to the `system_ssp` loggers (one handler on stderr); True when the
     progress bar should show."""
     log = logging.getLogger("system_ssp")
     log.setLevel(getattr(logging, args.log_level.upper()))
-    for handler in [h for h in log.handlers if getattr(h, "_neighbor_console", False)]:
-        log.removeHandler(handler)
+    release_console()
     handler = logging.StreamHandler(sys.stderr)
     handler.setFormatter(logging.Formatter("%(levelname)s %(name)s: %(message)s"))
     handler._neighbor_console = True

@@ -1,27 +1,13 @@
 """Our Jacobi algorithm against libcosim's fixed-step algorithm (libcosim runs in a subprocess)."""
-import json
-import subprocess
-import sys
-
 import numpy as np
 import pytest
 
 from master_fixtures import helpers as h
-from paths import DATA, MASTER_FIXTURES
+from paths import DATA
 import system_ssp
 
 pytest.importorskip("libcosimpy")
-HELPER = MASTER_FIXTURES / "libcosim_run.py"
-
-
-def libcosim_rows(system, step, n, names, tmp_path):
-    """libcosim's values of `names` after each of `n` steps of `step` s ("file": the system's
-    own), run in a subprocess (see libcosim_run.py)."""
-    out = tmp_path / "libcosim.json"
-    proc = subprocess.run([sys.executable, str(HELPER), str(system), str(step), str(n), str(out), *names],
-                          capture_output=True, text=True, timeout=300)
-    assert proc.returncode == 0, proc.stderr[-3000:]
-    return np.array(json.loads(out.read_text()))
+libcosim_rows = h.libcosim_rows
 
 
 @pytest.fixture(scope="session")

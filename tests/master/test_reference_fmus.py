@@ -42,20 +42,6 @@ def test_stair_ends_the_run_where_it_asks(tmp_path, capsys):
     assert out.read_text().splitlines()[-2:] == ["8.8,9", "9.0,10"]
 
 
-def test_fmi1_fmus_are_refused_naming_the_version(tmp_path, capsys):
-    """FMI 1.0 is refused, not imported (components.unsupported_fmu says why; FMI 3.0 runs:
-    test_fmi3_master.py). One line naming the user's file (not a temporary copy) and the version,
-    exit 2."""
-    path = DATA / "reference_fmus" / "1.0" / "Dahlquist.fmu"
-    assert cli.main(["run", str(path), "--step-size", "0.1"]) == 2
-    err = capsys.readouterr().err.strip()
-    assert err == (f"error: {path} is an FMI 1.0 co-simulation FMU; this master runs FMI 2.0 and 3.0 co-simulation "
-                   "FMUs and does not import FMI 1.0 (superseded in 2014): export it as FMI 2.0 or 3.0")
-    ssd = single_fmu_system(path, tmp_path)  # as a component of a system
-    with pytest.raises(system_ssp.SSPError, match=r"component 'Dahlquist': .*Dahlquist.fmu is an FMI 1.0 "):
-        system_ssp.System(ssd)
-
-
 def test_every_fmi_type_through_two_reference_feedthroughs(tmp_path, capsys):
     """Real, Integer, Boolean, String and Enumeration, each through a chain of two Reference FMU
     Feedthroughs (outputs equal their inputs): VanDerPol's x0 and Stair's counter move; the

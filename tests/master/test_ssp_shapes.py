@@ -22,7 +22,7 @@ SSM_HEAD = ('<?xml version="1.0" encoding="UTF-8"?>\n<ssm:ParameterMapping versi
 
 def balls(tmp_path, system_head="", files=None):
     """Two Reference BouncingBalls, bb1 and bb2, unconnected."""
-    (tmp_path / "resources").mkdir()
+    (tmp_path / "resources").mkdir(parents=True)
     shutil.copy(FMUS / "BouncingBall.fmu", tmp_path / "resources" / "BouncingBall.fmu")
     for rel, text in (files or {}).items():
         (tmp_path / rel).write_text(text)
@@ -41,7 +41,9 @@ def fmpy_ball(stop, step, **start):
 def test_an_ssm_as_omsimulator_writes_it(tmp_path):
     """OMSimulator exports an SSM template with an entry per parameter whose source is empty, to be
     filled in by the user (its test suite's ECS_HW.ssm); one source may feed several targets. The
-    template entries map nothing; 'gravity' reaches both balls, halved for bb2."""
+    template entries map nothing; 'gravity' reaches both balls, halved for bb2. 'bb2.e', which the
+    mapping leaves out, is not applied (SSP 1.0 section 7), with a warning saying that
+    OMSimulator would apply it by its name."""
     ssm = (SSM_HEAD
            + '<ssm:MappingEntry source="" target="bb1.e"/>\n<ssm:MappingEntry source="" target="bb2.g"/>\n'
            + '<ssm:MappingEntry source="gravity" target="bb1.g"/>\n'
@@ -53,9 +55,14 @@ def test_an_ssm_as_omsimulator_writes_it(tmp_path):
     ssd = balls(tmp_path, bind, {"values.ssv": ssv, "mapping.ssm": ssm})
     with system_ssp.System(ssd) as system:
         params = {f"{system.comps[ci].name}.{var}": value for (ci, var), value in make_plan(system).params.items()}
-    assert params == {"bb1.g": -3.0, "bb2.g": -1.5, "bb2.e": 0.5}  # bb1.e keeps its start value 0.7
+        assert len(system.warnings) == 1
+        assert f"{ssd}:" in system.warnings[0]  # the binding's file and line
+        assert ("the parameter mapping of this binding leaves out 1 parameter of its set that names a variable "
+                "(bb2.e): not applied, as SSP 1.0 section 7 says (OMSimulator applies them by their names") \
+            in system.warnings[0]
+    assert params == {"bb1.g": -3.0, "bb2.g": -1.5}  # bb1.e and bb2.e keep their start value 0.7
     r = system_ssp.simulate(ssd, step_size=0.01, stop_time=1.0)
-    for name, start in (("bb1", {"g": -3.0}), ("bb2", {"g": -1.5, "e": 0.5})):
+    for name, start in (("bb1", {"g": -3.0}), ("bb2", {"g": -1.5})):
         expected = fmpy_ball(1.0, 0.01, **start)
         np.testing.assert_array_equal(r.data[f"{name}.h"], expected["h"])
     # by hand: free fall from 1 m under g until the first bounce at sqrt(2 / |g|) s
@@ -72,6 +79,138 @@ def test_an_ssm_entry_without_a_source_attribute_is_refused_by_line(tmp_path):
         system_ssp.System(ssd)
     with pytest.raises(SSPError, match=r"mapping.ssm:3: <MappingEntry> needs a source attribute"):
         system_ssp.System(ssd, validate=False)
+
+
+def test_a_cad_tools_parameter_set_of_which_the_mapping_takes_one(tmp_path, caplog):
+    """The shape of OMSimulator's embrace system (its test suite's ECS_HW.ssm and RAPID_Systems
+    .ssv): a CAD tool's parameter set (SSV version 2.0 in an SSP 1.0 system, hierarchical part
+    names, units written "[m]" beside an ssc:Unit "m") bound to the root system with an SSM that
+    maps one of its parameters to two components and leaves template entries (source "") for the
+    rest. The mapped value reaches both balls' heights (as OMSimulator prints pipeB.L and pipeA.L
+    equal to the part's pipe length); the CAD parameters the mapping leaves out name nothing here
+    and are not applied, without a word, even one the set gives twice with two values (its
+    embrace_TwoConf's set does); "[m]" is read as "m" with one warning. Before: "unknown component
+    'product_subAssembly1'". A parameter given twice that the mapping applies is refused."""
+    cad = "product_subAssembly1.part_testPipe1"
+    ssv = ('<?xml version="1.0" encoding="UTF-8"?>\n<ssv:ParameterSet '
+           'xmlns:ssv="http://ssp-standard.org/SSP1/SystemStructureParameterValues" '
+           'xmlns:ssc="http://ssp-standard.org/SSP1/SystemStructureCommon" version="2.0" name="product_mainAssembly">'
+           '<ssv:Parameters>'
+           f'<ssv:Parameter name="{cad}.parameterSet_inputParameters.parameter_pipeRadius">'
+           '<ssv:Real unit="[m]" value="0.005"/></ssv:Parameter>'
+           f'<ssv:Parameter name="{cad}.parameterSet_outputParameters.parameter_pipeLength">'
+           '<ssv:Real unit="[m]" value="0.976535328081166"/></ssv:Parameter>'
+           f'<ssv:Parameter name="{cad}.parameterSet_inputParameters.parameter_testInteger">'
+           '<ssv:Integer value="7"/></ssv:Parameter>'
+           f'<ssv:Parameter name="{cad}.geometricalSet_constructionGeometry.parameter_X">'
+           '<ssv:Real unit="[m]" value="0.05"/></ssv:Parameter>'
+           f'<ssv:Parameter name="{cad}.geometricalSet_constructionGeometry.parameter_X">'
+           '<ssv:Real unit="[m]" value="-0.0025"/></ssv:Parameter>'
+           '</ssv:Parameters><ssv:Units><ssc:Unit name="m"><ssc:BaseUnit m="1"/></ssc:Unit></ssv:Units>'
+           '</ssv:ParameterSet>\n')
+    ssm = (SSM_HEAD + '<ssm:MappingEntry source="" target="bb1.e"/>\n<ssm:MappingEntry source="" target="bb2.e"/>\n'
+           f'<ssm:MappingEntry source="{cad}.parameterSet_outputParameters.parameter_pipeLength" target="bb1.h"/>\n'
+           f'<ssm:MappingEntry source="{cad}.parameterSet_outputParameters.parameter_pipeLength" target="bb2.h"/>\n'
+           "</ssm:ParameterMapping>\n")
+    bind = ('<ssd:ParameterBindings><ssd:ParameterBinding source="resources/cad.ssv">'
+            '<ssd:ParameterMapping source="resources/ECS.ssm"/></ssd:ParameterBinding></ssd:ParameterBindings>')
+    ssd = balls(tmp_path, bind, {"resources/cad.ssv": ssv, "resources/ECS.ssm": ssm})
+    with system_ssp.System(ssd) as system:
+        assert system.warnings == []
+        r = system.run(step_size=0.01, stop_time=0.5)
+    assert r.data["bb1.h"][0] == r.data["bb2.h"][0] == 0.976535328081166
+    np.testing.assert_array_equal(r.data["bb1.h"], fmpy_ball(0.5, 0.01, h=0.976535328081166)["h"])
+    bracketed = [rec.getMessage() for rec in caplog.records if "'[m]'" in rec.getMessage()]
+    assert len(bracketed) == 1 and "cad.ssv:2 (mapped by " in bracketed[0] and "ECS.ssm:5)" in bracketed[0]
+    assert "unit '[m]' has no definition; read as 'm'" in bracketed[0]
+    twice = ssm.replace("parameterSet_outputParameters.parameter_pipeLength\" target=\"bb2.h",
+                        "geometricalSet_constructionGeometry.parameter_X\" target=\"bb2.h")
+    assert twice != ssm
+    (tmp_path / "resources" / "ECS.ssm").write_text(twice)
+    with pytest.raises(SSPError, match=r"cad.ssv:2: parameter 'product_subAssembly1.part_testPipe1."
+                                       r"geometricalSet_constructionGeometry.parameter_X' is already set on line 2"):
+        system_ssp.System(ssd)
+
+
+def test_an_ssm_entry_that_maps_nothing_is_refused_by_its_line(tmp_path):
+    """An entry whose source the parameter set does not have, and one whose target names no
+    variable: one line each, naming the .ssm file and the entry's line."""
+    bind = ('<ssd:ParameterBindings><ssd:ParameterBinding source="values.ssv">'
+            '<ssd:ParameterMapping source="mapping.ssm"/></ssd:ParameterBinding></ssd:ParameterBindings>')
+    ssv = h.ssv_text([("gravity", "Real", "-3", None)])
+    ssm = SSM_HEAD + '<ssm:MappingEntry source="gravty" target="bb1.g"/>\n</ssm:ParameterMapping>\n'
+    ssd = balls(tmp_path / "a", bind, {"values.ssv": ssv, "mapping.ssm": ssm})
+    with pytest.raises(SSPError, match=r"mapping.ssm:3: mapping entry 'gravty' -> 'bb1.g' maps nothing: the "
+                                       r"parameter set bound at .*SystemStructure.ssd:\d+ has no parameter 'gravty' "
+                                       r"\(did you mean 'gravity'\?\)"):
+        system_ssp.System(ssd)
+    ssm = SSM_HEAD + '<ssm:MappingEntry source="gravity" target="bb1.gg"/>\n</ssm:ParameterMapping>\n'
+    ssd = balls(tmp_path / "b", bind, {"values.ssv": ssv, "mapping.ssm": ssm})
+    with system_ssp.System(ssd) as system, pytest.raises(
+            SSPError, match=r"values.ssv:\d+ \(mapped by .*mapping.ssm:3\): .*component 'bb1' has no variable 'gg'"):
+        make_plan(system)
+
+
+def gain_alone(tmp_path, fmus, bind, files, ssp2=False):
+    """One fixture gain (y = k u + b, u and b in m), its inputs unconnected, bound by `bind`."""
+    text = h.ssd_text(h.component("gain", "gain.fmu", bindings=bind),
+                      experiment='<ssd:DefaultExperiment startTime="0" stopTime="1"/>\n')
+    if ssp2:
+        text = as_ssp2(text)
+        files = {name: as_ssp2(content) for name, content in files.items()}
+    return h.write_system(tmp_path, fmus, {"gain.fmu": "gain"}, text, extra_files=files)
+
+
+def test_mapping_entries_with_transformations_as_omsimulator_writes_them_in_ssp2(fixture_fmus, tmp_path):
+    """The shape of OMSimulator's LinearTransformation3 (SSP 2.0 system, parameter set and
+    mapping): two parameters mapped with a LinearTransformation each, to a gain's k and its
+    unconnected input u. OMSimulator prints k = 4 * 2 + 5 = 13, u = 2 * 2 + 10 = 14, y = 182."""
+    ssv = h.ssv_text([("mapped_Gain_u", "Real", "2.0", None), ("mapped_Gain_k", "Real", "2.0", None)])
+    ssm = (SSM_HEAD + '<ssm:MappingEntry source="mapped_Gain_u" target="u"><ssc:LinearTransformation factor="2" '
+           'offset="10"/></ssm:MappingEntry>\n<ssm:MappingEntry source="mapped_Gain_k" target="k">'
+           '<ssc:LinearTransformation factor="4" offset="5"/></ssm:MappingEntry>\n</ssm:ParameterMapping>\n')
+    bind = '<ssd:ParameterBinding source="m.ssv"><ssd:ParameterMapping source="m.ssm"/></ssd:ParameterBinding>'
+    ssd = gain_alone(tmp_path, fixture_fmus, bind, {"m.ssv": ssv, "m.ssm": ssm}, ssp2=True)
+    assert 'version="2.0"' in (tmp_path / "m.ssm").read_text()
+    r = system_ssp.simulate(ssd, step_size=0.5)
+    assert (r.data["gain.u"][0], r.data["gain.y"][0], r.final["gain.y"]) == (14.0, 182.0, 182.0)
+
+
+@pytest.mark.parametrize("suppress, b", [("", 2 * 2.0 + 1), (' suppressUnitConversion="true"', 2 * 0.002 + 1)])
+def test_a_mapped_value_is_transformed_after_its_unit_conversion(fixture_fmus, tmp_path, suppress, b):
+    """SSP 1.0 section 7: the transformation acts on the value converted to the target's unit
+    (0.002 km -> 2 m, then 2 x + 1 = 5 m), or instead of the conversion when the entry suppresses
+    it (2 * 0.002 + 1 = 1.004 m). The mapping is inline, on the component's binding."""
+    ssv = h.ssv_text([("bias", "Real", "0.002", "km")], units='<ssc:Unit name="km"><ssc:BaseUnit m="1" '
+                     'factor="1000"/></ssc:Unit>')
+    bind = ('<ssd:ParameterBinding source="b.ssv"><ssd:ParameterMapping><ssm:ParameterMapping version="1.0">'
+            f'<ssm:MappingEntry source="bias" target="b"{suppress}><ssc:LinearTransformation factor="2" offset="1"/>'
+            '</ssm:MappingEntry></ssm:ParameterMapping></ssd:ParameterMapping></ssd:ParameterBinding>')
+    ssd = gain_alone(tmp_path, fixture_fmus, bind, {"b.ssv": ssv})
+    r = system_ssp.simulate(ssd, step_size=0.5)
+    assert r.data["gain.y"][0] == pytest.approx(b, rel=1e-15)  # u = 0: y = b
+
+
+def test_a_mapping_on_a_nested_systems_binding(fixture_fmus, tmp_path):
+    """A nested system's binding with a mapping: its targets are named inside that system (its
+    component deeper.g2's k, its own parameter connector x0p); the run equals the nested system
+    bound without a mapping."""
+    plain = nested_system(tmp_path / "plain", fixture_fmus)
+    mapped = nested_system(tmp_path / "mapped", fixture_fmus)
+    text = mapped.read_text()
+    inline_ssm = ('<ssd:ParameterMapping><ssm:ParameterMapping version="1.0">'
+                  '<ssm:MappingEntry source="gain_of_g2" target="deeper.g2.k"/>'
+                  '<ssm:MappingEntry source="start" target="x0p"/></ssm:ParameterMapping></ssd:ParameterMapping>')
+    text = text.replace('name="deeper.g2.k"', 'name="gain_of_g2"').replace('name="x0p"><ssv:', 'name="start"><ssv:')
+    text = text.replace("</ssd:ParameterValues></ssd:ParameterBinding>",
+                        "</ssd:ParameterValues>" + inline_ssm + "</ssd:ParameterBinding>", 1)
+    assert text.count("gain_of_g2") == 2 and text.count('"start"') == 2
+    mapped.write_text(text)
+    a = system_ssp.simulate(plain, step_size=0.1, stop_time=0.3)
+    b = system_ssp.simulate(mapped, step_size=0.1, stop_time=0.3)
+    for name in a.names:
+        np.testing.assert_array_equal(a.data[name], b.data[name], err_msg=name)
+    assert b.data["sub.integ.x"][0] == 0.5
 
 
 @pytest.fixture(scope="module")
@@ -108,6 +247,24 @@ def test_top_level_input_and_parameter_connectors_bound_by_a_parameter_set(fixtu
     assert r.final["integ.x"] == pytest.approx(-118.0)
     r = system_ssp.simulate(ssd, step_size=0.5, stop_time=2.0, parameters={"Input_cref": 4.0})  # as --set does
     assert r.final["gain.y"] == 13.0
+
+
+@pytest.mark.parametrize("values", [
+    [("k_cref", "Real", "3", None), ("gain.k", "Real", "10", None)],  # OMSimulator's import_export_parameters1
+    [("gain.k", "Real", "10", None), ("k_cref", "Real", "3", None)],
+])
+def test_a_connected_system_parameter_wins_over_the_components_own_binding(fixture_fmus, tmp_path, values):
+    """As OMSimulator has it (its import_export_parameters1 binds k_cref = 30, connected to
+    addP.k1, then addP.k1 = 10 in the same set, and gets 30): the connected system parameter gives
+    gain.k its value whichever comes first in the set. The caller's values still come last and
+    win (--set gain.k=5)."""
+    ssd = top_level_connectors_system(tmp_path, fixture_fmus)
+    (tmp_path / "root.ssv").write_text(h.ssv_text([("Input_cref", "Real", "-20", None), ("gain.b", "Real", "1", None)]
+                                                  + values))
+    r = system_ssp.simulate(ssd, step_size=0.5, stop_time=2.0)
+    assert set(r.data["gain.y"]) == {3 * -20.0 + 1}
+    r = system_ssp.simulate(ssd, step_size=0.5, stop_time=2.0, parameters={"gain.k": 5.0})
+    assert set(r.data["gain.y"]) == {5 * -20.0 + 1}
 
 
 def test_a_top_level_input_also_fed_by_an_output_is_refused(fixture_fmus, tmp_path):

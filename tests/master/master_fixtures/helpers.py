@@ -52,6 +52,17 @@ def builder_used():
     return _cache.get("builder")
 
 
+def libcosim_rows(system, step, n, names, tmp_path):
+    """libcosim's values of `names` after each of `n` steps of `step` s ("file": the system's
+    own), run in a subprocess (see libcosim_run.py)."""
+    import numpy as np
+    out = tmp_path / "libcosim.json"
+    proc = subprocess.run([PY, str(HERE / "libcosim_run.py"), str(system), str(step), str(n), str(out), *names],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr[-3000:]
+    return np.array(json.loads(out.read_text()))
+
+
 SSD_HEAD = """<?xml version="1.0" encoding="UTF-8"?>
 <ssd:SystemStructureDescription version="1.0" name="{name}"
     xmlns:ssd="http://ssp-standard.org/SSP1/SystemStructureDescription"
