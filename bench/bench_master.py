@@ -7,6 +7,8 @@ takes the same number of steps), each row measured in this run:
 - communication steps per second, recording every connector and recording one signal, with our
   runtime's batched step (neighborStepIO: set, doStep and get in one call into the FMU) and with
   the standard FMI calls only, and their ratio;
+- the same with Jacobi (one signal recorded), in the compiled loop and in the Python loop, as a
+  ratio of Gauss-Seidel's time;
 - the floor: the same three models' wrapper objects (the classes inside the FMUs, with the same
   parameters) called directly in a plain Python loop, no FMI and no master: do_step, with the
   values moved between the arrays the models share with the runtime by numpy indexing (the
@@ -35,7 +37,7 @@ import numpy as np  # noqa: E402
 import system_ssp  # noqa: E402
 from system_ssp.neighbor import thesis  # noqa: E402
 from system_ssp import builder  # noqa: E402
-from system_ssp.master import instances  # noqa: E402
+from system_ssp.master import compiled, instances  # noqa: E402
 
 SSP = ROOT / "build" / "ssp"
 
@@ -220,6 +222,14 @@ def main():
             print(f"  {label:<26} {n / fast:9.0f} steps/s batched, {n / slow:7.0f} standard calls: "
                   f"{slow / fast:.2f}x")
         one = best[("one signal recorded", True)] / n
+        # Jacobi (libcosim's algorithm) on the same system: the compiled loop, and the Python loop it replaced
+        for label, on in (("Jacobi, one signal recorded", True), ("Jacobi in the Python loop", False)):
+            compiled.ENABLED = on
+            best[label], _ = best_of(args.repeat, lambda: system.run(stop_time=n * 0.015, stop_when=[], outputs=few,
+                                                                     algorithm="jacobi"))
+            compiled.ENABLED = True
+            print(f"  {label:<26} {n / best[label]:9.0f} steps/s, {best[label] / (one * n):.2f}x Gauss-Seidel's time "
+                  "(one signal)")
 
         python_get_set = min(floor_run(system, n, through_get_set=True)[0] for _ in range(args.repeat)) / n
         floor_walls = []

@@ -97,11 +97,12 @@ class FixedStepAlgorithm:
         self.loop = None  # the compiled loop, when compile() takes it
 
     def compile(self, stop_ops, rows):
-        if self.jacobi or not compiled.eligible(self.table, range(self.n), rows):
+        if not compiled.eligible(self.table, range(self.n), rows):
             return False
         self.loop, self.span = compiled.Loop(self.table, rows, stop_ops=stop_ops), SpanSize()
         self.order_array, self.mult_array = np.array(self.order, dtype=np.int64), np.array(self.mult, dtype=np.int64)
-        self.loop.load(fixed=(self.order_array, self.mult_array))
+        self.span_function = compiled.jacobi_span if self.jacobi else compiled.fixed_span
+        self.loop.load(fixed=(self.order_array, self.mult_array), span=self.span_function)
         return True
 
     def start(self, info):
@@ -165,9 +166,9 @@ class FixedStepAlgorithm:
         p, table = self.plan, self.table
         k0, N = info.steps, p.n_steps
         rows, times = loop.enter(info.record_every)
-        steps, flags = compiled.fixed_span(loop.T, self.order_array, self.mult_array, bool(self.all_one),
-                                           float(p.start), float(p.stop), float(p.step_size), int(N), int(k0),
-                                           self.span.start(), loop.changed, loop.status, rows, times, loop.rec)
+        steps, flags = self.span_function(loop.T, self.order_array, self.mult_array, bool(self.all_one),
+                                          float(p.start), float(p.stop), float(p.step_size), int(N), int(k0),
+                                          self.span.start(), loop.changed, loop.status, rows, times, loop.rec)
         self.span.took()
         loop.leave()
         k = k0 + steps

@@ -218,12 +218,36 @@ def _get_outputs(T, ci, status_out):
 @_loop_function
 def _step(T, ci, t, dt, status_out):
     """The batched step of component ci (InstanceTable._batched_stepper's step)."""
+    _gather_step(T, ci)
+    return _call_step(T, ci, t, dt, status_out)
+
+
+@_loop_function
+def _gather_step(T, ci):
+    """The first part of a batched step: ci's inputs gathered into its StepIO block's input
+    buffers, each kind marked to be sent when it changed."""
     lay = T.io_layout
-    fi, ii = ci * lay[0], ci * lay[1]
+    ii = ci * lay[1]
     for k in range(3):
         m = T.set_by_kind[ci, k]
         if m >= 0:
             T.io_i32[ii + lay[4] + k] = 1 if _gather(T, m) else 0
+
+
+@_loop_function
+def _send_nothing(T, ci):
+    """ci's next batched step sends no input."""
+    base = ci * T.io_layout[1] + T.io_layout[4]
+    for k in range(3):
+        T.io_i32[base + k] = 0
+
+
+@_loop_function
+def _call_step(T, ci, t, dt, status_out):
+    """The rest of a batched step: neighborStepIO sends the gathered inputs, steps and reads the
+    outputs into the shared buffers."""
+    lay = T.io_layout
+    fi, ii = ci * lay[0], ci * lay[1]
     T.io_f64[fi + lay[2]] = t
     T.io_f64[fi + lay[3]] = dt
     s = _call_step_io(T.step_fn[ci], T.component[ci], T.io_address[ci])
@@ -497,6 +521,48 @@ def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, c
     return steps, flags
 
 
+@_loop_function
+def jacobi_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, changed, status_out, rows, times, rec):
+    """Up to max_steps Jacobi steps from step k (FixedStepAlgorithm.run's Jacobi step): every
+    component due gathers its inputs from the outputs of the last communication point first, then
+    each is stepped (its batched step sends those inputs, steps and reads its outputs). Each FMU
+    gets the calls, with the values, of the Python loop's Jacobi step (its inputs set for the
+    step, doStep, its outputs read); only the interleaving between FMUs differs. Rows, stop
+    signals and the returned (steps taken, flags) as fixed_span."""
+    steps = 0
+    status_out[0] = 0
+    none = NO_COMPONENTS
+    for ci in range(len(changed)):
+        changed[ci] = True
+    while steps < max_steps and k < n_steps:
+        t = start + k * h
+        for ci in order:
+            if all_one or k % mult[ci] == 0:
+                if k > 0:
+                    _gather_step(T, ci)
+                else:  # the first step's inputs are those the initialization set (as in Python)
+                    _send_nothing(T, ci)
+        for ci in order:
+            mk = mult[ci]
+            if all_one or k % mk == 0:
+                if not _call_step(T, ci, t, mk * h if k + mk < n_steps else stop - t, status_out):
+                    return steps, FAILED
+        k += 1
+        steps += 1
+        fired = _stop_fired(T, changed, status_out)
+        if fired < 0:
+            return steps, FAILED
+        if fired > 0:
+            return steps, STOP_FIRED
+        if k >= n_steps or steps >= max_steps:
+            break
+        if not _row_due(T, rows, times, rec, start + k * h, none, status_out):
+            if status_out[0] > 1:
+                return steps, FAILED
+            break
+    return steps, 0
+
+
 class LazyRefresh(NamedTuple):
     """One mode's refresh, lazily (_step_mode): which refreshed components may wait (`lazy`:
     those the schedule's and stop conditions' signals do not read), their readers in the mode
@@ -644,14 +710,14 @@ class Loop:
         self.status = np.zeros(3, dtype=np.int64)
         self.changed = np.zeros(len(table.instances), dtype=np.bool_)
 
-    def load(self, mode_arrays=None, fixed=None):
+    def load(self, mode_arrays=None, fixed=None, span=fixed_span):
         """Call the span function once without a step, so that numba loads (or compiles) it now,
         before the run's clock starts: `mode_arrays` (order, mult, refresh, LazyRefresh) of a scheduled run,
-        or `fixed` (order, mult) of a fixed-step one."""
+        or `fixed` (order, mult) of a fixed-step one, whose `span` is fixed_span or jacobi_span."""
         rows, times = self.rows.rows, self.rows.times
         if fixed is not None:
-            fixed_span(self.T, fixed[0], fixed[1], False, 0.0, 1.0, 1.0, 1, 0, 0, self.changed, self.status, rows,
-                       times, self.rec)
+            span(self.T, fixed[0], fixed[1], False, 0.0, 1.0, 1.0, 1, 0, 0, self.changed, self.status, rows, times,
+                 self.rec)
         else:
             order, mult, refresh, lazy = mode_arrays
             scheduled_span(self.T, lazy, order, mult, refresh, 1.0, 0.0, 1.0, 0.0, 0, 0.0, np.zeros(len(self.changed)),
