@@ -14,7 +14,7 @@ from system_ssp.master.system import simulate
 from test_master_core import loop_system
 from test_master_schedule import scheduled_system
 
-SPAN = compiled.scheduled_span, compiled.fixed_span
+SPAN = compiled.scheduled_span, compiled.fixed_span, compiled.jacobi_span
 
 
 def _run(path, loop, monkeypatch, **options):
@@ -30,6 +30,7 @@ def _run(path, loop, monkeypatch, **options):
 
     monkeypatch.setattr(compiled, "scheduled_span", counted(SPAN[0]))
     monkeypatch.setattr(compiled, "fixed_span", counted(SPAN[1]))
+    monkeypatch.setattr(compiled, "jacobi_span", counted(SPAN[2]))
     return simulate(path, **options), len(spans)
 
 
@@ -48,6 +49,22 @@ def test_compiled_fixed_step_loop_equals_the_python_loop(ssp_paths, monkeypatch,
     fast, spans = _run(ssp_paths[system], True, monkeypatch)
     assert spans_off == 0 and 0 < spans < fast.steps / 5  # many steps per call
     _same(fast, python)
+
+
+@pytest.mark.parametrize("system, options", [
+    ("detumble", {}), ("attitude_determination", {}), ("sun_avoidance_slew", {}),
+    ("detumble", {"step_multiples": {"dynamics": 3, "thrusters": 2}, "stop_when": [], "stop_time": 2.0}),
+])
+def test_compiled_jacobi_loop_equals_the_python_loop(ssp_paths, monkeypatch, system, options):
+    """Jacobi (libcosim's algorithm; every run with --algorithm jacobi, every system with OSP's
+    annotation) in the compiled loop: every component gathers its inputs from the last
+    communication point before any steps, as the Python loop's Jacobi step sets them all first."""
+    python, spans_off = _run(ssp_paths[system], False, monkeypatch, algorithm="jacobi", **options)
+    fast, spans = _run(ssp_paths[system], True, monkeypatch, algorithm="jacobi", **options)
+    assert spans_off == 0 and 0 < spans < fast.steps / 5
+    _same(fast, python)
+    gauss_seidel, _ = _run(ssp_paths[system], True, monkeypatch, **options)
+    assert not gauss_seidel.to_pandas().equals(fast.to_pandas())  # a Jacobi run indeed
 
 
 def test_compiled_loop_records_every_kth_step_and_at_the_end(ssp_paths, monkeypatch):
@@ -130,6 +147,23 @@ def test_python_loop_where_the_compiled_one_cannot_serve(ssp_paths, monkeypatch)
     options = {"stop_time": 600.0, "stop_when": [], "parameters": {"propulsion.burn_enable": True}}
     r, spans = _run(ssp_paths["deorbit"], True, monkeypatch, profile=True, **options)
     assert spans == 0 and r.profile is not None and r.modes["burn"]["steps"] == 1200
+
+
+@pytest.mark.parametrize("algorithm", ["gauss-seidel", "jacobi"])
+def test_the_profiler_times_every_components_calls_in_any_fixed_step_run(ssp_paths, monkeypatch, algorithm):
+    """--profile on a system without a schedule (it printed nothing before): the set, doStep and
+    get calls of each component timed, in the Python loop with the standard FMI calls, and the
+    run's values those of the compiled loop's, bit for bit."""
+    fast, _ = _run(ssp_paths["detumble"], True, monkeypatch, algorithm=algorithm)
+    profiled, spans = _run(ssp_paths["detumble"], True, monkeypatch, algorithm=algorithm, profile=True)
+    assert spans == 0
+    _same(fast, profiled)
+    prof = profiled.profile
+    assert set(prof["components"]) == set(prof["calls"]) == {"detumble", "thrusters", "dynamics"}
+    for name, calls in prof["calls"].items():
+        assert set(calls) == {"set", "doStep", "get"} and all(v > 0 for v in calls.values())
+        assert prof["components"][name] == pytest.approx(sum(calls.values()))
+    assert 0 < prof["master"] < prof["loop"]
 
 
 def test_span_steps_bound_what_one_call_takes(monkeypatch, ssp_paths):
