@@ -86,8 +86,8 @@ class _Run:
         if bar is not None:
             observers.append(bar)
         profiler = None
-        if plan.profile and plan.schedule is not None:
-            profiler = Profiler(algorithm, [c.name for c in system.comps])
+        if plan.profile:
+            profiler = Profiler(algorithm, table, [c.name for c in system.comps])
             observers.append(profiler)
         view = RunView(table, algorithm.refresh_for_record)
         for obs in callers:

@@ -255,23 +255,41 @@ class ProgressBar(Observer):
 
 
 class Profiler(Observer):
-    """Wall time per component (set + doStep + get in the stepping pass) and of the loop; the
-    master's share is the rest. Wraps the algorithm's per-component step functions."""
+    """Wall time per component in its calls (inputs set, doStep, outputs read: every call of the
+    run's algorithm, Jacobi, Gauss-Seidel and scheduled alike) and of the loop; the master's share
+    is the rest. The component's step runs as its standard FMI calls (the batched step, one call
+    for all three, would leave them inseparable), which give the same values."""
 
-    def __init__(self, algorithm, names):
+    CALLS = ("set", "doStep", "get")
+
+    def __init__(self, algorithm, table, names):
         self.names = names
-        self.spent = [0.0] * len(names)
+        self.spent = [[0.0, 0.0, 0.0] for _ in names]  # per component: set, doStep, get
         perf = time.perf_counter
-        spent = self.spent
 
-        def timed(ci, step):
-            def step_timed(t, dt):
+        def timed(ci, which, call):
+            cell = self.spent[ci]
+
+            def call_timed(*args):
                 w0 = perf()
-                step(t, dt)
-                spent[ci] += perf() - w0
-            return step_timed
+                call(*args)
+                cell[which] += perf() - w0
+            return call_timed
 
-        algorithm.steppers = [timed(ci, step) for ci, step in enumerate(algorithm.steppers)]
+        n = len(names)
+        # in place: the algorithms hold these lists
+        table.setters[:] = [timed(ci, 0, table.setters[ci]) for ci in range(n)]
+        table.do_steps[:] = [timed(ci, 1, table.do_steps[ci]) for ci in range(n)]
+        table.getters[:] = [timed(ci, 2, table.getters[ci]) for ci in range(n)]
+
+        def standard(set_, do_step, get):
+            def step(t, dt):
+                set_()
+                do_step(t, dt)
+                get()
+            return step
+
+        algorithm.steppers = [standard(table.setters[ci], table.do_steps[ci], table.getters[ci]) for ci in range(n)]
         self.wall0 = 0.0
         self.total = 0.0
 
@@ -282,5 +300,21 @@ class Profiler(Observer):
         self.total = time.perf_counter() - self.wall0
 
     def report(self):
-        return {"components": dict(zip(self.names, self.spent)), "loop": self.total,
-                "master": self.total - sum(self.spent)}
+        """{"components": {name: seconds in its calls}, "calls": {name: {"set", "doStep", "get":
+        seconds}}, "loop": seconds of the step loop, "master": the loop's rest}."""
+        return {"components": {name: sum(cell) for name, cell in zip(self.names, self.spent)},
+                "calls": {name: dict(zip(self.CALLS, cell)) for name, cell in zip(self.names, self.spent)},
+                "loop": self.total, "master": self.total - sum(sum(cell) for cell in self.spent)}
+
+
+def profile_table(profile):
+    """A run's profile (Profiler.report) as printed: a row per component (its set, doStep and get
+    calls and their sum), the slowest first, then the master's own share."""
+    lines = [f"wall time in the components' FMI calls, of {profile['loop']:.3f} s in the step loop (s):",
+             f"  {'component':<20} {'set':>9} {'doStep':>9} {'get':>9} {'total':>9}"]
+    for name, total in sorted(profile["components"].items(), key=lambda kv: -kv[1]):
+        c = profile["calls"][name]
+        lines.append(f"  {name:<20} {c['set']:9.3f} {c['doStep']:9.3f} {c['get']:9.3f} {total:9.3f}")
+    lines.append(f"  {'(master)':<20} {'':>29} {profile['master']:9.3f}")
+    return "\n".join(lines)
+

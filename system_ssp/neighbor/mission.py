@@ -44,6 +44,7 @@ from ..builder import resolve_system
 from ..errors import SSPError
 from ..limits import read_text_input
 from ..master import System, report, write_result
+from ..master.observers import profile_table
 from ..systems import PARAMETERS_DIR
 from ..tools.console import (ArgumentParser, DEFAULT_SSP_DIR, add_console_arguments, console_settings, parse_sets,
                              positive_float, staged_results)
@@ -670,10 +671,7 @@ def main(argv=None):
     print(table(s), end="")
     print(f"{r.steps} steps, {s['simulated_years']:.2f} simulated years, {r.wall_time:.1f} s wall; {r.stop_reason}")
     if r.profile:
-        prof = r.profile
-        for name, sec in sorted(prof["components"].items(), key=lambda kv: -kv[1]):
-            print(f"  {name:<12} {sec:8.2f} s")
-        print(f"  {'(master)':<12} {prof['master']:8.2f} s")
+        print(profile_table(r.profile))
     if requirements is not None:
         print(req.table(s["requirements"]))
     print(f"results in {args.out}")
