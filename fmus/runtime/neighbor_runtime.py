@@ -11,12 +11,17 @@ package with a name private to the FMU build
 process never share code or data; two instances of the same build share the loaded modules.
 """
 import importlib
+import importlib.abc
+import importlib.machinery
 import importlib.util
+import marshal
 import os
 import site
 import sys
+import tempfile
 import threading
 import traceback
+import types
 
 NONE = None
 # One lock for the import work of every FMU build of ours in this process (each build has its
@@ -53,6 +58,105 @@ def _make_packages_importable(cfg):
             site.addsitedir(folder)
 
 
+# ---- the private package's bytecode, kept across extractions ----------------------------------
+# A host extracts the FMU to a new folder for each run (FMPy, our master) or each process, where
+# Python would compile the package's modules again every time (a fifth of a short run's start).
+# The package's name carries the digest of its code, so its modules' bytecode is kept per user
+# and Python version (NEIGHBOR_FMU_CACHE, else the user's cache folder) as hash-checked .pyc files
+# (PEP 552: the source's hash is in the file and checked at every load; a stale or damaged one is
+# compiled again). Where the folder cannot be written, modules are compiled as before. It is a
+# cache like numba's, beside no source, so PYTHONDONTWRITEBYTECODE (which keeps __pycache__ out
+# of source folders) does not turn it off; NEIGHBOR_FMU_BYTECODE_CACHE=0 does.
+KEEP_BYTECODE = os.environ.get("NEIGHBOR_FMU_BYTECODE_CACHE", "1") != "0"
+
+def _bytecode_root():
+    explicit = os.environ.get("NEIGHBOR_FMU_CACHE")
+    if explicit:
+        return os.path.join(explicit, "bytecode")
+    if sys.platform == "win32":
+        base = os.environ.get("LOCALAPPDATA") or os.path.join(os.path.expanduser("~"), "AppData", "Local")
+    elif sys.platform == "darwin":
+        base = os.path.join(os.path.expanduser("~"), "Library", "Caches")
+    else:
+        base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return os.path.join(base, "neighbor-cosim", "fmu-bytecode")
+
+
+def _relocated(code, path):
+    """`code` (and the functions and classes in it) as compiled from `path`: numba's caches and
+    tracebacks name the file of the extraction that runs, not of the one that compiled it."""
+    consts = tuple(_relocated(c, path) if isinstance(c, types.CodeType) else c for c in code.co_consts)
+    return code.replace(co_filename=path, co_consts=consts)
+
+
+class _KeptBytecodeLoader(importlib.machinery.SourceFileLoader):
+    """A module of the private package, its bytecode read from and written to `pyc`."""
+
+    def __init__(self, fullname, path, pyc):
+        super().__init__(fullname, path)
+        self.pyc = pyc
+
+    def get_code(self, fullname):
+        path = self.get_filename(fullname)
+        source = self.get_data(path)
+        digest = importlib.util.source_hash(source)
+        header = importlib.util.MAGIC_NUMBER + (3).to_bytes(4, "little") + digest  # checked hash-based
+        try:
+            with open(self.pyc, "rb") as f:
+                kept = f.read()
+            if kept[:16] == header:
+                return _relocated(marshal.loads(kept[16:]), path)
+        except (OSError, ValueError, EOFError, TypeError):
+            pass
+        code = self.source_to_code(source, path)
+        if KEEP_BYTECODE:
+            try:
+                os.makedirs(os.path.dirname(self.pyc), exist_ok=True)
+                fd, tmp = tempfile.mkstemp(dir=os.path.dirname(self.pyc), suffix=".tmp")
+                try:
+                    with os.fdopen(fd, "wb") as f:
+                        f.write(header + marshal.dumps(code))
+                    os.replace(tmp, self.pyc)  # whole or not at all, whichever process writes it
+                except BaseException:
+                    os.unlink(tmp)
+                    raise
+            except OSError:
+                pass  # a read-only or full cache: compiled each time, as Python would
+        return code
+
+
+class _PackageFinder(importlib.abc.MetaPathFinder):
+    """Finds the modules of one private package (this FMU build's only) as Python's path finder
+    does, and loads their source through _KeptBytecodeLoader."""
+
+    def __init__(self, package):
+        self.package = package
+        self.root = os.path.join(_bytecode_root(), package, sys.implementation.cache_tag)
+
+    def find_spec(self, fullname, path=None, target=None):
+        if fullname != self.package and not fullname.startswith(self.package + "."):
+            return None
+        spec = importlib.machinery.PathFinder.find_spec(fullname, path)
+        if KEEP_BYTECODE and spec is not None and type(spec.loader) is importlib.machinery.SourceFileLoader:
+            self.use(spec)
+        return spec
+
+    def use(self, spec):
+        inside = spec.name.split(".")[1:] + (["__init__"] if spec.submodule_search_locations is not None else [])
+        spec.loader = _KeptBytecodeLoader(spec.name, spec.origin, os.path.join(self.root, *inside) + ".pyc")
+
+
+def _finder(package):
+    """This package's finder, in sys.meta_path once per process (several extractions of a build
+    share it: the code is the same)."""
+    for finder in sys.meta_path:
+        if isinstance(finder, _PackageFinder) and finder.package == package:
+            return finder
+    finder = _PackageFinder(package)
+    sys.meta_path.insert(0, finder)
+    return finder
+
+
 def _package(resources, name):
     """Import the FMU's private package from this extraction of the FMU. When the same build was
     loaded before (maybe from a folder that is gone now), its modules stay and its packages look
@@ -62,6 +166,8 @@ def _package(resources, name):
     if package is None:
         spec = importlib.util.spec_from_file_location(name, os.path.join(folder, "__init__.py"),
                                                       submodule_search_locations=[folder])
+        if KEEP_BYTECODE:
+            _finder(name).use(spec)
         package = importlib.util.module_from_spec(spec)
         sys.modules[name] = package
         try:
