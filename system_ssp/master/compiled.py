@@ -483,14 +483,30 @@ def scheduled_span(T, L, order, mult, refresh, h_mode, t, stop, tol, max_steps, 
 
 
 @_loop_function
+def _end_of_fixed_step(T, changed, status_out, rows, times, rec, t, last):
+    """After a fixed step to t: the stop signals read, then the row due recorded unless the step
+    ends the span (`last`). Returns FAILED or STOP_FIRED to end the span with, 0 to go on, -1 to
+    end it here (Python records the last row)."""
+    fired = _stop_fired(T, changed, status_out)
+    if fired < 0:
+        return FAILED
+    if fired > 0:
+        return STOP_FIRED
+    if last:
+        return -1
+    if not _row_due(T, rows, times, rec, t, NO_COMPONENTS, status_out):
+        return FAILED if status_out[0] > 1 else -1
+    return 0
+
+
+@_loop_function
 def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, changed, status_out, rows, times, rec):
     """Up to max_steps Gauss-Seidel steps from step k (FixedStepAlgorithm.run): the components
     stepped in order (multiples), then every component's inputs set and its feedthrough outputs
     read in order; rows due recorded as in scheduled_span. Returns (steps taken, flags); stops
     after a step whose stop signal is true and at the last step (Python records it)."""
-    steps, flags = 0, 0
+    steps = 0
     status_out[0] = 0
-    none = NO_COMPONENTS
     for ci in range(len(changed)):
         changed[ci] = True  # a fixed-step run reads the stop signals at every step
     while steps < max_steps and k < n_steps:
@@ -507,18 +523,13 @@ def fixed_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, c
                 return steps, FAILED
         k += 1
         steps += 1
-        fired = _stop_fired(T, changed, status_out)
-        if fired < 0:
-            return steps, FAILED
-        if fired > 0:
-            return steps, STOP_FIRED
-        if k >= n_steps or steps >= max_steps:
+        end = _end_of_fixed_step(T, changed, status_out, rows, times, rec, start + k * h,
+                                 k >= n_steps or steps >= max_steps)
+        if end > 0:
+            return steps, end
+        if end < 0:
             break
-        if not _row_due(T, rows, times, rec, start + k * h, none, status_out):
-            if status_out[0] > 1:
-                return steps, FAILED
-            break
-    return steps, flags
+    return steps, 0
 
 
 @_loop_function
@@ -531,7 +542,6 @@ def jacobi_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, 
     signals and the returned (steps taken, flags) as fixed_span."""
     steps = 0
     status_out[0] = 0
-    none = NO_COMPONENTS
     for ci in range(len(changed)):
         changed[ci] = True
     while steps < max_steps and k < n_steps:
@@ -549,16 +559,11 @@ def jacobi_span(T, order, mult, all_one, start, stop, h, n_steps, k, max_steps, 
                     return steps, FAILED
         k += 1
         steps += 1
-        fired = _stop_fired(T, changed, status_out)
-        if fired < 0:
-            return steps, FAILED
-        if fired > 0:
-            return steps, STOP_FIRED
-        if k >= n_steps or steps >= max_steps:
-            break
-        if not _row_due(T, rows, times, rec, start + k * h, none, status_out):
-            if status_out[0] > 1:
-                return steps, FAILED
+        end = _end_of_fixed_step(T, changed, status_out, rows, times, rec, start + k * h,
+                                 k >= n_steps or steps >= max_steps)
+        if end > 0:
+            return steps, end
+        if end < 0:
             break
     return steps, 0
 

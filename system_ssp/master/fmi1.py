@@ -21,7 +21,7 @@ What differs from FMI 2.0, and what the master does about it:
   DirectDependency elements are read: system_ssp.master.components).
 """
 import ctypes
-from ctypes import POINTER, c_char_p, c_double, c_int, c_size_t, c_ubyte, c_uint, c_void_p
+from ctypes import POINTER, c_double, c_int, c_size_t, c_ubyte, c_uint, c_void_p
 
 from fmpy import calloc, free
 from fmpy.fmi1 import (FMU1Slave, fmi1CallbackAllocateMemoryTYPE, fmi1CallbackFreeMemoryTYPE, fmi1CallbackFunctions,
@@ -29,14 +29,14 @@ from fmpy.fmi1 import (FMU1Slave, fmi1CallbackAllocateMemoryTYPE, fmi1CallbackFr
 from fmpy.logging import addLoggerProxy
 
 from .connections import KIND
+from .list_calls import ListCalls
 
 _KINDS = ("Real", "Integer", "Boolean", "String")  # the value calls: FMI 1.0's fmiBoolean is a char
-_MASTER_C = {"Real": c_double, "Integer": c_int, "Boolean": c_int, "String": c_char_p}
 _ALLOCATE = fmi1CallbackAllocateMemoryTYPE(calloc)
 _FREE = fmi1CallbackFreeMemoryTYPE(free)
 
 
-class Fmi1Calls:
+class Fmi1Calls(ListCalls):
     """An FMI 1.0 co-simulation FMU instance behind the calls the instance table makes on FMPy's
     FMU2Slave (see the module's text)."""
 
@@ -101,25 +101,6 @@ class Fmi1Calls:
 
         return set_boolean
 
-    def _typed(self, kind):
-        """get(vrs) / set(vrs, values) over Python lists (parameters, final values)."""
-        def get(vrs):
-            vrs = list(vrs)
-            buf = (_MASTER_C[kind] * len(vrs))()
-            s = self.fn[f"fmi2Get{kind}"](self.component, (c_uint * len(vrs))(*vrs), len(vrs), buf)
-            if s > 1:
-                raise RuntimeError(f"fmiGet{kind} returned status {s}")
-            return list(buf)
-
-        def set_(vrs, values):
-            vrs = list(vrs)
-            buf = (_MASTER_C[kind] * len(vrs))(*[v.encode("utf-8") if isinstance(v, str) else v for v in values])
-            s = self.fn[f"fmi2Set{kind}"](self.component, (c_uint * len(vrs))(*vrs), len(vrs), buf)
-            if s > 1:
-                raise RuntimeError(f"fmiSet{kind} returned status {s}")
-
-        return get, set_
-
     # ---- FMPy's FMU2Slave interface, as the instance table uses it ----------------------
     def instantiate(self, visible, callbacks, logging_on):
         messages, env = callbacks
@@ -139,10 +120,7 @@ class Fmi1Calls:
         if not self.slave.component:
             raise RuntimeError("fmiInstantiateSlave returned NULL")
         self.component = self.slave.component
-        self.getReal, self.setReal = self._typed("Real")
-        self.getInteger, self.setInteger = self._typed("Integer")
-        self.getBoolean, self.setBoolean = self._typed("Boolean")
-        self.getString, self.setString = self._typed("String")
+        self.bind_list_calls()
 
     def setupExperiment(self, tolerance, start, stop):
         self._experiment = (start, stop)

@@ -23,6 +23,8 @@ from ctypes import byref, c_bool, c_char_p, c_double, c_float, c_int, c_size_t, 
 from fmpy.fmi3 import FMU3Slave
 import numpy as np
 
+from .list_calls import MASTER_C, ListCalls
+
 # the C type and the call's type name of each FMI 3.0 type (an Enumeration is an Int64)
 C_TYPE = {"Float64": c_double, "Float32": c_float, "Int8": ctypes.c_int8, "UInt8": ctypes.c_uint8,
           "Int16": ctypes.c_int16, "UInt16": ctypes.c_uint16, "Int32": ctypes.c_int32, "UInt32": ctypes.c_uint32,
@@ -54,9 +56,11 @@ class _Plan:
             self.parts.append((type_, (c_uint32 * len(vrs))(*vrs), len(vrs), buf, total, positions, targets, vrs))
 
 
-class Fmi3Calls:
+class Fmi3Calls(ListCalls):
     """An FMI 3.0 co-simulation FMU instance behind the calls the instance table makes on FMPy's
     FMU2Slave (see the module's text)."""
+
+    CALL_PREFIX = "fmi3"
 
     def __init__(self, info, instance_name):
         md = info.fmi3_md
@@ -106,7 +110,7 @@ class Fmi3Calls:
         if len(plan.parts) == 1:
             type_, vrs, nvr, tbuf, total, positions, targets, plain = plan.parts[0]
             direct = (total == n and np.array_equal(positions, np.arange(n)) and np.array_equal(targets, np.arange(n))
-                      and C_TYPE[type_] is _MASTER_C[kind])  # Boolean never: 1-byte bool vs int
+                      and C_TYPE[type_] is MASTER_C[kind])  # Boolean never: 1-byte bool vs int
             if direct:
                 fn3 = self._c[(verb, CALL_TYPE[type_])]
                 arrays = [v for v in plain if self.sizes[v] > 1] if verb == "Set" else []
@@ -199,29 +203,6 @@ class Fmi3Calls:
             self.terminated = None
         return s
 
-    def _typed(self, kind):
-        """get(vrs) / set(vrs, values) over element value references (Python lists)."""
-        def get(vrs):
-            vrs = list(vrs)
-            arr = (c_uint32 * len(vrs))(*vrs)
-            buf = (_MASTER_C[kind] * len(vrs))()
-            s = self.fn[f"fmi2Get{kind}"](self.component, arr, len(vrs), buf)
-            if s > 1:
-                raise RuntimeError(f"fmi3Get{kind} returned status {s}")
-            return list(buf)
-
-        def set_(vrs, values):
-            vrs = list(vrs)
-            arr = (c_uint32 * len(vrs))(*vrs)
-            buf = (_MASTER_C[kind] * len(vrs))()
-            for i, v in enumerate(values):
-                buf[i] = v.encode("utf-8") if isinstance(v, str) else v
-            s = self.fn[f"fmi2Set{kind}"](self.component, arr, len(vrs), buf)
-            if s > 1:
-                raise RuntimeError(f"fmi3Set{kind} returned status {s}")
-
-        return get, set_
-
     # ---- FMPy's FMU2Slave interface, as the instance table uses it ----------------------
     def instantiate(self, visible, callbacks, logging_on):
         messages, env = callbacks
@@ -233,10 +214,7 @@ class Fmi3Calls:
                                logMessage=log)
         self._log = self.slave.logMessage  # kept alive with the instance
         self.component = self.slave.component
-        self.getReal, self.setReal = self._typed("Real")
-        self.getInteger, self.setInteger = self._typed("Integer")
-        self.getBoolean, self.setBoolean = self._typed("Boolean")
-        self.getString, self.setString = self._typed("String")
+        self.bind_list_calls()
 
     def setupExperiment(self, tolerance, start, stop):
         self._experiment = (tolerance, start, stop)
@@ -256,9 +234,6 @@ class Fmi3Calls:
 
     def freeLibrary(self):
         self.slave.freeLibrary()
-
-
-_MASTER_C = {"Real": c_double, "Integer": c_int, "Boolean": c_int, "String": c_char_p}
 
 
 def _convert(type_, value):
