@@ -172,11 +172,11 @@ def _refuse_duplicate_names(md, label):
     so no option runs it (FMPy's validation finds it too; this also holds without validation)."""
     first = {}
     for v in md.modelVariables:
-        if v.name in first and v is not first[v.name] and getattr(v, "alias", None) is None:
+        if v.name in first:
             raise SSPError(f"{label}: its modelDescription.xml declares the variable {v.name!r} twice (lines "
                            f"{first[v.name].sourceline} and {v.sourceline}): a connection, a value or a result column "
                            "could not say which is meant")
-        first.setdefault(v.name, v)
+        first[v.name] = v
 
 
 def _fmi3_connector_type(connector_type, info, v):
