@@ -47,7 +47,8 @@ class ComponentInfo:
         # output name -> set of input names it depends on directly (None = all inputs); an output
         # not in it depends on all inputs too (FMI 2.0 and 3.0 ModelStructure; FMI 1.0 DirectDependency)
         if self.fmi1:
-            self.deps = fmi1_direct_dependencies(unzipdir)
+            self.deps, variable_step = fmi1_structure(unzipdir)
+            md.coSimulation.canHandleVariableCommunicationStepSize = variable_step  # FMPy reads it as False
         else:
             self.deps = {}
             for unknown in md.outputs:
@@ -89,17 +90,21 @@ class ComponentInfo:
         return bool(d & connected_inputs) if connected_inputs is not None else bool(d)
 
 
-def fmi1_direct_dependencies(unzipdir):
-    """{output: set of the inputs it depends on directly} of an FMI 1.0 FMU, from the
-    DirectDependency elements of its outputs (FMPy does not read them); an output without one
-    depends on every input (FMI 1.0, section 2.10), and is left out."""
+def fmi1_structure(unzipdir):
+    """What FMPy does not read of an FMI 1.0 FMU's model description: {output: set of the inputs
+    it depends on directly}, from the DirectDependency elements of its outputs (an output without
+    one depends on every input, FMI 1.0 section 2.10, and is left out), and whether its
+    Capabilities say canHandleVariableCommunicationStepSize (nc:Schedule needs it)."""
     root = etree.parse(os.path.join(unzipdir, "modelDescription.xml")).getroot()
     deps = {}
     for sv in root.iterfind("ModelVariables/ScalarVariable"):
         direct = sv.find("DirectDependency")
         if sv.get("causality") == "output" and direct is not None:
             deps[sv.get("name")] = {(n.text or "").strip() for n in direct.iterfind("Name")}
-    return deps
+    capabilities = root.find("Implementation/*/Capabilities")
+    variable_step = capabilities is not None and capabilities.get("canHandleVariableCommunicationStepSize") in (
+        "true", "1")
+    return deps, variable_step
 
 
 def unsupported_fmu(md):

@@ -151,3 +151,20 @@ def test_an_fmi1_model_exchange_fmu_is_refused(tmp_path, capsys):
     with pytest.raises(system_ssp.SSPError, match=r"component 'd': .*DahlquistME.fmu is an FMI 1.0 model-exchange "
                                                   r"FMU; this master runs co-simulation FMUs"):
         system_ssp.System(tmp_path / "SystemStructure.ssd")
+
+
+def test_an_fmi1_fmu_under_an_nc_schedule(tmp_path):
+    """FMPy reads an FMI 1.0 FMU's canHandleVariableCommunicationStepSize as False; the master
+    reads its Capabilities (true for the Reference FMUs), so the FMU runs under nc:Schedule: one
+    unconditional mode of 0.2 s equals the fixed-step run of 0.2 s."""
+    (tmp_path / "resources").mkdir()
+    shutil.copy(FMI1 / "VanDerPol.fmu", tmp_path / "resources" / "VanDerPol.fmu")
+    schedule = ('<ssd:Annotations><ssc:Annotation type="org.neighbor-cosim.master"><nc:Master '
+                'xmlns:nc="https://neighbor-cosim.org/ssp/master" stepSize="0.2"><nc:Schedule><nc:Mode name="all" stepSize="0.2"/>'
+                '</nc:Schedule></nc:Master></ssc:Annotation></ssd:Annotations>')
+    ssd = tmp_path / "SystemStructure.ssd"
+    ssd.write_text(h.ssd_text(h.component("vdp", "VanDerPol.fmu"), system_extra=schedule))
+    scheduled = system_ssp.simulate(ssd, stop_time=2.0)
+    fixed = system_ssp.simulate(ssd, stop_time=2.0, step_size=0.2, schedule=False)
+    assert scheduled.modes["all"]["steps"] == 10
+    np.testing.assert_array_equal(scheduled.data["vdp.x0"], fixed.data["vdp.x0"])
