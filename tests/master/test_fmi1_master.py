@@ -160,7 +160,8 @@ def test_an_fmi1_fmu_under_an_nc_schedule(tmp_path):
     (tmp_path / "resources").mkdir()
     shutil.copy(FMI1 / "VanDerPol.fmu", tmp_path / "resources" / "VanDerPol.fmu")
     schedule = ('<ssd:Annotations><ssc:Annotation type="org.neighbor-cosim.master"><nc:Master '
-                'xmlns:nc="https://neighbor-cosim.org/ssp/master" stepSize="0.2"><nc:Schedule><nc:Mode name="all" stepSize="0.2"/>'
+                'xmlns:nc="https://neighbor-cosim.org/ssp/master" stepSize="0.2"><nc:Schedule>'
+                '<nc:Mode name="all" stepSize="0.2"/>'
                 '</nc:Schedule></nc:Master></ssc:Annotation></ssd:Annotations>')
     ssd = tmp_path / "SystemStructure.ssd"
     ssd.write_text(h.ssd_text(h.component("vdp", "VanDerPol.fmu"), system_extra=schedule))
