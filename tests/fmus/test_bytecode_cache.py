@@ -88,3 +88,13 @@ def test_no_bytecode_kept_when_turned_off_or_where_it_cannot_be_written(fmu_path
     env.pop("NEIGHBOR_FMU_CACHE", None)
     _, values2, _ = _run(fmu_paths["RigidBody"], tmp_path, "blocked", env)
     np.testing.assert_array_equal(values2, values)
+
+
+def test_an_explicit_cache_folder(fmu_paths, tmp_path):
+    """NEIGHBOR_FMU_CACHE names the folder (its bytecode/ part), whatever the user's cache is."""
+    chosen = tmp_path / "chosen"
+    env = dict(os.environ, XDG_CACHE_HOME=str(tmp_path / "user-cache"), NEIGHBOR_FMU_CACHE=str(chosen),
+               NEIGHBOR_FMU_BYTECODE_CACHE="1")
+    _, _, info = _run(fmu_paths["RigidBody"], tmp_path, "run", env)
+    assert info["pyc"].startswith(str(chosen / "bytecode")) and os.path.isfile(info["pyc"])
+    assert _kept(tmp_path / "user-cache") == {}
