@@ -83,6 +83,7 @@ def test_libcosims_linear_transformation_system(tmp_path):
     SSP 1.0 applies both in order, the later winning: realOut = 4, identity2.realIn = 1.3 * 4 + 50.
     libcosim applies only a component's first binding (its default parameter set): with realIn set
     to 2 here too, the two masters agree to the last bit at every step."""
+    pytest.importorskip("libcosimpy")
     r = system_ssp.simulate(LINEAR, stop_time=0.005, step_size=1e-3)
     assert set(r.data["identity1.realOut"]) == {4.0}
     assert set(r.data["identity2.realIn"]) == {1.3 * 4.0 + 50.0} and set(r.data["identity2.realOut"]) == {55.2}
@@ -108,6 +109,7 @@ def test_the_identity_fmu_passes_every_type(tmp_path):
 def test_a_coupled_fmi1_system_equals_libcosim(tmp_path):
     """VanDerPol's x0 through two FMI 1.0 Feedthroughs, the second's output scaled by a
     LinearTransformation into the third, as libcosim's Jacobi-type algorithm steps it."""
+    pytest.importorskip("libcosimpy")
     (tmp_path / "resources").mkdir()
     for m in ("VanDerPol", "Feedthrough"):
         shutil.copy(FMI1 / f"{m}.fmu", tmp_path / "resources" / f"{m}.fmu")
