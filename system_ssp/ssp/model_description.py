@@ -79,15 +79,16 @@ def read(source: str, label: str, validate: bool = True, strict: bool = False) -
     if md is None or semantic != problems:  # the XML schema refused it: FMPy cannot be trusted to read it
         raise SSPError(f"{label}: modelDescription.xml does not follow the FMI schema: {listed} ({skip} reads it "
                        "without the checks)")
+    # two variables of one name: left to the master's own check, which refuses them whatever the
+    # options (system_ssp.master.components), so no advice here names an option that cannot help
+    problems = [p for p in problems if not _DUPLICATE.search(p)]
     refused = [p for p in problems if lenient_effect(p) is None]
-    if any(_DUPLICATE.search(p) for p in refused):  # no option runs it (system_ssp.master.components)
-        raise SSPError(f"{label}: modelDescription.xml does not conform to the FMI standard: "
-                       f"{'; '.join(_one_line(p) for p in refused if _DUPLICATE.search(p))} (a connection, a value "
-                       "or a result column could not say which variable is meant)")
     if refused:
         raise SSPError(f"{label}: modelDescription.xml does not conform to the FMI standard: "
                        f"{'; '.join(_one_line(p) for p in refused)} (this would make the run wrong; {skip} reads it "
                        "without the checks)")
+    if not problems:
+        return Description(md, None)
     shown = "; ".join(f"{_one_line(p).rstrip('.')} ({lenient_effect(p)})" for p in problems)
     return Description(md, f"{label}: read leniently, as other tools read it ({option('--strict', 'strict=True')} "
                            f"refuses it): its modelDescription.xml breaks the FMI standard where the run does not "
