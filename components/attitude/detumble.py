@@ -83,7 +83,7 @@ class DetumbleController:
         self.settle.time_inside = float(state["time_inside"])
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def detumble_into(k, values, inputs, outputs, h, time_inside, stepping):
     """DetumbleController on its constants k (Kp, Kd, omega_d, omega_tol, levels, signed test,
     settle time): the stop test on omega = values[inputs[0:3]]; with `stepping` the settle count

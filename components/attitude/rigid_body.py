@@ -223,7 +223,7 @@ class RigidBody:
 
 # ---- the RK4 kernel (numba where installed; the same arithmetic, operation for operation, as
 # the plain-Python path, so both give the same bits) ------------------------------------------
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def _acceleration(w0, w1, w2, J, Ji, t, tw, h0, h1, h2):
     """Eq. 17 in gyrostat form: omega_dot = I^-1 [L - wheel_torque - omega x (I omega + h_w)]. With
     zero wheel terms this is exactly Eq. 17 (adding or subtracting 0.0 changes no non-zero float,
@@ -239,7 +239,7 @@ def _acceleration(w0, w1, w2, J, Ji, t, tw, h0, h1, h2):
             Ji[6] * r0 + Ji[7] * r1 + Ji[8] * r2)
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
     """n classical RK4 sub-steps of dt on (q, omega) with the torque held, h_w following the held
     wheel torque, h_w(s) = h_w + tw s (the wheel's own exact integration); `angles` (Eq. 31) gain
@@ -282,7 +282,7 @@ def rk4_steps(q, w, angles, J, Ji, torque, tw, hw, dt, n):
     return (qa, qb, qc, qd), (wa, wb, wc), (ea, eb, ec)
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def _body_torque(values, inputs):
     """The external torque: torque_B at values[inputs[0:3]], plus the disturbance torque at
     values[inputs[9:12]] where the caller passes twelve inputs (the FMU) rather than nine."""
@@ -292,7 +292,7 @@ def _body_torque(values, inputs):
     return (values[inputs[0]], values[inputs[1]], values[inputs[2]])
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def euler_step_into(x, values, inputs, h):
     """The thesis scripts' StateChange on the state array x in place: one explicit Euler step of h
     with the inputs at values[inputs[0:9]] as in rk4_step_into, q not normalized, then Eq. 31's
@@ -315,7 +315,7 @@ def euler_step_into(x, values, inputs, h):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def rk4_step_into(x, values, inputs, h, n):
     """RigidBody's RK4 communication step on its state array x in place: the torque, wheel torque
     and wheel momentum at values[inputs[0:9]], n sub-steps of h / n (rk4_steps), the quaternion
@@ -344,7 +344,7 @@ def rk4_step_into(x, values, inputs, h, n):
     return 0
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def publish_into(x, values, outputs):
     """values[outputs] = q, omega, omega_dot, the 1-2-3 angles of q (rotations.euler123), the body's
     J omega (angular_momentum), the integrated angles and the centre of mass from the state x (22

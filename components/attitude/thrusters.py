@@ -72,7 +72,7 @@ class ThrusterPairs:
         self.state[FIRE:FIRE + 3] = [float(x) for x in state["fire_time"]]
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def pairs_into(state, values, inputs, outputs, h, stepping):
     """ThrusterPairs on its state array: the flags nearest the command at values[inputs[0:3]]
     (thruster_control.nearest_pair_flags), with `stepping` the firing pairs' times advanced by h

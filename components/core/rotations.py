@@ -82,7 +82,7 @@ def quaternion_rate(q, w):
             0.5 * (-q1 * w1 - q2 * w2 - q3 * w3))
 
 
-@njit(cache=True)
+@njit(cache=True, plain_first=True)
 def quaternion_rate_kernel(q1, q2, q3, q4, w1, w2, w3):
     """quaternion_rate on floats, for compiled callers (the rigid body's RK4, the MEKF's update):
     the same operations."""

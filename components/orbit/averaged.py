@@ -64,7 +64,7 @@ the clock.
 import math
 
 import numpy as np
-from ..core.jit import njit
+from ..core.jit import function_of, loaded, njit
 from ..core.constants import DAY, MU_EARTH, OMEGA_EARTH, R_EQ
 
 from ..environment import geodesy
@@ -201,13 +201,13 @@ def _drag_function(kernel):
     """_drag_rates_kernel with `kernel` bound at compile time. Passing a numba function as an
     argument makes every call resolve its type (about 30 us, ten times the quadrature itself);
     a closure over it compiles once per kernel and process."""
-    f = _SPECIALIZED.get(kernel)
+    f = _SPECIALIZED.get(function_of(kernel))
     if f is None:
         @njit(cache=False)
         def f(y, jd, mu, bc, omega_atm, n_nodes, kernel_data):
             return _drag_rates_kernel(y, jd, mu, bc, omega_atm, n_nodes, kernel, kernel_data)
-        _SPECIALIZED[kernel] = f
-    return f
+        _SPECIALIZED[function_of(kernel)] = f
+    return loaded(f)
 
 
 @njit(cache=True)
@@ -355,22 +355,23 @@ def _advance_without_drag(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, re
                            base.vacuum_kernel, kernel_data)
 
 
-_ADVANCE = {jacchia_roberts.jacchia_roberts_kernel: _advance_jacchia_roberts,
-            harris_priester.harris_priester_kernel: _advance_harris_priester,
-            exponential.exponential_kernel: _advance_exponential, base.vacuum_kernel: _advance_without_drag}
+_ADVANCE = {function_of(k): f for k, f in ((jacchia_roberts.jacchia_roberts_kernel, _advance_jacchia_roberts),
+                                           (harris_priester.harris_priester_kernel, _advance_harris_priester),
+                                           (exponential.exponential_kernel, _advance_exponential),
+                                           (base.vacuum_kernel, _advance_without_drag))}
 
 
 def _advance_function(kernel):
     """_advance_kernel with the atmosphere's `kernel` bound in: cached for the product's kernels,
     else (NRLMSIS, a user's kernel) a closure compiled once per kernel and process, as _drag_function."""
-    f = _ADVANCE.get(kernel)
+    f = _ADVANCE.get(function_of(kernel))
     if f is None:
         @njit(cache=False)
         def f(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on, kernel_data):
             return _advance_kernel(y, t, t_end, min_step, prm, bc, n_nodes, drag, f_N, retro, thrust_on,
                                    kernel, kernel_data)
-        _ADVANCE[kernel] = f
-    return f
+        _ADVANCE[function_of(kernel)] = f
+    return loaded(f)
 
 
 @njit(cache=True)

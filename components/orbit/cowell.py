@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from ..core.jit import njit
+from ..core.jit import function_of, loaded, njit
 from ..core import rotations, time_utils
 from ..environment import atmosphere, geodesy
 from ..environment.atmosphere import base, exponential, harris_priester, jacchia_roberts
@@ -288,9 +288,10 @@ def _advance_without_drag(t, y0, t_end, h, rtol, atol, fp, J, nmax, grav, Cnm, S
                     kdata, A, B, C, E3, E5, reentry_altitude, max_steps)
 
 
-_CACHED_ADVANCE = {jacchia_roberts.jacchia_roberts_kernel: _advance_jacchia_roberts,
-                   harris_priester.harris_priester_kernel: _advance_harris_priester,
-                   exponential.exponential_kernel: _advance_exponential, base.vacuum_kernel: _advance_without_drag}
+_CACHED_ADVANCE = {function_of(k): f for k, f in ((jacchia_roberts.jacchia_roberts_kernel, _advance_jacchia_roberts),
+                                                  (harris_priester.harris_priester_kernel, _advance_harris_priester),
+                                                  (exponential.exponential_kernel, _advance_exponential),
+                                                  (base.vacuum_kernel, _advance_without_drag))}
 
 
 class CowellOrbit:
@@ -439,7 +440,7 @@ class CowellOrbit:
             args = (self.t_state, self.y, t, self.h, self.rtol, self.atol, self._force_parameters(), self.J,
                     self.zonal_degree, self._grav, self._Cnm, self._Snm)
             tail = (self._kdata, _A, _B, _C, _E3, _E5, self.reentry_altitude, MAX_INTERNAL_STEPS)
-            cached = _CACHED_ADVANCE.get(self._kernel)
+            cached = loaded(_CACHED_ADVANCE.get(function_of(self._kernel)))
             ts, y, h, reentered, steps, _ = (cached(*args, *tail) if cached is not None
                                              else _advance(*args, self._kernel, *tail))
             self.t_state, self.y, self.h, self.steps = float(ts), y, float(h), self.steps + int(steps)

@@ -391,5 +391,5 @@ def test_the_product_atmospheres_are_bound_in_by_cached_functions():
         if name == "msis":
             continue
         kernel = atmosphere.make_density_model(name, space_weather=sw, inclination=0.9).kernel
-        for integration in (averaged._advance_function(kernel), cowell._CACHED_ADVANCE[kernel]):
+        for integration in (averaged._advance_function(kernel), cowell._CACHED_ADVANCE[jit.function_of(kernel)]):
             assert type(integration._cache).__name__ == "FunctionCache", (name, integration)

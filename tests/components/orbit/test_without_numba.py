@@ -1,7 +1,8 @@
 """numba only makes the kernels faster: with it switched off (NEIGHBOR_COSIM_NUMBA=0, the path
 a host without numba takes) the atmospheres, the Cowell orbit, the orbit-averaged model, the
 attitude filter's matrix arithmetic, the estimator's compiled step and the attitude models'
-steps on shared arrays (rigid body, thruster pairs, detumble law) give the same results to 1e-12."""
+steps on shared arrays (rigid body, thruster pairs, detumble law) give the same results to 1e-12,
+and the attitude models' (the kernels declared plain_first) the same bits."""
 import json
 import os
 import subprocess
@@ -101,6 +102,10 @@ def test_plain_python_kernels_equal_the_compiled_ones():
     for key in compiled:
         np.testing.assert_allclose(plain[key], compiled[key], rtol=1e-12, atol=0, err_msg=key)
     assert compiled["cowell_exponential"] != compiled["cowell_jacchia_roberts"]  # the cases differ
+    # the attitude models' kernels are declared plain_first: a short run takes them as plain Python
+    # before numba is loaded (components.core.jit), which must not change a bit
+    for key in ("attitude_euler", "attitude_rk4"):
+        assert plain[key] == compiled[key], key
 
 
 def test_describe_names_the_path():
