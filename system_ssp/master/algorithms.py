@@ -6,13 +6,14 @@ a stop condition and calls the observers after every macro step; `finish` at the
 `refresh_for_record` brings the values a recorded row shows up to date."""
 import ctypes
 import math
+import os
+import sys
 import time
 from typing import Callable, Dict, List, Optional, Protocol, Sequence
 
 import numpy as np
 
 from ..errors import SimulationError
-from . import compiled
 from .connections import KIND
 from .instances import CTYPE, GET, StepFailed
 from .observers import StepInfo
@@ -42,6 +43,25 @@ class SpanSize:
             self.steps = min(2 * self.steps, SPAN_STEPS)
         elif spent > 2.0 * SPAN_SECONDS:
             self.steps = max(1, self.steps // 2)
+
+# A run of fewer steps keeps the Python loop, unless numba is in the process already: importing numba
+# and loading the compiled loop's functions from its cache (about a second here) costs more than the
+# compiled loop saves on such a run (about 10 us a step of the detumble system). The two loops give
+# the same results bit for bit; NEIGHBOR_COSIM_COMPILED_LOOP=1 takes the compiled one for every run
+# it can serve, =0 for none.
+SHORT_RUN_STEPS = 50_000
+
+
+def compiled_loop(table, rows, steps: float):
+    """system_ssp.master.compiled (numba imported with it) when its loop can serve the run of the
+    table's components recording `rows` and repays its loading for `steps` macro steps, else None."""
+    choice = os.environ.get("NEIGHBOR_COSIM_COMPILED_LOOP", "")
+    if choice == "0" or (choice != "1" and steps < SHORT_RUN_STEPS and "numba" not in sys.modules):
+        return None
+    from . import compiled
+
+    return compiled if compiled.eligible(table, range(len(table.instances)), rows) else None
+
 
 Stepper = Callable[[float, float], None]  # (t, h): set a component's inputs, doStep, get its outputs
 
@@ -94,11 +114,13 @@ class FixedStepAlgorithm:
         self.n = len(table.instances)
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
 
-        self.loop = None  # the compiled loop, when compile() takes it
+        self.loop = self.compiled = None  # the compiled loop and its module, when compile() takes it
 
     def compile(self, stop_ops, rows):
-        if not compiled.eligible(self.table, range(self.n), rows):
+        compiled = compiled_loop(self.table, rows, self.plan.n_steps)
+        if compiled is None:
             return False
+        self.compiled = compiled
         self.loop, self.span = compiled.Loop(self.table, rows, stop_ops=stop_ops), SpanSize()
         self.order_array, self.mult_array = np.array(self.order, dtype=np.int64), np.array(self.mult, dtype=np.int64)
         self.span_function = compiled.jacobi_span if self.jacobi else compiled.fixed_span
@@ -172,7 +194,7 @@ class FixedStepAlgorithm:
         self.span.took()
         loop.leave()
         k = k0 + steps
-        if flags & compiled.FAILED:
+        if flags & self.compiled.FAILED:
             table.t = info.t = p.start + k * p.step_size  # the step that failed
             raise loop.failure()
         info.steps = k
@@ -309,11 +331,14 @@ class ScheduledAlgorithm:
         self.steppers = list(table.steppers)  # per component: set, doStep, get (a profiler may wrap them)
         self.mode_time = {m.name: 0.0 for m in self.modes}
         self.mode_steps = {m.name: 0 for m in self.modes}
-        self.loop = None  # the compiled loop, when compile() takes it
+        self.loop = self.compiled = None  # the compiled loop and its module, when compile() takes it
 
     def compile(self, stop_ops, rows):
-        if not compiled.eligible(self.table, range(self.n), rows):
+        shortest = min(m.h for m in self.modes)  # the most steps the run may take
+        compiled = compiled_loop(self.table, rows, (self.plan.stop - self.plan.start) / shortest)
+        if compiled is None:
             return False
+        self.compiled = compiled
         self.loop = compiled.Loop(self.table, rows, self.signals, self.events, stop_ops, self.prod)
         self.span = SpanSize()
         for m in self.modes:
@@ -390,6 +415,7 @@ class ScheduledAlgorithm:
         clocks = np.array(tc, dtype=np.float64)
         order, mult, refresh, lazy = mode.arrays
         rows, times = loop.enter(mode.record_every)
+        compiled = self.compiled
         steps, t1, spent, flags = compiled.scheduled_span(
             T, lazy, order, mult, refresh, float(mode.h), float(t), float(stop), float(tol), self.span.start(),
             float(self.mode_time[mode.name]), clocks, loop.changed, loop.status, rows, times, loop.rec)

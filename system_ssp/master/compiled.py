@@ -19,7 +19,9 @@ So the FMUs receive the same calls with the same values in the same order; the r
 same bit for bit (tests run both loops). It serves runs whose components all export
 neighborStepIO (our FMUs, FMI 2.0) and whose connections need no Integer/Boolean mapping; every
 other run, and runs with the profiler, the caller's observers or FMU debug logging, keep the
-Python loop. NEIGHBOR_COSIM_COMPILED_LOOP=0 keeps the Python loop everywhere.
+Python loop, as do short runs while numba is not loaded (algorithms.compiled_loop imports this
+module, numba with it, only for a run it repays). NEIGHBOR_COSIM_COMPILED_LOOP=0 keeps the Python
+loop everywhere, =1 takes this one for short runs too.
 
 A failed call returns its status and what failed (ERROR_*: the component's batched step, set
 operation, get operation or signal read) and Python raises the StepFailed the Python loop would.

@@ -89,10 +89,11 @@ def test_find_cycle_finds_one():
     assert find_cycle({"a": {"b"}, "b": set()}) is None
 
 
-# The command's first code installs its signal handlers and only then imports the command line
-# (a second of numpy, fmpy, lxml): the one import that must wait for a function to run (the
-# package's __init__ gives the master's names on first use for the same reason, by importlib).
-DEFERRED = {("system_ssp.launch", "system_ssp.cli")}
+# The imports that must wait for a function to run: the command's first code installs its signal
+# handlers and only then imports the command line (a second of numpy, fmpy, lxml; the package's
+# __init__ gives the master's names on first use for the same reason, by importlib); the master
+# imports its compiled loop, and numba with it (about a second), only for a run the loop repays.
+DEFERRED = {("system_ssp.launch", "system_ssp.cli"), ("system_ssp.master.algorithms", "system_ssp.master.compiled")}
 
 
 def test_no_project_import_inside_a_function():
