@@ -4,17 +4,21 @@
 
 Each command runs in fresh processes, `--repeat` times (the best and the median printed), and is
 printed as a ratio against baselines measured in the same run: the bare interpreter
-(`python -c pass`), what every run of our FMUs needs whatever the master does (numba imported and
-one function loaded from its cache: numba initializes its CPU target there, which imports scipy
-when scipy is installed), and the issue's target.
+(`python -c pass`), numba's own start (numba imported and one function loaded from its cache:
+numba initializes its CPU target there, which imports scipy when scipy is installed; what a run
+paid before the kernels and the compiled loop were loaded only where they repay it), and the
+issue's target.
 
 - `neighbor-cosim --version` and `--help` (target 0.2 s);
 - `neighbor-cosim run detumble` (664 steps; target 0.7 s), with its import chain (-X importtime's
   largest cumulative imports) and the run's own wall time as the command prints it;
+- the same with numba loaded as before (NEIGHBOR_COSIM_NUMBA=1: every kernel compiled at its first
+  call; NEIGHBOR_COSIM_COMPILED_LOOP=1: the compiled loop for a short run too);
 - the same with the FMUs' bytecode cache off (NEIGHBOR_FMU_BYTECODE_CACHE=0: their private
   packages compiled from source in every process, as before it);
 - fmusim (the Reference-FMUs' C simulator, no Python in its environment) stepping RigidBody once
-  (target 0.4 s), when fmusim can be compiled here (tests/fmus/fmusim_host.py).
+  (target 0.4 s), when fmusim can be compiled here (tests/fmus/fmusim_host.py), and the same with
+  NEIGHBOR_COSIM_NUMBA=1.
 Build first: python build_fmus.py
 """
 import argparse
@@ -34,6 +38,9 @@ COMMAND = [sys.executable, "-m", "system_ssp"]
 # the numba floor: numpy and numba imported and one function loaded from numba's cache (numba
 # initializes its CPU target at the first function it compiles or loads)
 FLOOR_MODULE = ("import numba\n\n\n@numba.njit(cache=True)\ndef plus_one(x):\n    return x + 1\n")
+# numba loaded as before this round: every kernel compiled at its first call, the compiled loop for
+# every run it can serve
+EAGER = {"NEIGHBOR_COSIM_NUMBA": "1", "NEIGHBOR_COSIM_COMPILED_LOOP": "1"}
 FLOOR = "import sys; sys.path.insert(0, sys.argv[1]); import startup_floor; startup_floor.plus_one(1)"
 
 
@@ -74,7 +81,7 @@ def main():
     timed([sys.executable, "-c", FLOOR, str(folder)], 1)  # numba's cache written
     floor, _, _ = timed([sys.executable, "-c", FLOOR, str(folder)], n)
     print(f"baselines (best of {n}): python -c pass {bare:.3f} s; numba imported and one function loaded from its "
-          f"cache {floor:.3f} s (what every run of our FMUs pays)")
+          f"cache {floor:.3f} s (what every run of our FMUs paid before numba was loaded only where it repays)")
     for what, argv, target in (("neighbor-cosim --version", [*COMMAND, "--version"], 0.2),
                                ("neighbor-cosim --help", [*COMMAND, "--help"], 0.2)):
         best, median, _ = timed(argv, n)
@@ -86,6 +93,10 @@ def main():
     inside = next((line.split()[2] for line in out.splitlines() if line.startswith("wall time:")), "?")
     print(f"{'neighbor-cosim run detumble':<34} {best:6.3f} s (median {median:.3f}; the run itself {inside} s): "
           f"{best / floor:.2f}x the numba floor, {best / 0.7:.2f}x the target 0.7 s")
+    eager = dict(os.environ, **EAGER)
+    best_eager, median_eager, _ = timed(run, n, env=eager)
+    print(f"{'  numba loaded as before':<34} {best_eager:6.3f} s (median {median_eager:.3f}): loading it only where "
+          f"it repays saves {best_eager - best:.3f} s ({best_eager / best:.2f}x)")
     off = dict(os.environ, NEIGHBOR_FMU_BYTECODE_CACHE="0")
     best_off, median_off, _ = timed(run, n, env=off)
     print(f"{'  the FMUs bytecode cache off':<34} {best_off:6.3f} s (median {median_off:.3f}): the cache saves "
@@ -105,6 +116,9 @@ def main():
     best, median, _ = timed(argv, n, env=dict(fmusim_host.CLEAN_ENV))
     print(f"{'fmusim, RigidBody, one step':<34} {best:6.3f} s (median {median:.3f}): {best / floor:.2f}x the numba "
           f"floor, {best / 0.4:.2f}x the target 0.4 s")
+    best_eager, median_eager, _ = timed(argv, n, env=dict(fmusim_host.CLEAN_ENV, NEIGHBOR_COSIM_NUMBA="1"))
+    print(f"{'  numba loaded as before':<34} {best_eager:6.3f} s (median {median_eager:.3f}): the plain-Python first "
+          f"steps save {best_eager - best:.3f} s ({best_eager / best:.2f}x)")
 
 
 if __name__ == "__main__":
