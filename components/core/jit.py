@@ -194,8 +194,8 @@ class Kernel:
             raise AttributeError(name)
         return getattr(self.dispatcher, name)
 
-    def __reduce__(self):  # pickled as the function it is (a module's kernel by its name)
-        return getattr, (sys.modules[self.py_func.__module__], self.__name__)
+    def __reduce__(self):  # pickled as numba pickles its dispatchers (by value), as before it was lazy
+        return self.dispatcher.__reduce__()
 
 
 def function_of(kernel):

@@ -66,3 +66,13 @@ def test_past_the_budget_numba_is_loaded_and_the_results_stay_the_same():
     lazy, compiled = run(steps), run(steps, NEIGHBOR_COSIM_NUMBA="1")
     assert lazy["numba_after_steps"] and lazy["rebound"]
     assert lazy["values"] == compiled["values"]
+
+
+def test_a_kernel_pickles_as_numbas_dispatcher():
+    import pickle
+
+    from components.environment.atmosphere import base
+
+    kernel = base.gmst_nb  # bound under another name than its function's: pickled by value
+    again = pickle.loads(pickle.dumps(kernel))
+    assert again(2460000.5) == kernel(2460000.5) == base.magnetic_field.gmst(2460000.5)
