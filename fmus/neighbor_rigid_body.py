@@ -116,8 +116,11 @@ class RigidBody(NeighborSlave):
         if v["propellant_mass_properties"]:
             self.model.follow_propellant(self.input_value("propellant_used") + self.input_value("rcs_propellant"),
                                          v["mass"], self._tank)
-        self.model.step_from(self.shared, self._inputs_at, step_size)
-        self.publish_after_step()
+        # the step and the publish (NeighborSlave.publish_after_step) in one compiled call
+        if self.model.step_and_publish(self.shared, self._inputs_at, self._outputs_at, step_size):
+            self.mark_published()
+        else:  # the get that reads them raises publish's error
+            self._outputs_stale()
         return True
 
     def publish(self):

@@ -174,7 +174,22 @@ class RigidBody:
         if self.integrator == "euler":
             error = euler_step_into(self.x, values, inputs, h)
         else:
-            error = rk4_step_into(self.x, values, inputs, h, max(1, math.ceil(h / self.max_substep - 1e-9)))
+            error = rk4_step_into(self.x, values, inputs, h, self._substeps(h))
+        self._refuse(error, values, inputs)
+
+    def step_and_publish(self, values, inputs, outputs, h):
+        """step_from(values, inputs, h) then publish_into(values, outputs) in one compiled call (the
+        FMU's step: one call from Python where there were two). False when the step was taken but
+        the outputs were not written (publish_into would raise the quaternion's error)."""
+        error = step_publish_into(self.x, values, inputs, outputs, h, self._substeps(h), self.integrator == "euler")
+        self._refuse(max(error, 0), values, inputs)
+        return error == 0
+
+    def _substeps(self, h):
+        return 1 if self.integrator == "euler" else max(1, math.ceil(h / self.max_substep - 1e-9))
+
+    def _refuse(self, error, values, inputs):
+        """Raise the error a step kernel's code stands for (0: none)."""
         if error:
             if error <= 4:
                 name = _INPUT_NAMES[error - 1]
@@ -372,3 +387,14 @@ def publish_into(x, values, outputs):
     for i in range(6):  # the integrated angles, the centre of mass
         values[outputs[16 + i]] = x[10 + i]
     return True
+
+
+@njit(cache=True, plain_first=True)
+def step_publish_into(x, values, inputs, outputs, h, n, euler):
+    """euler_step_into (euler) or rk4_step_into with n sub-steps, then, when the step was taken,
+    publish_into: the step's code (1-5, nothing published), 0 when published, -1 when publish_into
+    wrote nothing (the quaternion's norm)."""
+    error = euler_step_into(x, values, inputs, h) if euler else rk4_step_into(x, values, inputs, h, n)
+    if error:
+        return error
+    return 0 if publish_into(x, values, outputs) else -1
