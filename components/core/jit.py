@@ -41,7 +41,8 @@ import re
 import sys
 
 _CHOICE = os.environ.get("NEIGHBOR_COSIM_NUMBA", "")  # "0": never numba; "1": numba from the first call
-ENABLED = _CHOICE != "0" and importlib.util.find_spec("numba") is not None
+_INSTALLED = importlib.util.find_spec("numba") is not None
+ENABLED = _CHOICE != "0" and _INSTALLED
 numba = None  # the module, once a kernel needed it (_numba)
 # The plain-Python calls the plain-first kernels of this copy may take before numba is loaded: about
 # half a second of the attitude models' steps here (30 calls and 144 us a step of the rigid body's RK4,
@@ -239,5 +240,5 @@ def describe():
     if ENABLED:
         from importlib.metadata import version
         return f"numba {version('numba')}: compiled kernels"
-    why = "numba is not installed" if importlib.util.find_spec("numba") is None else "NEIGHBOR_COSIM_NUMBA=0"
+    why = "numba is not installed" if not _INSTALLED else "NEIGHBOR_COSIM_NUMBA=0"
     return f"{why}: plain-Python kernels (the same results, slower)"
