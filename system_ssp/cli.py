@@ -161,12 +161,19 @@ def main(argv=None):
     argv = sys.argv[1:] if argv is None else list(argv)
     debug = "--log-level=debug" in argv or any(a == "--log-level" and argv[k + 1:k + 2] == ["debug"]
                                                  for k, a in enumerate(argv))
-    previous = {sig: signal.signal(sig, handler) for sig, handler in HANDLERS.items()}
+    previous = {}
     try:
         with command_line_spelling():  # messages name options as --algorithm jacobi, not algorithm='jacobi'
             if argv[:1] and argv[0] in COMMANDS:
-                return command(COMMANDS[argv[0]])(argv[1:])
-            return _run_or_info(argv)
+                function, arguments = command(COMMANDS[argv[0]]), argv[1:]
+            else:
+                arguments = _parser().parse_args(argv)  # first: --help needs no import
+                function = command(RUN_INFO)
+            # only now, the command's imports done: a KeyboardInterrupt raised inside an import can be
+            # swallowed (a weakref callback's "Exception ignored"), turned into an ImportError (numpy's)
+            # or end the process by the signal; until here system_ssp.launch's handler ends it cleanly
+            previous = {sig: signal.signal(sig, handler) for sig, handler in HANDLERS.items()}
+            return function(arguments)
     except RunInterrupted as exc:
         print(one_line(exc), file=sys.stderr)
         _say_partial(exc)
@@ -238,8 +245,3 @@ def _say_partial(exc):
         print(f"partial results ({rows}recorded before it stopped): {exc.partial_file}", file=sys.stderr)
     elif exc.partial_note:
         print(f"partial results: {exc.partial_note}", file=sys.stderr)
-
-
-def _run_or_info(argv):
-    args = _parser().parse_args(argv)
-    return command(RUN_INFO)(args)

@@ -1,7 +1,8 @@
 """The first code of the `neighbor-cosim` command (and `python -m system_ssp`): it installs the
 signal handlers before the second or so of imports, so that Ctrl-C, SIGTERM or SIGHUP then end
 the command at once with one line and the signal's exit code instead of a traceback. Nothing has
-been written at that point; the command line (system_ssp.cli) then takes the signals over."""
+been written at that point; the command line (system_ssp.cli) takes the signals over once the
+subcommand's module and its imports are loaded."""
 import os
 import signal
 import sys

@@ -364,7 +364,8 @@ def _catches_sighup(pid):
 @pytest.mark.parametrize("delay", [0.0, 0.05, 0.15, 0.3])
 def test_ctrl_c_during_startup_is_one_line_and_exit_130(ssp_paths, tmp_path, delay):
     """Ctrl-C `delay` s after the command's first code ran, while it imports numpy, fmpy, lxml and
-    the models (about a second). Before the interpreter reaches that code no program can help it."""
+    the models (about half a second), or later. Before the interpreter reaches that code no program
+    can help it."""
     tmpdir = tmp_path / "tmp"
     tmpdir.mkdir()
     proc = subprocess.Popen([sys.executable, "-m", "system_ssp", "run", str(ssp_paths["detumble"]), "--stop-time",
@@ -377,7 +378,9 @@ def test_ctrl_c_during_startup_is_one_line_and_exit_130(ssp_paths, tmp_path, del
     time.sleep(delay)
     proc.send_signal(signal.SIGINT)
     _, err = proc.communicate(timeout=60)
-    if proc.returncode == 0:
+    if proc.returncode == 0 or (proc.returncode == -signal.SIGINT and not err):
+        # the second: the signal came after the command's work, once the interpreter's exit had
+        # given SIGINT back its default action (as any program's exit does)
         pytest.skip("the run finished before the signal")
     assert proc.returncode == 130 and "Traceback" not in err and len(err.splitlines()) == 1, err
     assert err.startswith("interrupted (SIGINT)")
