@@ -22,6 +22,7 @@ publishes its outputs into it (see the section "values shared with the runtime" 
 import copy
 import math
 import os
+import sys
 from collections import OrderedDict
 from operator import itemgetter
 from typing import Any, Callable, Iterable, NamedTuple, Optional, Sequence, Union
@@ -31,6 +32,7 @@ from pythonfmu.enums import Fmi2Causality, Fmi2Initial, Fmi2Variability
 from pythonfmu.fmi2slave import Fmi2Slave
 from pythonfmu.variables import Boolean, Integer, Real, String
 
+from components.core import jit
 from components.core.names import Names, element_names, matrix_names
 from components.mission.neighbor import SPACECRAFT
 
@@ -43,6 +45,8 @@ Scalar = Union[float, int, bool, str]
 SHARED_INPUT, SHARED_STATE_OUTPUT, SHARED_FEEDTHROUGH_OUTPUT = 1, 2, 3
 FRESH_STATE, FRESH_FEEDTHROUGH = 0, 1
 _SHARED_KINDS = {Real: 0, Integer: 1, Boolean: 2}
+# "0": never a native step (arm_native), every step through Python (the tests and benchmarks compare)
+NATIVE = os.environ.get("NEIGHBOR_COSIM_NATIVE", "") != "0"
 # The moving-target inputs of the RCS controller family (declared by `target_inputs`), named here
 # once because a controller's outputs depend on them before they are declared.
 TARGET_INPUTS = element_names("q_target_BN", 4) + element_names("omega_target_B", 3)
@@ -126,6 +130,8 @@ class NeighborSlave(Fmi2Slave):
         self._get_plans = {cls: {} for cls in _KINDS}  # type -> {value references: plan (_get_plan)}
         self._set_plans = {cls: {} for cls in _KINDS}  # type -> {value references: input names or None}
         self.shared = None  # share_values: every Real/Integer/Boolean input and output by value reference
+        self.share_native = None  # share_values: the native step's two slots (arm_native)
+        self._native_arrays = self._native_context = None
 
     # ---- the FMI get and set calls ----------------------------------------------------------
     # pythonfmu's own look up each variable and check its type on every call. Ours follow a plan
@@ -309,7 +315,7 @@ class NeighborSlave(Fmi2Slave):
                 raise ParameterError(f"{type(self).__name__} instance '{self.instance_name}': parameter {name} = "
                                      f"{value!r}: expected a finite number")
             self.values[name] = kind(value)
-            self._model = None  # rebuilt from the new parameter values on next use
+            self._drop_model()  # rebuilt from the new parameter values on next use
             self._outputs_stale()
 
         self._register(name, kind, Fmi2Causality.parameter, Fmi2Variability.fixed, unit, description,
@@ -468,6 +474,7 @@ class NeighborSlave(Fmi2Slave):
         self.shared = np.zeros(n)
         self.share_codes = np.zeros(n, np.int32)
         self.share_flags = np.zeros(2, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH
+        self.share_native = np.zeros(2, np.int64)  # the step's address (0: none), its context's
         outputs = {cls: [] for cls in _SHARED_KINDS}
         for vr, var in self.vars.items():
             code = _SHARED_KINDS.get(type(var))
@@ -505,6 +512,35 @@ class NeighborSlave(Fmi2Slave):
             self.publish()
         except Exception:
             self._outputs_stale()
+
+    # A sharing wrapper whose step is one compiled kernel on its model's arrays may also hand the
+    # binary a native step (components.core.native): the binary then calls it instead of do_step,
+    # without Python. The wrapper arms it after a Python step once numba is loaded (native_ready);
+    # a rebuilt model (a parameter, the experiment's setup, an FMU state) disarms it, and the next
+    # Python step arms it again on the new model's arrays.
+    def native_ready(self) -> bool:
+        """True once numba is in the process (it is not started for a native step), unless
+        NEIGHBOR_COSIM_NATIVE=0 or the FMU is the FMI 3.0 one (whose loader keeps the time in its
+        Python step): a wrapper may then import its native steps and arm one."""
+        return (NATIVE and jit.ENABLED and "numba" in sys.modules and self.share_native is not None
+                and getattr(self, "_neighbor_arrays", None) is None)
+
+    def arm_native(self, step: Any, *arrays: np.ndarray) -> None:
+        """From the next doStep on, the binary calls the cfunc `step` on `arrays` (kept here)."""
+        from components.core import native
+        self._native_arrays = arrays
+        self._native_context = native.context(*arrays)
+        self.share_native[1] = self._native_context.ctypes.data
+        self.share_native[0] = step.address
+
+    def disarm_native(self) -> None:
+        if self.share_native is not None:
+            self.share_native[0] = 0  # first: the binary reads it before the context
+        self._native_arrays = self._native_context = None
+
+    def _drop_model(self) -> None:
+        self._model = None
+        self.disarm_native()
 
     def mark_published(self) -> None:
         """A wrapper's publish wrote every shared output: they are fresh."""
@@ -601,7 +637,7 @@ class NeighborSlave(Fmi2Slave):
     def setup_experiment(self, start_time: float, stop_time: Optional[float] = None,
                          tolerance: Optional[float] = None) -> None:
         self.start_time = float(start_time or 0.0)
-        self._model = None  # rebuilt so that a model that keeps time starts at start_time
+        self._drop_model()  # rebuilt so that a model that keeps time starts at start_time
         self._outputs_stale()
 
     def exit_initialization_mode(self) -> None:
@@ -619,7 +655,7 @@ class NeighborSlave(Fmi2Slave):
     def _set_fmu_state(self, state):
         self.values = copy.deepcopy(state["values"])
         self._input_version += 1  # never a version an earlier cache entry could carry
-        self._model = None
+        self._drop_model()
         if self.shared is not None:
             self.shared[:] = state["shared"]  # in place: the runtime holds the array's address
             self._outputs_stale()

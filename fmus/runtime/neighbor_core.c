@@ -9,6 +9,7 @@
 #endif
 #include <stdarg.h>
 #include <stddef.h>
+#include <stdint.h>
 #include <stdio.h>
 #include <stdlib.h>
 #include <string.h>
@@ -491,6 +492,10 @@ typedef struct {
     int *sh_flags;
     size_t sh_n;
     PyObject *m_publish;  /* the slave's publish: writes every shared output, marks them fresh */
+    /* The slave's native step (NeighborSlave.arm_native), two int64 it owns: the address of a
+     * compiled int step(context, t, h) that takes the step and publishes without Python (0: none
+     * now) and its context. NULL when the slave shares no values. */
+    const long long *sh_native;
     int state;            /* where the standard's state machine is (S_* below) */
     double next_time;     /* where the next doStep must start: the start time (0 until a setup or
                              an initialization says otherwise), then the end of the last step */
@@ -751,6 +756,7 @@ static int link_shared(Instance *inst) {
     inst->sh_codes = NULL;
     inst->sh_spans = NULL;
     inst->sh_flags = NULL;
+    inst->sh_native = NULL;
     inst->sh_n = 0;
     if (inst->m_publish) {
         py.DecRef(inst->m_publish);
@@ -770,6 +776,7 @@ static int link_shared(Instance *inst) {
         void *flags = py.LongAsVoidPtr(py.TupleGetItem(res, 2));
         long n = py.LongAsLong(py.TupleGetItem(res, 3));
         void *spans = py.LongAsVoidPtr(py.TupleGetItem(res, 4));  /* NULL (0) without arrays */
+        void *native = py.LongAsVoidPtr(py.TupleGetItem(res, 5));  /* NULL (0): always through Python */
         inst->m_publish = method(inst, "publish");
         if (py.ErrOccurred() || !values || !codes || !flags || n < 0 || !inst->m_publish) {
             ok = 0;
@@ -778,6 +785,7 @@ static int link_shared(Instance *inst) {
             inst->sh_codes = (const int *)codes;
             inst->sh_flags = (int *)flags;
             inst->sh_spans = (const int *)spans;
+            inst->sh_native = (const long long *)native;
             inst->sh_n = (size_t)n;
         }
     }
@@ -1305,7 +1313,16 @@ static Status skip_to(void *c, double t) {
     return ST_OK;
 }
 
+typedef int (*NativeStep)(long long context, double t, double h);
+
 static Status step_model(void *c, double t, double h, const char *what) {
+    const Instance *armed = (const Instance *)c;
+    if (armed && !armed->broken && armed->sh_native && armed->sh_native[0]) {
+        /* the model's compiled step: no Python, no GIL (it touches only the slave's arrays) */
+        NativeStep step = (NativeStep)(intptr_t)armed->sh_native[0];
+        if (step(armed->sh_native[1], t, h) == 0) return ST_OK;
+        /* it changed nothing: the Python step below takes it, or reports why it cannot */
+    }
     ENTER(c, what)  /* a sharing model's step publishes its outputs (or leaves them stale) itself */
     PyObject *res = call(inst, inst->m_do_step, tuple_of(2, py.FloatFromDouble(t), py.FloatFromDouble(h)), what,
                          &status);

@@ -289,7 +289,8 @@ def set_values(slave, kind, vrs, values):
 
 def shared_memory(slave):
     """(address of the values, of the codes, of the flags, number of value references, address of
-    the spans or 0) of the arrays a slave shares with the binary (NeighborSlave.share_values), or
+    the spans or 0, address of the native step's two slots or 0: NeighborSlave.arm_native) of the
+    arrays a slave shares with the binary (NeighborSlave.share_values), or
     None: its values then cross through get_*/set_*. For FMI 3.0 the spans give how many elements
     each value reference stands for (an array's, 1 for a scalar, 0 inside an array). The arrays
     stay the slave's (the binary asks again after a reset)."""
@@ -309,7 +310,9 @@ def shared_memory(slave):
         slave.share_spans = codes.copy()  # int32, kept with the slave
         slave.share_spans[:] = span_array
         spans = slave.share_spans.ctypes.data
-    return values.ctypes.data, codes.ctypes.data, flags.ctypes.data, len(values), spans
+    native = getattr(slave, "share_native", None)  # FMI 3.0 keeps time in the Python step (above)
+    native = 0 if native is None or arrays is not None else native.ctypes.data
+    return values.ctypes.data, codes.ctypes.data, flags.ctypes.data, len(values), spans, native
 
 
 def reset(slave):
