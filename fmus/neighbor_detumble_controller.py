@@ -54,6 +54,11 @@ class DetumbleController(NeighborSlave):
         # advance (the settle count) and publish in one compiled call: `done` follows the new count
         self.model.step_into(self.shared, self._inputs_at, self._outputs_at, step_size)
         self.mark_published()
+        if not self.share_native[0] and self.native_ready():
+            from components.attitude import native_steps  # numba is loaded: the same step, no Python
+            model = self.model
+            self.arm_native(native_steps.step("detumble_law"), model.constants, self.shared, self._inputs_at,
+                            self._outputs_at, self.share_flags, model.settle.cell)
         return True
 
     def publish(self):

@@ -53,6 +53,10 @@ class RcsThrusters(NeighborSlave):
     def do_step(self, current_time, step_size):
         self.model.step_into(self.shared, self._inputs_at, self._outputs_at, step_size)
         self.mark_published()
+        if not self.share_native[0] and self.native_ready():
+            from components.attitude import native_steps  # numba is loaded: the same step, no Python
+            self.arm_native(native_steps.step("thruster_pairs"), self.model.state, self.shared, self._inputs_at,
+                            self._outputs_at, self.share_flags)
         return True
 
     def publish(self):

@@ -28,6 +28,8 @@ x, y and z against the nominal inertia (box or inertia_B), which the flight soft
 in range); the dispersion campaigns draw it. Zero, the model is the nominal one bit for bit.
 """
 
+import numpy as np
+
 from neighbor_fmu_support import NeighborSlave
 
 from components.attitude import mass_properties, rigid_body
@@ -121,6 +123,11 @@ class RigidBody(NeighborSlave):
             self.mark_published()
         else:  # the get that reads them raises publish's error
             self._outputs_stale()
+        if not self.share_native[0] and not v["propellant_mass_properties"] and self.native_ready():
+            from components.attitude import native_steps  # numba is loaded: the same step, no Python
+            model = self.model
+            self.arm_native(native_steps.step("rigid_body"), model.x, self.shared, self._inputs_at, self._outputs_at,
+                            self.share_flags, np.array([model.max_substep, model.integrator == "euler"], float))
         return True
 
     def publish(self):

@@ -6,6 +6,8 @@ the pair torque), a smaller command fires nothing (Appendix C, every controller)
 """
 import math
 
+import numpy as np
+
 from ..mission.neighbor import SPACECRAFT
 
 F_THRUSTER = SPACECRAFT.rcs_thrust  # N, one cold-gas RCS thruster (MarCO heritage, Appendix A)
@@ -85,7 +87,15 @@ class SettleTimer:
         if not (math.isfinite(dwell) and dwell >= 0):
             raise ValueError(f"settle_time = {dwell!r} s must be a finite number >= 0")
         self.dwell = dwell
-        self.time_inside = 0.0
+        self.cell = np.zeros(1)  # time_inside, in an array that a native step advances in place
+
+    @property
+    def time_inside(self):
+        return float(self.cell[0])
+
+    @time_inside.setter
+    def time_inside(self, value):
+        self.cell[0] = value
 
     def done(self, inside):
         return bool(inside) and self.time_inside >= self.dwell

@@ -1,0 +1,70 @@
+"""The attitude models' native steps (components.core.native): their FMUs' steps as cfuncs that
+the FMU runtime calls without Python, over the same kernels as the Python steps (the same bits).
+Imported once numba is in the process; `step(name)` compiles (or loads from numba's cache) only
+the step asked for: each takes a few tenths of a second to load."""
+import math
+
+from numba import cfunc
+
+from ..core import native
+from . import detumble, rigid_body as body, thrusters
+
+
+def rigid_body(context, t, h):
+    """RigidBody's FMU step (RigidBody.step_and_publish, NeighborSlave.mark_published): context =
+    the state x, the shared values, the input and output indices, the share flags and
+    (max_substep, 1 for euler). 0: stepped, the outputs published or, when the quaternion cannot
+    be published, left stale for the get to raise; 1: an input is not finite, nothing changed."""
+    pairs = native.entries(context, 6)
+    x, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
+    inputs, outputs = native.int64s(pairs, 2), native.int64s(pairs, 3)
+    flags, settings = native.int32s(pairs, 4), native.float64s(pairs, 5)
+    euler = settings[1] != 0.0
+    substeps = 1 if euler else max(1, math.ceil(h / settings[0] - 1e-9))  # RigidBody._substeps
+    error = body.step_publish_into(x, values, inputs, outputs, h, substeps, euler)
+    if error > 0:
+        return 1
+    fresh = 1 if error == 0 else 0
+    flags[0] = fresh
+    flags[1] = fresh
+    return 0
+
+
+
+def thruster_pairs(context, t, h):
+    """RcsThrusters' FMU step (ThrusterPairs.step_into, mark_published): context = the pairs'
+    state, the shared values, the input and output indices, the share flags. 1: a command is not
+    finite, nothing changed."""
+    pairs = native.entries(context, 5)
+    state, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
+    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
+    if thrusters.pairs_into(state, values, inputs, outputs, h, True):
+        return 1
+    flags[0] = 1
+    flags[1] = 1
+    return 0
+
+
+def detumble_law(context, t, h):
+    """DetumbleController's FMU step (DetumbleController.step_into, mark_published): context = the
+    law's constants, the shared values, the input and output indices, the share flags and the
+    settle timer's cell (time_inside)."""
+    pairs = native.entries(context, 6)
+    constants, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
+    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
+    cell = native.float64s(pairs, 5)
+    cell[0] = detumble.detumble_into(constants, values, inputs, outputs, h, cell[0], True)
+    flags[0] = 1
+    flags[1] = 1
+    return 0
+
+
+_STEPS = {}
+
+
+def step(name):
+    """The cfunc of the step `name` (rigid_body, thruster_pairs, detumble_law)."""
+    compiled = _STEPS.get(name)
+    if compiled is None:
+        compiled = _STEPS[name] = cfunc(native.STEP, cache=True)(globals()[name])
+    return compiled

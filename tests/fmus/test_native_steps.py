@@ -1,0 +1,95 @@
+"""Native steps (components.core.native, NeighborSlave.arm_native): once numba is in the process,
+RigidBody, RcsThrusters and DetumbleController hand the binary a compiled step that it calls
+instead of their Python do_step.
+
+Through the binary (FMPy loading the built FMUs, numba loaded as in a long run), against the same
+FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs bit for bit over steps
+with changing inputs, after an FMU state is restored (the model rebuilt: the step disarmed, then
+armed again on the new arrays) and after a reset; and the Python do_step is entered only to arm
+the step (once, and once more after the state is restored), where without it every step enters it.
+"""
+import json
+import os
+import subprocess
+import sys
+
+import pytest
+
+pytest.importorskip("numba")
+
+MODELS = ("RigidBody", "RcsThrusters", "DetumbleController")
+STEPS = 300
+
+RUN = r"""
+import json, sys
+import numba  # as in a long run: numba is in the process before the FMUs step
+import numpy as np
+import fmpy
+from fmpy.fmi2 import FMU2Slave
+
+path, steps, unzip = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+md = fmpy.read_model_description(path)
+wrapper = "neighbor_" + "".join("_" + c.lower() if c.isupper() else c for c in md.modelName).lstrip("_") + ".py"
+entered = [0]
+
+def count(frame, event, arg):  # the wrapper's Python do_step, entered from the binary
+    if event == "call" and frame.f_code.co_name == "do_step" and frame.f_code.co_filename.endswith(wrapper):
+        entered[0] += 1
+
+variables = [v for v in md.modelVariables if v.causality in ("input", "output")]
+ins = [v.valueReference for v in variables if v.causality == "input" and v.type == "Real"]
+outs = {t: [v.valueReference for v in variables if v.causality == "output" and v.type == t]
+        for t in ("Real", "Integer", "Boolean")}
+f = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path, unzipdir=unzip),
+              modelIdentifier=md.coSimulation.modelIdentifier, instanceName="native")
+
+def start():
+    f.setupExperiment(startTime=0.0)
+    f.enterInitializationMode()
+    f.exitInitializationMode()
+
+def step(k, inputs):
+    f.setReal(ins, inputs[k])
+    f.doStep(k * 0.015, 0.015)
+    return f.getReal(outs["Real"]) + f.getInteger(outs["Integer"]) + [bool(b) for b in f.getBoolean(outs["Boolean"])]
+
+rng = np.random.default_rng(5)
+inputs = [rng.uniform(-s, s, len(ins)).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
+f.instantiate()
+start()
+sys.setprofile(count)
+rows, half = [], None
+for k in range(steps):
+    if k == steps // 2:
+        half = f.getFMUstate()
+    rows.append(step(k, inputs))
+f.setFMUstate(half)
+replay = [step(k, inputs) for k in range(steps // 2, steps)]
+f.reset()
+start()
+again = [step(k, inputs) for k in range(10)]
+sys.setprofile(None)
+f.terminate()
+f.freeInstance()
+print(json.dumps({"rows": rows, "replay": replay, "again": again, "entered": entered[0]}))
+"""
+
+
+def _run(path, tmp_path, native):
+    env = dict(os.environ, NEIGHBOR_COSIM_NATIVE=native, NEIGHBOR_COSIM_NUMBA="1")
+    proc = subprocess.run([sys.executable, "-c", RUN, str(path), str(STEPS), str(tmp_path / f"unzip{native}")],
+                          capture_output=True, text=True, env=env, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+@pytest.mark.parametrize("model", MODELS)
+def test_native_step_gives_the_python_steps_bits(fmu_paths, tmp_path, model):
+    native, python = _run(fmu_paths[model], tmp_path, "1"), _run(fmu_paths[model], tmp_path, "0")
+    assert native["rows"] == python["rows"]  # bit for bit (JSON gives floats back exactly)
+    assert native["replay"] == native["rows"][STEPS // 2:] == python["replay"]
+    assert native["again"] == native["rows"][:10] == python["again"]
+    assert python["entered"] == STEPS + STEPS // 2 + 10
+    # native: the first step arms it, the step after the restored state and after the reset re-arm it
+    assert native["entered"] == 3
+    assert len({tuple(r) for r in native["rows"]}) > 5  # the outputs moved (the laws quantize them)
