@@ -7,6 +7,8 @@ takes the same number of steps), each row measured in this run:
 - communication steps per second, recording every connector and recording one signal, with our
   runtime's batched step (neighborStepIO: set, doStep and get in one call into the FMU) and with
   the standard FMI calls only, and their ratio;
+- the same (one signal) with the models' Python steps instead of their native ones
+  (NEIGHBOR_COSIM_NATIVE=0, in a second process), and the ratio;
 - the same with Jacobi (one signal recorded), in the compiled loop and in the Python loop, as a
   ratio of Gauss-Seidel's time;
 - the floor: the same three models' wrapper objects (the classes inside the FMUs, with the same
@@ -22,6 +24,7 @@ takes the same number of steps), each row measured in this run:
 Build first: python build_fmus.py
 """
 import argparse
+import os
 import re
 import statistics
 import subprocess
@@ -207,8 +210,13 @@ def main():
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--steps", type=int, default=4000)
     ap.add_argument("--repeat", type=int, default=3)
+    ap.add_argument("--one-signal", action="store_true", help=argparse.SUPPRESS)  # the second process's answer
     args = ap.parse_args()
     n = args.steps
+    if args.one_signal:
+        with system_ssp.System(SSP / "detumble.ssp") as system:
+            print(n / best_of(args.repeat, lambda: run_detumble(system, n, ["dynamics.q_BN[4]"]))[0])
+        return
     print(f"detumble system, Gauss-Seidel, h = 15 ms, {n} steps per run, best of {args.repeat}")
     with system_ssp.System(SSP / "detumble.ssp") as system:
         few = ["dynamics.q_BN[4]"]
@@ -222,6 +230,14 @@ def main():
             print(f"  {label:<26} {n / fast:9.0f} steps/s batched, {n / slow:7.0f} standard calls: "
                   f"{slow / fast:.2f}x")
         one = best[("one signal recorded", True)] / n
+        # the models' native steps (components.core.native) against their Python steps, same run
+        proc = subprocess.run([sys.executable, __file__, "--one-signal", "--steps", str(n), "--repeat",
+                               str(args.repeat)], capture_output=True, text=True,
+                              env=dict(os.environ, NEIGHBOR_COSIM_NATIVE="0"))
+        if proc.returncode == 0:
+            python_steps = float(proc.stdout.strip().splitlines()[-1])
+            print(f"  {'the same, Python steps':<26} {python_steps:9.0f} steps/s (NEIGHBOR_COSIM_NATIVE=0): the native "
+                  f"steps {1 / one / python_steps:.2f}x faster")
         # Jacobi (libcosim's algorithm) on the same system: the compiled loop, and the Python loop it replaced
         for label, on in (("Jacobi, one signal recorded", True), ("Jacobi in the Python loop", False)):
             compiled.ENABLED = on
