@@ -1,7 +1,7 @@
 """The attitude models' native steps (components.core.native): their FMUs' steps as cfuncs that
 the FMU runtime calls without Python, over the same kernels as the Python steps (the same bits).
-Imported once numba is in the process; `step(name)` compiles (or loads from numba's cache) only
-the step asked for: each takes a few tenths of a second to load."""
+Imported once numba is in the process; `step(name)` compiles only the step asked for (seconds, the
+first time on a machine) or loads it from numba's cache (milliseconds once numba runs)."""
 import math
 
 from numba import cfunc
@@ -28,7 +28,6 @@ def rigid_body(context, t, h):
     flags[0] = fresh
     flags[1] = fresh
     return 0
-
 
 
 def thruster_pairs(context, t, h):

@@ -9,7 +9,7 @@ step calls the same kernels as the Python step on those arrays, so it gives the 
 returns 0 when it took the step, anything else when it changed nothing (the Python step then takes
 it, or raises the error the kernel's code stands for).
 
-Imported once numba is in the process (NeighborSlave.native_steps): it needs numba itself.
+Imported once numba is in the process (NeighborSlave.native_ready, arm_native): it needs numba itself.
 """
 import numpy as np
 from numba import carray, types
