@@ -58,7 +58,8 @@ class DetumbleController(NeighborSlave):
             from components.attitude import native_steps  # numba is loaded: the same step, no Python
             model = self.model
             self.arm_native(native_steps.step("detumble_law"), model.constants, self.shared, self._inputs_at,
-                            self._outputs_at, self.share_flags, model.settle.cell)
+                            self._outputs_at, self.share_flags, model.settle.cell,
+                            publish=native_steps.step("detumble_law_publish"))
         return True
 
     def publish(self):

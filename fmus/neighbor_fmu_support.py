@@ -474,7 +474,7 @@ class NeighborSlave(Fmi2Slave):
         self.shared = np.zeros(n)
         self.share_codes = np.zeros(n, np.int32)
         self.share_flags = np.zeros(2, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH
-        self.share_native = np.zeros(2, np.int64)  # the step's address (0: none), its context's
+        self.share_native = np.zeros(3, np.int64)  # the step's address (0: none), its context's, a publish's
         outputs = {cls: [] for cls in _SHARED_KINDS}
         for vr, var in self.vars.items():
             code = _SHARED_KINDS.get(type(var))
@@ -525,13 +525,16 @@ class NeighborSlave(Fmi2Slave):
         return (NATIVE and jit.ENABLED and "numba" in sys.modules and self.share_native is not None
                 and getattr(self, "_neighbor_arrays", None) is None)
 
-    def arm_native(self, step: Any, *arrays: np.ndarray) -> None:
-        """From the next doStep on, the binary calls the cfunc `step` on `arrays` (kept here)."""
+    def arm_native(self, step: Any, *arrays: np.ndarray, publish: Any = None) -> None:
+        """From the next doStep on, the binary calls the cfunc `step` on `arrays` (kept here); and
+        the cfunc `publish` (same signature and context, t and h unused), when given, where it would
+        call the Python publish for a get of stale outputs."""
         from components.core import native
         self._native_arrays = arrays
         self._native_context = native.context(*arrays)
         self.share_native[1] = self._native_context.ctypes.data
-        self.share_native[0] = step.address
+        self.share_native[2] = 0 if publish is None else publish.address
+        self.share_native[0] = step.address  # last: the binary reads it first
 
     def disarm_native(self) -> None:
         if self.share_native is not None:

@@ -56,7 +56,8 @@ class RcsThrusters(NeighborSlave):
         if not self.share_native[0] and self.native_ready():
             from components.attitude import native_steps  # numba is loaded: the same step, no Python
             self.arm_native(native_steps.step("thruster_pairs"), self.model.state, self.shared, self._inputs_at,
-                            self._outputs_at, self.share_flags)
+                            self._outputs_at, self.share_flags,
+                            publish=native_steps.step("thruster_pairs_publish"))
         return True
 
     def publish(self):

@@ -44,6 +44,19 @@ def thruster_pairs(context, t, h):
     return 0
 
 
+def thruster_pairs_publish(context, t, h):
+    """RcsThrusters' publish (ThrusterPairs.step_into without stepping, mark_published) on
+    thruster_pairs' context; t and h unused. 1: a command is not finite, nothing changed."""
+    pairs = native.entries(context, 5)
+    state, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
+    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
+    if thrusters.pairs_into(state, values, inputs, outputs, 0.0, False):
+        return 1
+    flags[0] = 1
+    flags[1] = 1
+    return 0
+
+
 def detumble_law(context, t, h):
     """DetumbleController's FMU step (DetumbleController.step_into, mark_published): context = the
     law's constants, the shared values, the input and output indices, the share flags and the
@@ -58,11 +71,25 @@ def detumble_law(context, t, h):
     return 0
 
 
+def detumble_law_publish(context, t, h):
+    """DetumbleController's publish (DetumbleController.step_into without stepping,
+    mark_published) on detumble_law's context; t and h unused."""
+    pairs = native.entries(context, 6)
+    constants, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
+    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
+    cell = native.float64s(pairs, 5)
+    cell[0] = detumble.detumble_into(constants, values, inputs, outputs, 0.0, cell[0], False)
+    flags[0] = 1
+    flags[1] = 1
+    return 0
+
+
 _STEPS = {}
 
 
 def step(name):
-    """The cfunc of the step `name` (rigid_body, thruster_pairs, detumble_law)."""
+    """The cfunc of the step or publish `name` (rigid_body, thruster_pairs, thruster_pairs_publish,
+    detumble_law, detumble_law_publish)."""
     compiled = _STEPS.get(name)
     if compiled is None:
         compiled = _STEPS[name] = cfunc(native.STEP, cache=True)(globals()[name])

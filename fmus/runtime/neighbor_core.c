@@ -492,9 +492,10 @@ typedef struct {
     int *sh_flags;
     size_t sh_n;
     PyObject *m_publish;  /* the slave's publish: writes every shared output, marks them fresh */
-    /* The slave's native step (NeighborSlave.arm_native), two int64 it owns: the address of a
+    /* The slave's native step (NeighborSlave.arm_native), three int64 it owns: the address of a
      * compiled int step(context, t, h) that takes the step and publishes without Python (0: none
-     * now) and its context. NULL when the slave shares no values. */
+     * now), its context, and the address of a compiled publish on the same context (0: publish
+     * through Python). NULL when the slave shares no values. */
     const long long *sh_native;
     int state;            /* where the standard's state machine is (S_* below) */
     double next_time;     /* where the next doStep must start: the start time (0 until a setup or
@@ -1034,9 +1035,18 @@ static void copy_shared_out(const Instance *inst, int kind, const unsigned int v
 
 /* A get of shared variables: from memory, after one call of the model's publish when an output
    asked for is not fresh (a step, a parameter or, for a feedthrough output, an input changed). */
+typedef int (*NativeStep)(long long context, double t, double h);
+
 static Status get_shared(Instance *inst, int kind, const unsigned int vr[], size_t nvr, void *out,
                          size_t bool_size, int needs, const char *what) {
     int stale = ((needs & 1) && !inst->sh_flags[FRESH_STATE]) || ((needs & 2) && !inst->sh_flags[FRESH_FEEDTHROUGH]);
+    const long long *native = inst->sh_native;
+    if (stale && !inst->broken && native && native[0] && native[2]) {
+        /* the model's compiled publish (armed with its step): writes the outputs, marks them fresh;
+           non-zero when it changed nothing (the Python publish below then raises the error) */
+        NativeStep publish = (NativeStep)(intptr_t)native[2];
+        stale = publish(native[1], 0.0, 0.0) != 0;
+    }
     if (stale) {
         int gil = py.GILStateEnsure();
         Status status = ST_OK;
@@ -1312,8 +1322,6 @@ static Status skip_to(void *c, double t) {
     ((Instance *)c)->next_time = t;
     return ST_OK;
 }
-
-typedef int (*NativeStep)(long long context, double t, double h);
 
 static Status step_model(void *c, double t, double h, const char *what) {
     const Instance *armed = (const Instance *)c;

@@ -1,12 +1,14 @@
 """Native steps (components.core.native, NeighborSlave.arm_native): once numba is in the process,
 RigidBody, RcsThrusters and DetumbleController hand the binary a compiled step that it calls
-instead of their Python do_step.
+instead of their Python do_step, and the two laws with outputs that depend on inputs a compiled
+publish it calls instead of their Python publish (a get after a set, as Gauss-Seidel does).
 
 Through the binary (FMPy loading the built FMUs, numba loaded as in a long run), against the same
 FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs bit for bit over steps
 with changing inputs, after an FMU state is restored (the model rebuilt: the step disarmed, then
 armed again on the new arrays) and after a reset; and the Python do_step is entered only to arm
-the step (once, and once more after the state is restored), where without it every step enters it.
+the step (once, and once more after the state is restored), where without it every step enters it;
+likewise the Python publish.
 """
 import json
 import os
@@ -30,11 +32,11 @@ from fmpy.fmi2 import FMU2Slave
 path, steps, unzip = sys.argv[1], int(sys.argv[2]), sys.argv[3]
 md = fmpy.read_model_description(path)
 wrapper = "neighbor_" + "".join("_" + c.lower() if c.isupper() else c for c in md.modelName).lstrip("_") + ".py"
-entered = [0]
+entered = {"do_step": 0, "publish": 0}
 
-def count(frame, event, arg):  # the wrapper's Python do_step, entered from the binary
-    if event == "call" and frame.f_code.co_name == "do_step" and frame.f_code.co_filename.endswith(wrapper):
-        entered[0] += 1
+def count(frame, event, arg):  # the wrapper's Python do_step and publish, entered from the binary
+    if event == "call" and frame.f_code.co_name in entered and frame.f_code.co_filename.endswith(wrapper):
+        entered[frame.f_code.co_name] += 1
 
 variables = [v for v in md.modelVariables if v.causality in ("input", "output")]
 ins = [v.valueReference for v in variables if v.causality == "input" and v.type == "Real"]
@@ -48,10 +50,14 @@ def start():
     f.enterInitializationMode()
     f.exitInitializationMode()
 
+def outputs():
+    return f.getReal(outs["Real"]) + f.getInteger(outs["Integer"]) + [bool(b) for b in f.getBoolean(outs["Boolean"])]
+
 def step(k, inputs):
     f.setReal(ins, inputs[k])
+    before = outputs()  # after the set: the outputs that depend on inputs published again
     f.doStep(k * 0.015, 0.015)
-    return f.getReal(outs["Real"]) + f.getInteger(outs["Integer"]) + [bool(b) for b in f.getBoolean(outs["Boolean"])]
+    return before + outputs()
 
 rng = np.random.default_rng(5)
 inputs = [rng.uniform(-s, s, len(ins)).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
@@ -71,7 +77,7 @@ again = [step(k, inputs) for k in range(10)]
 sys.setprofile(None)
 f.terminate()
 f.freeInstance()
-print(json.dumps({"rows": rows, "replay": replay, "again": again, "entered": entered[0]}))
+print(json.dumps({"rows": rows, "replay": replay, "again": again, "entered": entered}))
 """
 
 
@@ -89,7 +95,11 @@ def test_native_step_gives_the_python_steps_bits(fmu_paths, tmp_path, model):
     assert native["rows"] == python["rows"]  # bit for bit (JSON gives floats back exactly)
     assert native["replay"] == native["rows"][STEPS // 2:] == python["replay"]
     assert native["again"] == native["rows"][:10] == python["again"]
-    assert python["entered"] == STEPS + STEPS // 2 + 10
+    assert python["entered"]["do_step"] == STEPS + STEPS // 2 + 10
     # native: the first step arms it, the step after the restored state and after the reset re-arm it
-    assert native["entered"] == 3
+    assert native["entered"]["do_step"] == 3
+    if model != "RigidBody":  # its outputs depend on no input: a set leaves them fresh
+        assert python["entered"]["publish"] >= STEPS + STEPS // 2 + 10
+        # before each of the three Python steps (the step not armed yet) the publish is Python too
+        assert native["entered"]["publish"] == 3
     assert len({tuple(r) for r in native["rows"]}) > 5  # the outputs moved (the laws quantize them)
