@@ -123,11 +123,16 @@ class RigidBody(NeighborSlave):
             self.mark_published()
         else:  # the get that reads them raises publish's error
             self._outputs_stale()
-        if not self.share_native[0] and not v["propellant_mass_properties"] and self.native_ready():
+        if not self.share_native[0] and self.native_ready():
             from components.attitude import native_steps  # numba is loaded: the same step, no Python
             model = self.model
-            self.arm_native(native_steps.step("rigid_body"), model.x, self.shared, self._inputs_at, self._outputs_at,
-                            self.share_flags, np.array([model.max_substep, model.integrator == "euler"], float))
+            arrays = (model.x, self.shared, self._inputs_at, self._outputs_at, self.share_flags,
+                      np.array([model.max_substep, model.integrator == "euler"], float))
+            if v["propellant_mass_properties"]:  # native while the inertia need not follow the tank
+                used = self.shared_indices((("propellant_used", 1), ("rcs_propellant", 1)))
+                self.arm_native(native_steps.step("rigid_body_following"), *arrays, model.drawn_cell, used)
+            else:
+                self.arm_native(native_steps.step("rigid_body"), *arrays)
         return True
 
     def publish(self):

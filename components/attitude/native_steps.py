@@ -6,8 +6,8 @@ import math
 
 from numba import cfunc
 
-from ..core import native
-from . import detumble, rigid_body as body, thrusters
+from ..core import jit, native
+from . import detumble, mass_properties, rigid_body as body, thrusters
 
 
 def rigid_body(context, t, h):
@@ -15,6 +15,25 @@ def rigid_body(context, t, h):
     the state x, the shared values, the input and output indices, the share flags and
     (max_substep, 1 for euler). 0: stepped, the outputs published or, when the quaternion cannot
     be published, left stale for the get to raise; 1: an input is not finite, nothing changed."""
+    return _rigid_body_step(context, h)
+
+
+def rigid_body_following(context, t, h):
+    """RigidBody's FMU step with propellant_mass_properties, while the propellant drawn stays
+    within mass_properties.RESOLUTION of the amount its inertia follows (RigidBody.follow_propellant
+    has nothing to do then): context = rigid_body's, then the followed amount's cell
+    (RigidBody.drawn_cell) and the indices of the inputs propellant_used and rcs_propellant.
+    1 also when the inertia must follow: nothing changed, and the Python step recomputes it."""
+    pairs = native.entries(context, 8)
+    values, cell, used = native.float64s(pairs, 1), native.float64s(pairs, 6), native.int64s(pairs, 7)
+    drawn = values[used[0]] + values[used[1]]  # the Python step's sum of the two inputs
+    if not abs(drawn - cell[0]) < mass_properties.RESOLUTION:
+        return 1
+    return _rigid_body_step(context, h)
+
+
+@jit.numba.njit(inline="always")
+def _rigid_body_step(context, h):
     pairs = native.entries(context, 6)
     x, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
     inputs, outputs = native.int64s(pairs, 2), native.int64s(pairs, 3)
@@ -88,8 +107,8 @@ _STEPS = {}
 
 
 def step(name):
-    """The cfunc of the step or publish `name` (rigid_body, thruster_pairs, thruster_pairs_publish,
-    detumble_law, detumble_law_publish)."""
+    """The cfunc of the step or publish `name` (rigid_body, rigid_body_following, thruster_pairs,
+    thruster_pairs_publish, detumble_law, detumble_law_publish)."""
     compiled = _STEPS.get(name)
     if compiled is None:
         compiled = _STEPS[name] = cfunc(native.STEP, cache=True)(globals()[name])

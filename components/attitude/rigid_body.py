@@ -120,6 +120,7 @@ class RigidBody:
         self._inputs = np.zeros(9)  # step()'s torques in the compiled step's form
         self.set_inertia(tuple(map(tuple, J.tolist())), tuple(map(tuple, np.linalg.inv(J).tolist())))
         self.J0 = self.J  # the inertia at takeover, before any propellant is drawn
+        self.drawn_cell = np.zeros(1)  # the FMU's native step reads it where the binary calls it
         self.drawn = 0.0  # kg of propellant the inertia has followed (follow_propellant)
         self.center_of_mass = (0.0, 0.0, 0.0)  # m in B, from the takeover centre of mass
         q0 = tuple(float(x) for x in q0)
@@ -136,6 +137,15 @@ class RigidBody:
         if len(euler0) != 3 or not all(math.isfinite(x) for x in euler0):
             raise ValueError(f"euler0 {list(euler0)} must be three finite angles in rad")
         self.euler_integrated = euler0
+
+    @property
+    def drawn(self):
+        """kg of propellant the inertia has followed (follow_propellant), kept in drawn_cell."""
+        return float(self.drawn_cell[0])
+
+    @drawn.setter
+    def drawn(self, value):
+        self.drawn_cell[0] = value
 
     def set_inertia(self, J, Jinv):
         """Hold the inertia J (and its inverse) from now on: the mass properties as the tank empties

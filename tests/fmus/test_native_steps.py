@@ -29,7 +29,7 @@ import numpy as np
 import fmpy
 from fmpy.fmi2 import FMU2Slave
 
-path, steps, unzip = sys.argv[1], int(sys.argv[2]), sys.argv[3]
+path, steps, unzip, following = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
 md = fmpy.read_model_description(path)
 wrapper = "neighbor_" + "".join("_" + c.lower() if c.isupper() else c for c in md.modelName).lstrip("_") + ".py"
 entered = {"do_step": 0, "publish": 0}
@@ -45,9 +45,13 @@ outs = {t: [v.valueReference for v in variables if v.causality == "output" and v
 f = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path, unzipdir=unzip),
               modelIdentifier=md.coSimulation.modelIdentifier, instanceName="native")
 
+by_name = {v.name: v.valueReference for v in md.modelVariables}
+
 def start():
     f.setupExperiment(startTime=0.0)
     f.enterInitializationMode()
+    if following:  # RigidBody's inertia follows the propellant drawn
+        f.setBoolean([by_name["propellant_mass_properties"]], [True])
     f.exitInitializationMode()
 
 def outputs():
@@ -61,6 +65,10 @@ def step(k, inputs):
 
 rng = np.random.default_rng(5)
 inputs = [rng.uniform(-s, s, len(ins)).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
+if following:  # the tank drains by 3e-5 kg a step: the inertia follows every few steps (1e-4 kg)
+    for k, row in enumerate(inputs):
+        row[ins.index(by_name["propellant_used"])] = 2e-5 * k
+        row[ins.index(by_name["rcs_propellant"])] = 1e-5 * k
 f.instantiate()
 start()
 sys.setprofile(count)
@@ -81,10 +89,10 @@ print(json.dumps({"rows": rows, "replay": replay, "again": again, "entered": ent
 """
 
 
-def _run(path, tmp_path, native):
+def _run(path, tmp_path, native, following=False):
     env = dict(os.environ, NEIGHBOR_COSIM_NATIVE=native, NEIGHBOR_COSIM_NUMBA="1")
-    proc = subprocess.run([sys.executable, "-c", RUN, str(path), str(STEPS), str(tmp_path / f"unzip{native}")],
-                          capture_output=True, text=True, env=env, timeout=600)
+    proc = subprocess.run([sys.executable, "-c", RUN, str(path), str(STEPS), str(tmp_path / f"unzip{native}"),
+                           "1" if following else "0"], capture_output=True, text=True, env=env, timeout=600)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -103,3 +111,20 @@ def test_native_step_gives_the_python_steps_bits(fmu_paths, tmp_path, model):
         # before each of the three Python steps (the step not armed yet) the publish is Python too
         assert native["entered"]["publish"] == 3
     assert len({tuple(r) for r in native["rows"]}) > 5  # the outputs moved (the laws quantize them)
+
+
+def test_native_step_follows_the_propellant_as_the_python_step(fmu_paths, tmp_path):
+    """RigidBody with propellant_mass_properties: native while the propellant drawn stays within
+    mass_properties.RESOLUTION of the amount the inertia follows; the steps where it moved past it
+    go through Python (which recomputes the inertia), the rest not; the same bits throughout."""
+    native = _run(fmu_paths["RigidBody"], tmp_path, "1", following=True)
+    python = _run(fmu_paths["RigidBody"], tmp_path, "0", following=True)
+    assert native["rows"] == python["rows"]
+    assert native["replay"] == native["rows"][STEPS // 2:] == python["replay"]
+    assert native["again"] == native["rows"][:10] == python["again"]
+    steps = STEPS + STEPS // 2 + 10
+    assert python["entered"]["do_step"] == steps
+    # 3e-5 kg a step: the inertia follows at about every fourth step, which the Python step takes
+    assert steps // 5 < native["entered"]["do_step"] < steps // 2
+    centre = [row[-3:] for row in native["rows"]]  # center_of_mass_B, the last Real output after the step
+    assert len({tuple(c) for c in centre}) > STEPS // 5  # the centre of mass moved as the tank drained
