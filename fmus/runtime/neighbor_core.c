@@ -1033,10 +1033,11 @@ static void copy_shared_out(const Instance *inst, int kind, const unsigned int v
     }
 }
 
-/* A get of shared variables: from memory, after one call of the model's publish when an output
-   asked for is not fresh (a step, a parameter or, for a feedthrough output, an input changed). */
+/* A model's native step or publish (NeighborSlave.arm_native): 0 when it did its work. */
 typedef int (*NativeStep)(long long context, double t, double h);
 
+/* A get of shared variables: from memory, after one call of the model's publish when an output
+   asked for is not fresh (a step, a parameter or, for a feedthrough output, an input changed). */
 static Status get_shared(Instance *inst, int kind, const unsigned int vr[], size_t nvr, void *out,
                          size_t bool_size, int needs, const char *what) {
     int stale = ((needs & 1) && !inst->sh_flags[FRESH_STATE]) || ((needs & 2) && !inst->sh_flags[FRESH_FEEDTHROUGH]);
