@@ -520,10 +520,9 @@ class NeighborSlave(Fmi2Slave):
     # Python step arms it again on the new model's arrays.
     def native_ready(self) -> bool:
         """True once numba is in the process (it is not started for a native step), unless
-        NEIGHBOR_COSIM_NATIVE=0 or the FMU is the FMI 3.0 one (whose loader keeps the time in its
-        Python step): a wrapper may then import its native steps and arm one."""
-        return (NATIVE and jit.ENABLED and "numba" in sys.modules and self.share_native is not None
-                and getattr(self, "_neighbor_arrays", None) is None)
+        NEIGHBOR_COSIM_NATIVE=0: a wrapper may then import its native steps and arm one. (The FMI
+        3.0 loader's clock, which its Python step advances, the binary advances after a native one.)"""
+        return NATIVE and jit.ENABLED and "numba" in sys.modules and self.share_native is not None
 
     def arm_native(self, step: Any, *arrays: np.ndarray, publish: Any = None) -> None:
         """From the next doStep on, the binary calls the cfunc `step` on `arrays` (kept here); and
@@ -649,13 +648,17 @@ class NeighborSlave(Fmi2Slave):
 
     # ---- FMU state: every value plus the model's full (hidden) state --------------------
     def _get_fmu_state(self):
+        clock = getattr(self, "_neighbor_clock", None)  # FMI 3.0: the time (neighbor_runtime)
         return {
             "values": copy.deepcopy(self.values),
             "model": None if self._model is None else self._model.get_state(),
             "shared": None if self.shared is None else self.shared.copy(),
+            "clock": None if clock is None else float(clock[0]),
         }
 
     def _set_fmu_state(self, state):
+        if state.get("clock") is not None:
+            self._neighbor_clock[0] = state["clock"]  # in place: the binary holds its address
         self.values = copy.deepcopy(state["values"])
         self._input_version += 1  # never a version an earlier cache entry could carry
         self._drop_model()

@@ -497,6 +497,8 @@ typedef struct {
      * now), its context, and the address of a compiled publish on the same context (0: publish
      * through Python). NULL when the slave shares no values. */
     const long long *sh_native;
+    double *sh_clock;     /* FMI 3.0: the model's time (NeighborSlave's _neighbor_clock), which a
+                             native step advances; NULL for FMI 2.0 */
     int state;            /* where the standard's state machine is (S_* below) */
     double next_time;     /* where the next doStep must start: the start time (0 until a setup or
                              an initialization says otherwise), then the end of the last step */
@@ -758,6 +760,7 @@ static int link_shared(Instance *inst) {
     inst->sh_spans = NULL;
     inst->sh_flags = NULL;
     inst->sh_native = NULL;
+    inst->sh_clock = NULL;
     inst->sh_n = 0;
     if (inst->m_publish) {
         py.DecRef(inst->m_publish);
@@ -778,6 +781,7 @@ static int link_shared(Instance *inst) {
         long n = py.LongAsLong(py.TupleGetItem(res, 3));
         void *spans = py.LongAsVoidPtr(py.TupleGetItem(res, 4));  /* NULL (0) without arrays */
         void *native = py.LongAsVoidPtr(py.TupleGetItem(res, 5));  /* NULL (0): always through Python */
+        void *clock = py.LongAsVoidPtr(py.TupleGetItem(res, 6));  /* NULL (0) for FMI 2.0 */
         inst->m_publish = method(inst, "publish");
         if (py.ErrOccurred() || !values || !codes || !flags || n < 0 || !inst->m_publish) {
             ok = 0;
@@ -787,6 +791,7 @@ static int link_shared(Instance *inst) {
             inst->sh_flags = (int *)flags;
             inst->sh_spans = (const int *)spans;
             inst->sh_native = (const long long *)native;
+            inst->sh_clock = (double *)clock;
             inst->sh_n = (size_t)n;
         }
     }
@@ -1329,7 +1334,10 @@ static Status step_model(void *c, double t, double h, const char *what) {
     if (armed && !armed->broken && armed->sh_native && armed->sh_native[0]) {
         /* the model's compiled step: no Python, no GIL (it touches only the slave's arrays) */
         NativeStep step = (NativeStep)(intptr_t)armed->sh_native[0];
-        if (step(armed->sh_native[1], t, h) == 0) return ST_OK;
+        if (step(armed->sh_native[1], t, h) == 0) {
+            if (armed->sh_clock) armed->sh_clock[0] = t + h;  /* as the FMI 3.0 loader's Python step */
+            return ST_OK;
+        }
         /* it changed nothing: the Python step below takes it, or reports why it cannot */
     }
     ENTER(c, what)  /* a sharing model's step publishes its outputs (or leaves them stale) itself */

@@ -15,6 +15,7 @@ import importlib.abc
 import importlib.machinery
 import importlib.util
 import marshal
+import math
 import os
 import site
 import sys
@@ -236,14 +237,18 @@ def _fmi3_variables(slave, cfg):
         arrays[int(vr)] = int(n)
     slave._neighbor_arrays = arrays
     slave._neighbor_inner = {vr + k for vr, n in arrays.items() for k in range(1, n)}
+    import numpy  # imported by _instantiate
+
     slave._neighbor_time_vr = int(cfg["time"][0])
-    slave._neighbor_time = None
+    # the time after the last step, NaN before the first: an array the binary also writes when it
+    # takes a native step (shared_memory), kept in the FMU state (NeighborSlave._get_fmu_state)
+    slave._neighbor_clock = numpy.full(1, math.nan)
     step = slave.do_step
 
     def do_step(current_time, step_size):
         done = step(current_time, step_size)
         if done:
-            slave._neighbor_time = current_time + step_size
+            slave._neighbor_clock[0] = current_time + step_size
         return done
 
     slave.do_step = do_step
@@ -271,7 +276,8 @@ def get_values(slave, kind, vrs):
     """FMI 3.0 get of the variables `vrs` of `kind` (0 Float64, 1 Int32, 2 Boolean, 3 String): the
     values, arrays serialized in row-major order."""
     if kind == 0 and slave._neighbor_time_vr in vrs:
-        time = slave.start_time if slave._neighbor_time is None else slave._neighbor_time
+        clock = float(slave._neighbor_clock[0])
+        time = slave.start_time if math.isnan(clock) else clock
         i = vrs.index(slave._neighbor_time_vr)
         return get_values(slave, kind, vrs[:i]) + [time] + get_values(slave, kind, vrs[i + 1:])
     return getattr(slave, f"get_{KINDS[kind]}")(_elements(slave, vrs))
@@ -289,8 +295,8 @@ def set_values(slave, kind, vrs, values):
 
 def shared_memory(slave):
     """(address of the values, of the codes, of the flags, number of value references, address of
-    the spans or 0, address of the native step's two slots or 0: NeighborSlave.arm_native) of the
-    arrays a slave shares with the binary (NeighborSlave.share_values), or
+    the spans or 0, address of the native step's slots or 0: NeighborSlave.arm_native, address of
+    the FMI 3.0 clock or 0) of the arrays a slave shares with the binary (NeighborSlave.share_values), or
     None: its values then cross through get_*/set_*. For FMI 3.0 the spans give how many elements
     each value reference stands for (an array's, 1 for a scalar, 0 inside an array). The arrays
     stay the slave's (the binary asks again after a reset)."""
@@ -310,9 +316,11 @@ def shared_memory(slave):
         slave.share_spans = codes.copy()  # int32, kept with the slave
         slave.share_spans[:] = span_array
         spans = slave.share_spans.ctypes.data
-    native = getattr(slave, "share_native", None)  # FMI 3.0 keeps time in the Python step (above)
-    native = 0 if native is None or arrays is not None else native.ctypes.data
-    return values.ctypes.data, codes.ctypes.data, flags.ctypes.data, len(values), spans, native
+    native = getattr(slave, "share_native", None)
+    native = 0 if native is None else native.ctypes.data
+    clock = getattr(slave, "_neighbor_clock", None)  # FMI 3.0: a native step advances the time too
+    clock = 0 if clock is None else clock.ctypes.data
+    return values.ctypes.data, codes.ctypes.data, flags.ctypes.data, len(values), spans, native, clock
 
 
 def reset(slave):
@@ -320,8 +328,8 @@ def reset(slave):
     queue = slave.log_queue
     with _LOCK:
         slave.__init__(**slave._neighbor_init)
-    if hasattr(slave, "_neighbor_time"):
-        slave._neighbor_time = None
+    if hasattr(slave, "_neighbor_clock"):
+        slave._neighbor_clock[0] = math.nan
     queue.extend(slave.log_queue)
     slave.log_queue = queue
 

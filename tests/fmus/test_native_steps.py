@@ -3,8 +3,8 @@ RigidBody, RcsThrusters and DetumbleController hand the binary a compiled step t
 instead of their Python do_step, and the two laws with outputs that depend on inputs a compiled
 publish it calls instead of their Python publish (a get after a set, as Gauss-Seidel does).
 
-Through the binary (FMPy loading the built FMUs, numba loaded as in a long run), against the same
-FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs bit for bit over steps
+Through the binary (FMPy loading the built FMUs, FMI 2.0 and 3.0, numba loaded as in a long run),
+against the same FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs bit for bit over steps
 with changing inputs, after an FMU state is restored (the model rebuilt: the step disarmed, then
 armed again on the new arrays) and after a reset; and the Python do_step is entered only to arm
 the step (once, and once more after the state is restored), where without it every step enters it;
@@ -28,9 +28,11 @@ import numba  # as in a long run: numba is in the process before the FMUs step
 import numpy as np
 import fmpy
 from fmpy.fmi2 import FMU2Slave
+from fmpy.fmi3 import FMU3Slave
 
 path, steps, unzip, following = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
 md = fmpy.read_model_description(path)
+fmi3 = md.fmiVersion.startswith("3")
 wrapper = "neighbor_" + "".join("_" + c.lower() if c.isupper() else c for c in md.modelName).lstrip("_") + ".py"
 entered = {"do_step": 0, "publish": 0}
 
@@ -38,46 +40,68 @@ def count(frame, event, arg):  # the wrapper's Python do_step and publish, enter
     if event == "call" and frame.f_code.co_name in entered and frame.f_code.co_filename.endswith(wrapper):
         entered[frame.f_code.co_name] += 1
 
+REAL, INTEGER = ("Float64", "Int32") if fmi3 else ("Real", "Integer")
+
+def size(v):  # elements of an FMI 3.0 array, 1 for a scalar
+    n = 1
+    for d in v.dimensions or []:
+        n *= int(d.start)
+    return n
+
 variables = [v for v in md.modelVariables if v.causality in ("input", "output")]
-ins = [v.valueReference for v in variables if v.causality == "input" and v.type == "Real"]
-outs = {t: [v.valueReference for v in variables if v.causality == "output" and v.type == t]
-        for t in ("Real", "Integer", "Boolean")}
-f = FMU2Slave(guid=md.guid, unzipDirectory=fmpy.extract(path, unzipdir=unzip),
-              modelIdentifier=md.coSimulation.modelIdentifier, instanceName="native")
+inputs_of = [v for v in variables if v.causality == "input" and v.type == REAL]
+ins = [v.valueReference for v in inputs_of]
+n_in = sum(size(v) for v in inputs_of)
+outs = {t: [v for v in variables if v.causality == "output" and v.type == t] for t in (REAL, INTEGER, "Boolean")}
+time = [v.valueReference for v in md.modelVariables if v.causality == "independent"]  # FMI 3.0
+f = (FMU3Slave if fmi3 else FMU2Slave)(guid=md.guid, unzipDirectory=fmpy.extract(path, unzipdir=unzip),
+                                       modelIdentifier=md.coSimulation.modelIdentifier, instanceName="native")
+
+def get(kind):
+    vrs = [v.valueReference for v in outs[kind]]
+    if not fmi3:
+        return getattr(f, "get" + kind)(vrs)
+    return getattr(f, "get" + kind)(vrs, sum(size(v) for v in outs[kind]))
 
 by_name = {v.name: v.valueReference for v in md.modelVariables}
 
 def start():
-    f.setupExperiment(startTime=0.0)
-    f.enterInitializationMode()
+    if fmi3:
+        f.enterInitializationMode(startTime=0.0)
+    else:
+        f.setupExperiment(startTime=0.0)
+        f.enterInitializationMode()
     if following:  # RigidBody's inertia follows the propellant drawn
         f.setBoolean([by_name["propellant_mass_properties"]], [True])
     f.exitInitializationMode()
 
-def outputs():
-    return f.getReal(outs["Real"]) + f.getInteger(outs["Integer"]) + [bool(b) for b in f.getBoolean(outs["Boolean"])]
+def outputs():  # FMI 3.0: with the time, which the binary keeps after a native step (a get of its own:
+    # the time is not one of the model's shared values, so a get with it goes through Python)
+    clock = f.getFloat64(time) if fmi3 else []
+    return get(REAL) + get(INTEGER) + [bool(b) for b in get("Boolean")] + clock
 
 def step(k, inputs):
-    f.setReal(ins, inputs[k])
+    getattr(f, "set" + REAL)(ins, inputs[k])
     before = outputs()  # after the set: the outputs that depend on inputs published again
     f.doStep(k * 0.015, 0.015)
     return before + outputs()
 
 rng = np.random.default_rng(5)
-inputs = [rng.uniform(-s, s, len(ins)).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
+inputs = [rng.uniform(-s, s, n_in).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
 if following:  # the tank drains by 3e-5 kg a step: the inertia follows every few steps (1e-4 kg)
+    at = {v.valueReference: sum(size(u) for u in inputs_of[:i]) for i, v in enumerate(inputs_of)}
     for k, row in enumerate(inputs):
-        row[ins.index(by_name["propellant_used"])] = 2e-5 * k
-        row[ins.index(by_name["rcs_propellant"])] = 1e-5 * k
+        row[at[by_name["propellant_used"]]] = 2e-5 * k
+        row[at[by_name["rcs_propellant"]]] = 1e-5 * k
 f.instantiate()
 start()
 sys.setprofile(count)
 rows, half = [], None
 for k in range(steps):
     if k == steps // 2:
-        half = f.getFMUstate()
+        half = getattr(f, "getFMUState" if fmi3 else "getFMUstate")()
     rows.append(step(k, inputs))
-f.setFMUstate(half)
+getattr(f, "setFMUState" if fmi3 else "setFMUstate")(half)
 replay = [step(k, inputs) for k in range(steps // 2, steps)]
 f.reset()
 start()
@@ -97,10 +121,13 @@ def _run(path, tmp_path, native, following=False):
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
+@pytest.mark.parametrize("fmi", ("2.0", "3.0"))
 @pytest.mark.parametrize("model", MODELS)
-def test_native_step_gives_the_python_steps_bits(fmu_paths, tmp_path, model):
-    native, python = _run(fmu_paths[model], tmp_path, "1"), _run(fmu_paths[model], tmp_path, "0")
+def test_native_step_gives_the_python_steps_bits(fmu_paths, fmu3_paths, tmp_path, model, fmi):
+    path = (fmu_paths if fmi == "2.0" else fmu3_paths)[model]
+    native, python = _run(path, tmp_path, "1"), _run(path, tmp_path, "0")
     assert native["rows"] == python["rows"]  # bit for bit (JSON gives floats back exactly)
+    # (FMI 3.0: with the time, which the restored state and the reset set back)
     assert native["replay"] == native["rows"][STEPS // 2:] == python["replay"]
     assert native["again"] == native["rows"][:10] == python["again"]
     assert python["entered"]["do_step"] == STEPS + STEPS // 2 + 10
