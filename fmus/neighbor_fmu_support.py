@@ -520,8 +520,8 @@ class NeighborSlave(Fmi2Slave):
     # Python step arms it again on the new model's arrays.
     def native_ready(self) -> bool:
         """True once numba is in the process (it is not started for a native step), unless
-        NEIGHBOR_COSIM_NATIVE=0: a wrapper may then import its native steps and arm one. (The FMI
-        3.0 loader's clock, which its Python step advances, the binary advances after a native one.)"""
+        NEIGHBOR_COSIM_NATIVE=0: a wrapper may then import its native steps and arm one. (For FMI
+        3.0 the binary advances the loader's clock after a native step, as the loader's step does.)"""
         return NATIVE and jit.ENABLED and "numba" in sys.modules and self.share_native is not None
 
     def arm_native(self, step: Any, *arrays: np.ndarray, publish: Any = None) -> None:
