@@ -3,12 +3,12 @@ RigidBody, RcsThrusters and DetumbleController hand the binary a compiled step t
 instead of their Python do_step, and the two laws with outputs that depend on inputs a compiled
 publish it calls instead of their Python publish (a get after a set, as Gauss-Seidel does).
 
-Through the binary (FMPy loading the built FMUs, FMI 2.0 and 3.0, numba loaded as in a long run),
-against the same FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs bit for bit over steps
-with changing inputs, after an FMU state is restored (the model rebuilt: the step disarmed, then
-armed again on the new arrays) and after a reset; and the Python do_step is entered only to arm
-the step (once, and once more after the state is restored), where without it every step enters it;
-likewise the Python publish.
+Through the binary (FMPy loading the built FMUs, FMI 2.0 and 3.0, numba loaded as in a long
+run), against the same FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs
+(and FMI 3.0's time) bit for bit over steps with changing inputs, after an FMU state is restored
+(the model rebuilt: the step disarmed, then armed again on the new arrays) and after a reset; and
+the Python do_step is entered only to arm the step (once, and once more after the state is
+restored and after the reset), where without it every step enters it; likewise the Python publish.
 """
 import json
 import os
