@@ -53,23 +53,21 @@ def thruster_pairs(context, t, h):
     """RcsThrusters' FMU step (ThrusterPairs.step_into, mark_published): context = the pairs'
     state, the shared values, the input and output indices, the share flags. 1: a command is not
     finite, nothing changed."""
-    pairs = native.entries(context, 5)
-    state, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
-    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
-    if thrusters.pairs_into(state, values, inputs, outputs, h, True):
-        return 1
-    flags[0] = 1
-    flags[1] = 1
-    return 0
+    return _thruster_pairs(context, h, True)
 
 
 def thruster_pairs_publish(context, t, h):
     """RcsThrusters' publish (ThrusterPairs.step_into without stepping, mark_published) on
     thruster_pairs' context; t and h unused. 1: a command is not finite, nothing changed."""
+    return _thruster_pairs(context, 0.0, False)
+
+
+@jit.numba.njit(inline="always")
+def _thruster_pairs(context, h, stepping):
     pairs = native.entries(context, 5)
     state, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
     inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
-    if thrusters.pairs_into(state, values, inputs, outputs, 0.0, False):
+    if thrusters.pairs_into(state, values, inputs, outputs, h, stepping):
         return 1
     flags[0] = 1
     flags[1] = 1
@@ -80,24 +78,22 @@ def detumble_law(context, t, h):
     """DetumbleController's FMU step (DetumbleController.step_into, mark_published): context = the
     law's constants, the shared values, the input and output indices, the share flags and the
     settle timer's cell (time_inside)."""
-    pairs = native.entries(context, 6)
-    constants, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
-    inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
-    cell = native.float64s(pairs, 5)
-    cell[0] = detumble.detumble_into(constants, values, inputs, outputs, h, cell[0], True)
-    flags[0] = 1
-    flags[1] = 1
-    return 0
+    return _detumble_law(context, h, True)
 
 
 def detumble_law_publish(context, t, h):
     """DetumbleController's publish (DetumbleController.step_into without stepping,
     mark_published) on detumble_law's context; t and h unused."""
+    return _detumble_law(context, 0.0, False)
+
+
+@jit.numba.njit(inline="always")
+def _detumble_law(context, h, stepping):
     pairs = native.entries(context, 6)
     constants, values = native.float64s(pairs, 0), native.float64s(pairs, 1)
     inputs, outputs, flags = native.int64s(pairs, 2), native.int64s(pairs, 3), native.int32s(pairs, 4)
     cell = native.float64s(pairs, 5)
-    cell[0] = detumble.detumble_into(constants, values, inputs, outputs, 0.0, cell[0], False)
+    cell[0] = detumble.detumble_into(constants, values, inputs, outputs, h, cell[0], stepping)
     flags[0] = 1
     flags[1] = 1
     return 0
