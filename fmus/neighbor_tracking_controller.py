@@ -17,7 +17,13 @@ With knowledge_sigmas or impulse_bits (appended last) the boundary layer e widen
 estimator's 1-sigma attitude error (input sigma_attitude_B) and the impulse bit, so the law does
 not fire at the estimate's noise (DeorbitTrackingController.boundary_layer); 0 and 0 (the
 defaults) keep the thesis' fixed e.
+
+The inputs and outputs are values shared with the runtime, and the step and the outputs are one
+compiled kernel (deorbit_tracking.tracking_into, the methods' bits); once numba is in the process
+the binary calls both natively (components.attitude.native_steps.tracking_law). Every output
+depends on inputs: the step leaves them stale, and the get after the master's sets publishes them.
 """
+import numpy as np
 from neighbor_fmu_support import TARGET_INPUTS, NeighborSlave
 
 from components.attitude import deorbit_tracking, rigid_body, thruster_control
@@ -81,6 +87,9 @@ class TrackingController(NeighborSlave):
         self.output_array("boundary_layer", 3, lambda: self.feedthrough(self._layer), "rad/s",
                           "The saturation thresholds e in use (the fixed e, or wider for the estimate's noise and "
                           "the impulse bit)", depends_on=SIGMA_INPUTS)
+        self.share_values()
+        self._inputs_at = self.shared_indices(deorbit_tracking.READS)
+        self._outputs_at = self.shared_indices(deorbit_tracking.PUBLISHED)
 
     def build_model(self):
         J = self.inertia(rigid_body.box_inertia)
@@ -94,7 +103,7 @@ class TrackingController(NeighborSlave):
     def _targeted(self):
         """The model, its reference taken from the inputs when target_from_input and enabled (a
         disabled controller's inputs are not refreshed by a master that suspends it)."""
-        if self.values["target_from_input"] and self.values["enabled"]:
+        if self.values["target_from_input"] and self.input_value("enabled"):
             self.model.follow(self.vector("q_target_BN", 4), self.vector("omega_target_B", 3))
         return self.model
 
@@ -123,8 +132,32 @@ class TrackingController(NeighborSlave):
         return self._targeted().target(self.vector("q_BN", 4))
 
     def do_step(self, current_time, step_size):
-        if self.values["target_from_input"]:
-            self._targeted()  # a new target from the guidance re-anchors q_d before it is propagated
-        self.model.advance(step_size, self.vector("q_BN", 4), self.values["enabled"])
+        # follow a new target (it re-anchors q_d before it is propagated) and advance, compiled; the
+        # outputs are published when read (they all depend on inputs, which the master sets next)
+        if self._law(step_size, True):  # a target it refuses, unchanged: the Python step raises the error
+            self._targeted()
+            self.model.advance(step_size, self.vector("q_BN", 4), self.input_value("enabled"))
         self._input_version += 1  # q_d changed: outputs computed before the step are stale
+        self._outputs_stale()
+        if not self.share_native[0] and self.native_ready():
+            from components.attitude import native_steps  # numba is loaded: the same step, no Python
+            model = self.model
+            self.arm_native(native_steps.step("tracking_law"), model.constants, model.x, self.shared,
+                            self._inputs_at, self._outputs_at, self.share_flags,
+                            np.array([float(self.values["target_from_input"])]),
+                            publish=native_steps.step("tracking_law_publish"))
         return True
+
+    def publish(self):
+        # the getters' values in one compiled call; where it refuses (a target or sigma that is not
+        # allowed, a zero quaternion), the getters themselves, which raise the error
+        if self._law(0.0, False):
+            super().publish()
+        else:
+            self.mark_published()
+
+    def _law(self, step_size, stepping):
+        model = self.model
+        return deorbit_tracking.tracking_into(model.constants, model.x, self.shared, self._inputs_at,
+                                              self._outputs_at, step_size, stepping,
+                                              self.values["target_from_input"])

@@ -35,16 +35,26 @@ enabled, and released when the controller is disabled, so that the next enable l
 Before the latch the command uses q_d = q (zero attitude error). Like the script, q_d is
 integrated with one explicit Euler step per communication step and not normalized; the
 inverse divides by the norm (attitude.inverse, as in the scripts).
+
+The FMU runs the law through `tracking_into`, one compiled kernel on the controller's constants and
+its state array `x` (q_d, omega_d, the anchor and e live there; the attributes are properties over
+it): the same operations as the methods, bit for bit, the pointing error's and the boundary
+layer's hypot by components.core.cpython_math (numba's own differs from Python's in the last bit).
 """
 import math
 
+import numpy as np
+
 from ..core import rotations
 from ..core.constants import MU_EARTH, R_EQ
+from ..core.cpython_math import hypot
+from ..core.jit import njit
 from . import rigid_body
 from . import thruster_control as tc
 
 TRACKING_ALTITUDE = 400e3  # m, average altitude during the first de-orbit scenario (Eq. 67)
 TORQUE_FORMS = ("eq72", "script_literal")
+STATE_SIZE = 19  # DeorbitTrackingController.x: q_d, has q_d, omega_d, has anchor, anchor q and omega, e
 
 
 def orbit_period(radius, mu=MU_EARTH):
@@ -98,6 +108,7 @@ class DeorbitTrackingController:
     def __init__(self, inertia, k=1.0, G=(0.1, 0.1, 0.1), e=(0.001, 0.001, 0.001), omega_d=None,
                  omega_dot_d=(0.0, 0.0, 0.0), torque_level=None, q_d0=None, torque_form="eq72",
                  knowledge_sigmas=0.0, impulse_bits=0.0, rate_sigma=0.0, min_on_time=0.015):
+        self.x = np.zeros(STATE_SIZE)  # the state, in tracking_into's layout (the properties below)
         J = rigid_body.check_inertia(inertia)
         self.J = tuple(tuple(float(x) for x in row) for row in J.tolist())
         k = float(k)
@@ -123,11 +134,52 @@ class DeorbitTrackingController:
         # reaches its torque, |s_i| >= e_i level_i / (J_ii G_i), the law's deadband in s
         self.deadband_per_e = tuple(self.levels[i] / (self.J[i][i] * self.G[i]) for i in range(3))
         self.bits = tc.impulse_bit_rates(self.levels, [self.J[i][i] for i in range(3)], min_on_time)
-        self._layer_of = None  # the sigma_attitude self.e was sized for
-        self.boundary_layer((0.0, 0.0, 0.0))
         self.q_d0 = None if q_d0 is None else rotations.normalized(tuple(float(x) for x in q_d0), "q_d0")
+        # what tracking_into reads besides the state
+        self.constants = np.array([k, *self.G, *self.e_fixed, *self.omega_dot_d, *self.levels,
+                                   *(x for row in self.J for x in row), self.knowledge_sigmas, self.impulse_bits,
+                                   self.rate_sigma, *self.deadband_per_e, *self.bits,
+                                   float(torque_form == "script_literal"), float(self.q_d0 is None)])
+        self.boundary_layer((0.0, 0.0, 0.0))
         self.q_d = self.q_d0  # None: latch the measured q at the first enabled step
         self.anchor = None  # the last target taken by follow()
+
+    # ---- the state, kept in self.x (tracking_into's layout) ----------------------------------
+    @property
+    def q_d(self):
+        return tuple(self.x[0:4].tolist()) if self.x[4] else None
+
+    @q_d.setter
+    def q_d(self, value):
+        if value is not None:
+            self.x[0:4] = value
+        self.x[4] = value is not None
+
+    @property
+    def omega_d(self):
+        return tuple(self.x[5:8].tolist())
+
+    @omega_d.setter
+    def omega_d(self, value):
+        self.x[5:8] = value
+
+    @property
+    def anchor(self):
+        return (tuple(self.x[9:13].tolist()), tuple(self.x[13:16].tolist())) if self.x[8] else None
+
+    @anchor.setter
+    def anchor(self, value):
+        if value is not None:
+            self.x[9:13], self.x[13:16] = value
+        self.x[8] = value is not None
+
+    @property
+    def e(self):
+        return tuple(self.x[16:19].tolist())
+
+    @e.setter
+    def e(self, value):
+        self.x[16:19] = value
 
     # ---- boundary layer sized for estimates -------------------------------------------------
     def boundary_layer(self, sigma_attitude):
@@ -142,13 +194,10 @@ class DeorbitTrackingController:
             self.e = self.e_fixed
             return self.e
         sig = tuple(float(x) for x in sigma_attitude)
-        if sig == self._layer_of:  # an estimate's sigmas change with its covariance, not at every step
-            return self.e
         if len(sig) != 3 or not all(math.isfinite(x) and x >= 0.0 for x in sig):
             raise ValueError(f"sigma_attitude {list(sig)} must be three finite numbers >= 0 (rad)")
         self.e = tuple(max(self.e_fixed[i], max(n * math.hypot(self.rate_sigma, 0.5 * k * sig[i]), m * self.bits[i])
                            / self.deadband_per_e[i]) for i in range(3))
-        self._layer_of = sig
         return self.e
 
     # ---- desired attitude ----------------------------------------------------------------
@@ -275,3 +324,161 @@ class DeorbitTrackingController:
         self.q_d = None if state["q_d"] is None else tuple(state["q_d"])
         self.omega_d = tuple(state["omega_d"])
         self.anchor = None if state["anchor"] is None else (tuple(state["anchor"][0]), tuple(state["anchor"][1]))
+
+
+# ---- the FMU's step and publish as one compiled kernel ----------------------------------------
+# The variables tracking_into reads and writes, in its order (the FMU's names)
+READS = (("q_BN", 4), ("omega_BN_B", 3), ("enabled", 1), ("q_target_BN", 4), ("omega_target_B", 3),
+         ("sigma_attitude_B", 3))
+PUBLISHED = (("torque_cmd_B", 3), ("thrust_flag", 3), ("done", 1), ("attitude_error", 1), ("pointing_error", 1),
+             ("q_d", 4), ("sliding_vector", 3), ("boundary_layer", 3))
+# what tracking_into returns when it changed nothing, for the Python methods to raise the error
+FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION = 1, 2, 3
+
+
+@njit(cache=True, inline="always")
+def _error_quaternion(x, values, inputs):
+    """error_quaternion(q) on the state x and q = values[inputs[0:4]]; all zero for a zero q_d^-1
+    (where the Python method divides by zero)."""
+    p1, p2, p3, p4 = values[inputs[0]], values[inputs[1]], values[inputs[2]], values[inputs[3]]
+    if x[4] != 0.0:
+        d1, d2, d3, d4 = x[0], x[1], x[2], x[3]
+    else:
+        d1, d2, d3, d4 = p1, p2, p3, p4
+    n = math.sqrt(d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4)
+    if n == 0.0:
+        return 0.0, 0.0, 0.0, 0.0
+    r1, r2, r3, r4 = -d1 / n, -d2 / n, -d3 / n, d4 / n
+    return (p4 * r1 + r4 * p1 - (p2 * r3 - p3 * r2),
+            p4 * r2 + r4 * p2 - (p3 * r1 - p1 * r3),
+            p4 * r3 + r4 * p3 - (p1 * r2 - p2 * r1),
+            p4 * r4 - (p1 * r1 + p2 * r2 + p3 * r3))
+
+
+@njit(cache=True, plain_first=True)
+def tracking_into(c, x, values, inputs, outputs, h, stepping, follow_input):
+    """DeorbitTrackingController on its constants c and state x, the FMU's inputs values[inputs]
+    (READS): with `follow_input` and enabled, follow the target inputs; then with `stepping`
+    advance q_d by h and write nothing, else size e (boundary_layer) and write values[outputs]
+    (PUBLISHED: the gated command, done, the errors, q_d, s, e). The same operations as those
+    methods. Returns 0, or FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION having changed nothing."""
+    enabled = values[inputs[7]] != 0.0
+    if follow_input and enabled:
+        same = x[8] != 0.0
+        for i in range(7):
+            if not values[inputs[8 + i]] == x[9 + i]:
+                same = False
+        if not same:  # follow(): a new target re-anchors q_d
+            t1, t2, t3, t4 = values[inputs[8]], values[inputs[9]], values[inputs[10]], values[inputs[11]]
+            n = math.sqrt(t1 * t1 + t2 * t2 + t3 * t3 + t4 * t4)
+            if not math.isfinite(n) or n < 1e-12:
+                return FOLLOW_REFUSED
+            for i in range(3):
+                if not math.isfinite(values[inputs[12 + i]]):
+                    return FOLLOW_REFUSED
+            x[0], x[1], x[2], x[3] = t1 / n, t2 / n, t3 / n, t4 / n
+            x[4] = 1.0
+            for i in range(3):
+                x[5 + i] = values[inputs[12 + i]]
+            for i in range(7):
+                x[9 + i] = values[inputs[8 + i]]
+            x[8] = 1.0
+    if stepping:  # advance(h, q, enabled)
+        if c[32] != 0.0 and not enabled:
+            x[4] = 0.0
+            x[8] = 0.0
+            return 0
+        if x[4] != 0.0:
+            q1, q2, q3, q4 = x[0], x[1], x[2], x[3]
+        else:
+            q1, q2, q3, q4 = values[inputs[0]], values[inputs[1]], values[inputs[2]], values[inputs[3]]
+        w1, w2, w3 = x[5], x[6], x[7]
+        hh = 0.5 * h
+        x[0] = q1 + hh * (q4 * w1 - q3 * w2 + q2 * w3)
+        x[1] = q2 + hh * (q3 * w1 + q4 * w2 - q1 * w3)
+        x[2] = q3 + hh * (-q2 * w1 + q1 * w2 + q4 * w3)
+        x[3] = q4 + hh * (-q1 * w1 - q2 * w2 - q3 * w3)
+        x[4] = 1.0
+        return 0
+    # boundary_layer(sigma_attitude_B)
+    sigmas, bits = c[22], c[23]
+    if sigmas == 0.0 and bits == 0.0:
+        for i in range(3):
+            x[16 + i] = c[4 + i]
+    else:
+        for i in range(3):
+            sig = values[inputs[15 + i]]
+            if not (math.isfinite(sig) and sig >= 0.0):
+                return LAYER_REFUSED
+        for i in range(3):
+            wide = sigmas * hypot(c[24], 0.5 * c[0] * values[inputs[15 + i]])
+            bit = bits * c[28 + i]
+            wide = bit if bit > wide else wide  # Python's max(a, b): b only when greater
+            wide = wide / c[25 + i]
+            x[16 + i] = wide if wide > c[4 + i] else c[4 + i]
+    # evaluate(q, omega)
+    d1, d2, d3, d4 = _error_quaternion(x, values, inputs)
+    n2 = d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4
+    if n2 == 0.0:
+        return ZERO_QUATERNION
+    sg = (d4 > 0) - (d4 < 0)
+    k = c[0]
+    w0, w1, w2 = values[inputs[4]], values[inputs[5]], values[inputs[6]]
+    wd0, wd1, wd2 = x[5], x[6], x[7]
+    s0, s1, s2 = w0 - wd0 + k * sg * d1, w1 - wd1 + k * sg * d2, w2 - wd2 + k * sg * d3
+    e0, e1, e2 = x[16], x[17], x[18]
+    sb0 = 1.0 if s0 > e0 else (-1.0 if s0 < -e0 else s0 / e0)
+    sb1 = 1.0 if s1 > e1 else (-1.0 if s1 < -e1 else s1 / e1)
+    sb2 = 1.0 if s2 > e2 else (-1.0 if s2 < -e2 else s2 / e2)
+    a0, a1, a2 = sg * d1, sg * d2, sg * d3
+    b0, b1, b2 = w0 + wd0, w1 + wd1, w2 + wd2
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    adq4 = abs(d4)
+    J00, J01, J02, J10, J11, J12, J20, J21, J22 = c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21]
+    h0 = J00 * w0 + J01 * w1 + J02 * w2
+    h1 = J10 * w0 + J11 * w1 + J12 * w2
+    h2 = J20 * w0 + J21 * w1 + J22 * w2
+    g0, g1, g2 = w1 * h2 - w2 * h1, w2 * h0 - w0 * h2, w0 * h1 - w1 * h0
+    if c[31] == 0.0:  # eq72
+        half_k = 0.5 * k
+        u0 = half_k * (adq4 * (wd0 - w0) - c0) + c[7] - c[1] * sb0
+        u1 = half_k * (adq4 * (wd1 - w1) - c1) + c[8] - c[2] * sb1
+        u2 = half_k * (adq4 * (wd2 - w2) - c2) + c[9] - c[3] * sb2
+        r0 = J00 * u0 + J01 * u1 + J02 * u2 + g0
+        r1 = J10 * u0 + J11 * u1 + J12 * u2 + g1
+        r2 = J20 * u0 + J21 * u1 + J22 * u2 + g2
+    else:  # the printed script line
+        f = 0.5 * k * adq4
+        v0, v1, v2 = f * (wd0 - w0), f * (wd1 - w1), f * (wd2 - w2)
+        r0 = J00 * v0 + J01 * v1 + J02 * v2 - c0 + c[7] - c[1] * sb0 + g0
+        r1 = J10 * v0 + J11 * v1 + J12 * v2 - c1 + c[8] - c[2] * sb1 + g1
+        r2 = J20 * v0 + J21 * v1 + J22 * v2 - c2 + c[9] - c[3] * sb2 + g2
+    for i in range(3):  # the gated, quantized command (thruster_control.quantize)
+        raw = r0 if i == 0 else (r1 if i == 1 else r2)
+        level = c[10 + i]
+        torque, flag = 0.0, 0.0
+        if enabled:
+            if raw >= level:
+                torque, flag = level, 1.0
+            elif raw <= -level:
+                torque, flag = -level, -1.0
+        values[outputs[i]] = torque
+        values[outputs[3 + i]] = flag
+    values[outputs[6]] = 1.0 if (abs(s0) <= e0 and abs(s1) <= e1 and abs(s2) <= e2) else 0.0
+    # attitude_error and pointing_error
+    ratio = abs(d4) / math.sqrt(n2)
+    values[outputs[7]] = 2.0 * math.acos(ratio if ratio < 1.0 else 1.0)  # Python's min(1.0, ratio)
+    px = ((d1 * d1 - d2 * d2 - d3 * d3 + d4 * d4) / n2, 2 * (d1 * d2 - d3 * d4) / n2, 2 * (d1 * d3 + d2 * d4) / n2)
+    values[outputs[8]] = math.atan2(hypot(px[1], px[2]), px[0])
+    if x[4] != 0.0:
+        for i in range(4):
+            values[outputs[9 + i]] = x[i]
+    else:
+        for i in range(4):
+            values[outputs[9 + i]] = values[inputs[i]]
+    values[outputs[13]] = s0
+    values[outputs[14]] = s1
+    values[outputs[15]] = s2
+    for i in range(3):
+        values[outputs[16 + i]] = x[16 + i]
+    return 0

@@ -7,7 +7,7 @@ import math
 from numba import cfunc
 
 from ..core import jit, native
-from . import detumble, mass_properties, rigid_body as body, thrusters
+from . import deorbit_tracking, detumble, mass_properties, rigid_body as body, thrusters
 
 
 def rigid_body(context, t, h):
@@ -99,12 +99,41 @@ def _detumble_law(context, h, stepping):
     return 0
 
 
+def tracking_law(context, t, h):
+    """TrackingController's FMU step (tracking_into stepping: follow the target, advance q_d; the
+    outputs left stale): context = the law's constants and state, the shared values, the input and
+    output indices, the share flags and (target_from_input). 1: a target it refuses, nothing
+    changed (the Python step raises the error)."""
+    return _tracking_law(context, h, True)
+
+
+def tracking_law_publish(context, t, h):
+    """TrackingController's publish (tracking_into without stepping, mark_published) on
+    tracking_law's context; t and h unused. 1: an input it refuses, for the Python publish."""
+    return _tracking_law(context, 0.0, False)
+
+
+@jit.numba.njit(inline="always")
+def _tracking_law(context, h, stepping):
+    pairs = native.entries(context, 7)
+    constants, x, values = native.float64s(pairs, 0), native.float64s(pairs, 1), native.float64s(pairs, 2)
+    inputs, outputs, flags = native.int64s(pairs, 3), native.int64s(pairs, 4), native.int32s(pairs, 5)
+    follow = native.float64s(pairs, 6)[0] != 0.0
+    if deorbit_tracking.tracking_into(constants, x, values, inputs, outputs, h, stepping, follow):
+        return 1
+    fresh = 0 if stepping else 1
+    flags[0] = fresh
+    flags[1] = fresh
+    return 0
+
+
 _STEPS = {}
 
 
 def step(name):
     """The cfunc of the step or publish `name` (rigid_body, rigid_body_following, thruster_pairs,
-    thruster_pairs_publish, detumble_law, detumble_law_publish)."""
+    thruster_pairs_publish, detumble_law, detumble_law_publish, tracking_law,
+    tracking_law_publish)."""
     compiled = _STEPS.get(name)
     if compiled is None:
         compiled = _STEPS[name] = cfunc(native.STEP, cache=True)(globals()[name])

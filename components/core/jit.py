@@ -164,9 +164,10 @@ class Kernel:
     """A function numba compiles (or loads from its cache) when it is first called. Calls by the
     module's own name go straight to numba's dispatcher from then on: the name is rebound to it."""
 
-    def __init__(self, function, options, plain_first):
+    def __init__(self, function, options, plain_first, plain=None):
         functools.update_wrapper(self, function)
         self.py_func = function
+        self._plain = function if plain is None else plain
         self._options = options
         self._plain_first = plain_first
         self._dispatcher = None
@@ -176,7 +177,7 @@ class Kernel:
         if self._dispatcher is None:
             if self._plain_first and _plain_calls_left > 0 and "numba" not in sys.modules:
                 _plain_calls_left -= 1
-                return self.py_func(*args)
+                return self._plain(*args)
             self.dispatcher  # noqa: B018 - loads numba and the kernel
         return self._dispatcher(*args)
 
@@ -212,15 +213,17 @@ def loaded(kernel):
     return kernel.dispatcher if isinstance(kernel, Kernel) else kernel
 
 
-def njit(*args, plain_first=False, **kwargs):
+def njit(*args, plain_first=False, plain=None, **kwargs):
     """A decorator making a Kernel with numba.njit's options (numba then compiles at the first
     call), or returning the function unchanged where numba is not used. `plain_first`: the plain
-    Python run of the function, and of every kernel it calls, gives numba's bits (tested)."""
-    if len(args) == 1 and callable(args[0]) and not kwargs:
+    Python run of the function, and of every kernel it calls, gives numba's bits (tested).
+    `plain`: the function that plain Python calls instead (the library function that the compiled
+    one reproduces, such as math.hypot)."""
+    if len(args) == 1 and callable(args[0]) and not kwargs and plain is None:
         return njit(plain_first=plain_first)(args[0])
     if not ENABLED:
-        return lambda function: function
-    return lambda function: Kernel(function, dict(kwargs), plain_first)
+        return lambda function: function if plain is None else plain
+    return lambda function: Kernel(function, dict(kwargs), plain_first, plain)
 
 
 def _plain_objmode(**types):

@@ -1,7 +1,9 @@
 """Native steps (components.core.native, NeighborSlave.arm_native): once numba is in the process,
-RigidBody, RcsThrusters and DetumbleController hand the binary a compiled step that it calls
-instead of their Python do_step, and the two laws with outputs that depend on inputs a compiled
-publish it calls instead of their Python publish (a get after a set, as Gauss-Seidel does).
+RigidBody, RcsThrusters, DetumbleController and TrackingController hand the binary a compiled step
+that it calls instead of their Python do_step, and the three laws with outputs that depend on
+inputs a compiled publish it calls instead of their Python publish (a get after a set, as
+Gauss-Seidel does). The tracking law runs as the mission runs it: its target and boundary layer
+from the inputs.
 
 Through the binary (FMPy loading the built FMUs, FMI 2.0 and 3.0, numba loaded as in a long
 run), against the same FMUs with NEIGHBOR_COSIM_NATIVE=0 in a second process: the same outputs
@@ -19,7 +21,10 @@ import pytest
 
 pytest.importorskip("numba")
 
-MODELS = ("RigidBody", "RcsThrusters", "DetumbleController")
+MODELS = ("RigidBody", "RcsThrusters", "DetumbleController", "TrackingController")
+# parameters set before the run, and inputs kept >= 0 (the estimator's sigmas)
+SETUP = {"TrackingController": {"booleans": {"target_from_input": True}, "nonnegative": ["sigma_attitude_B"],
+                                "reals": {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4}}}
 STEPS = 300
 
 RUN = r"""
@@ -31,6 +36,7 @@ from fmpy.fmi2 import FMU2Slave
 from fmpy.fmi3 import FMU3Slave
 
 path, steps, unzip, following = sys.argv[1], int(sys.argv[2]), sys.argv[3], sys.argv[4] == "1"
+setup = json.loads(sys.argv[5])
 md = fmpy.read_model_description(path)
 fmi3 = md.fmiVersion.startswith("3")
 wrapper = "neighbor_" + "".join("_" + c.lower() if c.isupper() else c for c in md.modelName).lstrip("_") + ".py"
@@ -73,6 +79,10 @@ def start():
         f.enterInitializationMode()
     if following:  # RigidBody's inertia follows the propellant drawn
         f.setBoolean([by_name["propellant_mass_properties"]], [True])
+    for name, value in setup.get("booleans", {}).items():
+        f.setBoolean([by_name[name]], [value])
+    for name, value in setup.get("reals", {}).items():
+        getattr(f, "set" + REAL)([by_name[name]], [value])
     f.exitInitializationMode()
 
 def outputs():  # FMI 3.0: with the time, which the binary keeps after a native step (a get of its own:
@@ -88,8 +98,13 @@ def step(k, inputs):
 
 rng = np.random.default_rng(5)
 inputs = [rng.uniform(-s, s, n_in).tolist() for s in [0.2] * (steps // 3) + [1e-4] * (steps - steps // 3)]
+at = {v.valueReference: sum(size(u) for u in inputs_of[:i]) for i, v in enumerate(inputs_of)}
+for v in inputs_of:
+    if v.name.split("[")[0] in setup.get("nonnegative", []):
+        for row in inputs:
+            for i in range(at[v.valueReference], at[v.valueReference] + size(v)):
+                row[i] = abs(row[i])
 if following:  # the tank drains by 3e-5 kg a step: the inertia follows every few steps (1e-4 kg)
-    at = {v.valueReference: sum(size(u) for u in inputs_of[:i]) for i, v in enumerate(inputs_of)}
     for k, row in enumerate(inputs):
         row[at[by_name["propellant_used"]]] = 2e-5 * k
         row[at[by_name["rcs_propellant"]]] = 1e-5 * k
@@ -113,10 +128,11 @@ print(json.dumps({"rows": rows, "replay": replay, "again": again, "entered": ent
 """
 
 
-def _run(path, tmp_path, native, following=False):
+def _run(path, tmp_path, native, following=False, setup=None):
     env = dict(os.environ, NEIGHBOR_COSIM_NATIVE=native, NEIGHBOR_COSIM_NUMBA="1")
     proc = subprocess.run([sys.executable, "-c", RUN, str(path), str(STEPS), str(tmp_path / f"unzip{native}"),
-                           "1" if following else "0"], capture_output=True, text=True, env=env, timeout=600)
+                           "1" if following else "0", json.dumps(setup or {})],
+                          capture_output=True, text=True, env=env, timeout=600)
     assert proc.returncode == 0, proc.stderr
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
@@ -125,7 +141,8 @@ def _run(path, tmp_path, native, following=False):
 @pytest.mark.parametrize("model", MODELS)
 def test_native_step_gives_the_python_steps_bits(fmu_paths, fmu3_paths, tmp_path, model, fmi):
     path = (fmu_paths if fmi == "2.0" else fmu3_paths)[model]
-    native, python = _run(path, tmp_path, "1"), _run(path, tmp_path, "0")
+    setup = SETUP.get(model)
+    native, python = _run(path, tmp_path, "1", setup=setup), _run(path, tmp_path, "0", setup=setup)
     assert native["rows"] == python["rows"]  # bit for bit (JSON gives floats back exactly)
     # (FMI 3.0: with the time, which the restored state and the reset set back)
     assert native["replay"] == native["rows"][STEPS // 2:] == python["replay"]

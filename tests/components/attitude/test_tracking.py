@@ -304,3 +304,55 @@ def test_fmu_rejects_bad_gain(build_one):
             fmpy.simulate_fmu(path, stop_time=0.03, output_interval=0.015, start_values=start, logger=log,
                               debug_logging=True)
         assert any(all(w in m for w in words) for m in messages), messages
+
+
+def _law_by_methods(ctl, q, w, enabled, target, sigma, h, follow):
+    """The FMU's outputs (deorbit_tracking.PUBLISHED) by the model's methods, then its step."""
+    if follow and enabled:
+        ctl.follow(target[:4], target[4:])
+    e = ctl.boundary_layer(sigma)
+    torque, flags, s, _ = ctl.evaluate(q, w)
+    if not enabled:
+        torque, flags = [0.0, 0.0, 0.0], [0, 0, 0]
+    out = [*torque, *flags, float(all(abs(s[i]) <= e[i] for i in range(3))), ctl.attitude_error(q),
+           ctl.pointing_error(q), *ctl.target(q), *s, *e]
+    if follow and enabled:
+        ctl.follow(target[:4], target[4:])
+    ctl.advance(h, q, enabled)
+    return out
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["plain", "numba"])
+def test_tracking_into_gives_the_methods_bits(compiled):
+    """tracking_into, the FMU's step and publish in one kernel (plain Python and compiled), writes
+    the methods' values bit for bit over a burn-like sequence: noisy estimates, a sigma that
+    changes every step, a guidance target that moves every 33 steps, the law disabled and enabled
+    again, both torque forms, the latch and a fixed q_d0."""
+    law = dtr.tracking_into if compiled else dtr.tracking_into.py_func
+    rng = np.random.default_rng(11)
+    reads, published = (sum(n for _, n in names) for names in (dtr.READS, dtr.PUBLISHED))
+    for kwargs, follow in (({"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4}, True),
+                           ({"torque_form": "script_literal", "q_d0": Q0}, False), ({}, True)):
+        ref, ctl = dtr.DeorbitTrackingController(J_BOX, **kwargs), dtr.DeorbitTrackingController(J_BOX, **kwargs)
+        values = np.zeros(reads + published)
+        inputs, outputs = np.arange(reads), np.arange(reads, reads + published)
+        target = np.array([*Q0, 0.0, 1.1e-3, 0.0])
+        for step in range(600):
+            if step % 33 == 0:
+                target[:4] = rotations.normalized(target[:4] + rng.normal(0.0, 1e-3, 4))
+            q = np.array(Q0) + rng.normal(0.0, 2e-3, 4)
+            w = np.array(W0) + rng.normal(0.0, 1e-3, 3)
+            enabled = not 200 <= step < 260
+            sigma = np.abs(rng.normal(0.0, 1e-3, 3))
+            values[:reads] = [*q, *w, float(enabled), *target, *sigma]
+            expected = _law_by_methods(ref, tuple(q.tolist()), tuple(w.tolist()), enabled, tuple(target.tolist()),
+                                       tuple(sigma.tolist()), H, follow)
+            assert law(ctl.constants, ctl.x, values, inputs, outputs, 0.0, False, follow) == 0
+            assert values[reads:].tolist() == expected, (kwargs, step)
+            assert law(ctl.constants, ctl.x, values, inputs, outputs, H, True, follow) == 0
+            assert ctl.get_state() == ref.get_state()
+    # what it refuses, it leaves unchanged for the methods to raise the error
+    before = ctl.x.copy()
+    values[8:12] = 0.0
+    assert law(ctl.constants, ctl.x, values, inputs, outputs, H, True, True) == dtr.FOLLOW_REFUSED
+    assert ctl.x.tolist() == before.tolist()
