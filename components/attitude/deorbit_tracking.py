@@ -336,7 +336,7 @@ PUBLISHED = (("torque_cmd_B", 3), ("thrust_flag", 3), ("done", 1), ("attitude_er
 FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION = 1, 2, 3
 
 
-@njit(cache=True, inline="always")
+@njit(cache=True, inline="always", plain_first=True)
 def _error_quaternion(x, values, inputs):
     """error_quaternion(q) on the state x and q = values[inputs[0:4]]; all zero for a zero q_d^-1
     (where the Python method divides by zero)."""
@@ -363,65 +363,91 @@ def tracking_into(c, x, values, inputs, outputs, h, stepping, follow_input):
     (PUBLISHED: the gated command, done, the errors, q_d, s, e). The same operations as those
     methods. Returns 0, or FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION having changed nothing."""
     enabled = values[inputs[7]] != 0.0
-    if follow_input and enabled:
-        same = x[8] != 0.0
-        for i in range(7):
-            if not values[inputs[8 + i]] == x[9 + i]:
-                same = False
-        if not same:  # follow(): a new target re-anchors q_d
-            t1, t2, t3, t4 = values[inputs[8]], values[inputs[9]], values[inputs[10]], values[inputs[11]]
-            n = math.sqrt(t1 * t1 + t2 * t2 + t3 * t3 + t4 * t4)
-            if not math.isfinite(n) or n < 1e-12:
-                return FOLLOW_REFUSED
-            for i in range(3):
-                if not math.isfinite(values[inputs[12 + i]]):
-                    return FOLLOW_REFUSED
-            x[0], x[1], x[2], x[3] = t1 / n, t2 / n, t3 / n, t4 / n
-            x[4] = 1.0
-            for i in range(3):
-                x[5 + i] = values[inputs[12 + i]]
-            for i in range(7):
-                x[9 + i] = values[inputs[8 + i]]
-            x[8] = 1.0
-    if stepping:  # advance(h, q, enabled)
-        if c[32] != 0.0 and not enabled:
-            x[4] = 0.0
-            x[8] = 0.0
-            return 0
-        if x[4] != 0.0:
-            q1, q2, q3, q4 = x[0], x[1], x[2], x[3]
-        else:
-            q1, q2, q3, q4 = values[inputs[0]], values[inputs[1]], values[inputs[2]], values[inputs[3]]
-        w1, w2, w3 = x[5], x[6], x[7]
-        hh = 0.5 * h
-        x[0] = q1 + hh * (q4 * w1 - q3 * w2 + q2 * w3)
-        x[1] = q2 + hh * (q3 * w1 + q4 * w2 - q1 * w3)
-        x[2] = q3 + hh * (-q2 * w1 + q1 * w2 + q4 * w3)
-        x[3] = q4 + hh * (-q1 * w1 - q2 * w2 - q3 * w3)
-        x[4] = 1.0
+    if follow_input and enabled and not _follow(x, values, inputs):
+        return FOLLOW_REFUSED
+    if stepping:
+        _advance(c, x, values, inputs, h, enabled)
         return 0
-    # boundary_layer(sigma_attitude_B)
+    if not _size_layer(c, x, values, inputs):
+        return LAYER_REFUSED
+    return _publish(c, x, values, inputs, outputs, enabled)
+
+
+@njit(cache=True, inline="always", plain_first=True)
+def _follow(x, values, inputs):
+    """follow(q_target, omega_target): a new target re-anchors q_d. False: refused, unchanged."""
+    same = x[8] != 0.0
+    for i in range(7):
+        if not values[inputs[8 + i]] == x[9 + i]:
+            same = False
+    if same:
+        return True
+    t1, t2, t3, t4 = values[inputs[8]], values[inputs[9]], values[inputs[10]], values[inputs[11]]
+    n = math.sqrt(t1 * t1 + t2 * t2 + t3 * t3 + t4 * t4)
+    if not math.isfinite(n) or n < 1e-12:
+        return False
+    for i in range(3):
+        if not math.isfinite(values[inputs[12 + i]]):
+            return False
+    x[0], x[1], x[2], x[3] = t1 / n, t2 / n, t3 / n, t4 / n
+    x[4] = 1.0
+    for i in range(3):
+        x[5 + i] = values[inputs[12 + i]]
+    for i in range(7):
+        x[9 + i] = values[inputs[8 + i]]
+    x[8] = 1.0
+    return True
+
+
+@njit(cache=True, inline="always", plain_first=True)
+def _advance(c, x, values, inputs, h, enabled):
+    """advance(h, q, enabled)."""
+    if c[32] != 0.0 and not enabled:
+        x[4] = 0.0
+        x[8] = 0.0
+        return
+    if x[4] != 0.0:
+        q1, q2, q3, q4 = x[0], x[1], x[2], x[3]
+    else:
+        q1, q2, q3, q4 = values[inputs[0]], values[inputs[1]], values[inputs[2]], values[inputs[3]]
+    w1, w2, w3 = x[5], x[6], x[7]
+    hh = 0.5 * h
+    x[0] = q1 + hh * (q4 * w1 - q3 * w2 + q2 * w3)
+    x[1] = q2 + hh * (q3 * w1 + q4 * w2 - q1 * w3)
+    x[2] = q3 + hh * (-q2 * w1 + q1 * w2 + q4 * w3)
+    x[3] = q4 + hh * (-q1 * w1 - q2 * w2 - q3 * w3)
+    x[4] = 1.0
+
+
+@njit(cache=True, inline="always", plain_first=True)
+def _size_layer(c, x, values, inputs):
+    """boundary_layer(sigma_attitude_B) into x[16:19]. False: a sigma refused, unchanged."""
     sigmas, bits = c[22], c[23]
     if sigmas == 0.0 and bits == 0.0:
         for i in range(3):
             x[16 + i] = c[4 + i]
-    else:
-        for i in range(3):
-            sig = values[inputs[15 + i]]
-            if not (math.isfinite(sig) and sig >= 0.0):
-                return LAYER_REFUSED
-        for i in range(3):
-            wide = sigmas * hypot(c[24], 0.5 * c[0] * values[inputs[15 + i]])
-            bit = bits * c[28 + i]
-            wide = bit if bit > wide else wide  # Python's max(a, b): b only when greater
-            wide = wide / c[25 + i]
-            x[16 + i] = wide if wide > c[4 + i] else c[4 + i]
-    # evaluate(q, omega)
+        return True
+    for i in range(3):
+        sig = values[inputs[15 + i]]
+        if not (math.isfinite(sig) and sig >= 0.0):
+            return False
+    for i in range(3):
+        wide = sigmas * hypot(c[24], 0.5 * c[0] * values[inputs[15 + i]])
+        bit = bits * c[28 + i]
+        wide = bit if bit > wide else wide  # Python's max(a, b): b only when greater
+        wide = wide / c[25 + i]
+        x[16 + i] = wide if wide > c[4 + i] else c[4 + i]
+    return True
+
+
+@njit(cache=True, inline="always", plain_first=True)
+def _publish(c, x, values, inputs, outputs, enabled):
+    """evaluate(q, omega) and the outputs the FMU's getters define, from q_d and e in x."""
     d1, d2, d3, d4 = _error_quaternion(x, values, inputs)
     n2 = d1 * d1 + d2 * d2 + d3 * d3 + d4 * d4
     if n2 == 0.0:
         return ZERO_QUATERNION
-    sg = (d4 > 0) - (d4 < 0)
+    sg = 1 if d4 > 0 else (-1 if d4 < 0 else 0)  # evaluate: (dq4 > 0) - (dq4 < 0)
     k = c[0]
     w0, w1, w2 = values[inputs[4]], values[inputs[5]], values[inputs[6]]
     wd0, wd1, wd2 = x[5], x[6], x[7]
@@ -430,29 +456,7 @@ def tracking_into(c, x, values, inputs, outputs, h, stepping, follow_input):
     sb0 = 1.0 if s0 > e0 else (-1.0 if s0 < -e0 else s0 / e0)
     sb1 = 1.0 if s1 > e1 else (-1.0 if s1 < -e1 else s1 / e1)
     sb2 = 1.0 if s2 > e2 else (-1.0 if s2 < -e2 else s2 / e2)
-    a0, a1, a2 = sg * d1, sg * d2, sg * d3
-    b0, b1, b2 = w0 + wd0, w1 + wd1, w2 + wd2
-    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
-    adq4 = abs(d4)
-    J00, J01, J02, J10, J11, J12, J20, J21, J22 = c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21]
-    h0 = J00 * w0 + J01 * w1 + J02 * w2
-    h1 = J10 * w0 + J11 * w1 + J12 * w2
-    h2 = J20 * w0 + J21 * w1 + J22 * w2
-    g0, g1, g2 = w1 * h2 - w2 * h1, w2 * h0 - w0 * h2, w0 * h1 - w1 * h0
-    if c[31] == 0.0:  # eq72
-        half_k = 0.5 * k
-        u0 = half_k * (adq4 * (wd0 - w0) - c0) + c[7] - c[1] * sb0
-        u1 = half_k * (adq4 * (wd1 - w1) - c1) + c[8] - c[2] * sb1
-        u2 = half_k * (adq4 * (wd2 - w2) - c2) + c[9] - c[3] * sb2
-        r0 = J00 * u0 + J01 * u1 + J02 * u2 + g0
-        r1 = J10 * u0 + J11 * u1 + J12 * u2 + g1
-        r2 = J20 * u0 + J21 * u1 + J22 * u2 + g2
-    else:  # the printed script line
-        f = 0.5 * k * adq4
-        v0, v1, v2 = f * (wd0 - w0), f * (wd1 - w1), f * (wd2 - w2)
-        r0 = J00 * v0 + J01 * v1 + J02 * v2 - c0 + c[7] - c[1] * sb0 + g0
-        r1 = J10 * v0 + J11 * v1 + J12 * v2 - c1 + c[8] - c[2] * sb1 + g1
-        r2 = J20 * v0 + J21 * v1 + J22 * v2 - c2 + c[9] - c[3] * sb2 + g2
+    r0, r1, r2 = _raw_torque(c, d1 * sg, d2 * sg, d3 * sg, abs(d4), w0, w1, w2, wd0, wd1, wd2, sb0, sb1, sb2)
     for i in range(3):  # the gated, quantized command (thruster_control.quantize)
         raw = r0 if i == 0 else (r1 if i == 1 else r2)
         level = c[10 + i]
@@ -465,20 +469,41 @@ def tracking_into(c, x, values, inputs, outputs, h, stepping, follow_input):
         values[outputs[i]] = torque
         values[outputs[3 + i]] = flag
     values[outputs[6]] = 1.0 if (abs(s0) <= e0 and abs(s1) <= e1 and abs(s2) <= e2) else 0.0
-    # attitude_error and pointing_error
-    ratio = abs(d4) / math.sqrt(n2)
+    ratio = abs(d4) / math.sqrt(n2)  # attitude_error and pointing_error
     values[outputs[7]] = 2.0 * math.acos(ratio if ratio < 1.0 else 1.0)  # Python's min(1.0, ratio)
     px = ((d1 * d1 - d2 * d2 - d3 * d3 + d4 * d4) / n2, 2 * (d1 * d2 - d3 * d4) / n2, 2 * (d1 * d3 + d2 * d4) / n2)
     values[outputs[8]] = math.atan2(hypot(px[1], px[2]), px[0])
-    if x[4] != 0.0:
-        for i in range(4):
-            values[outputs[9 + i]] = x[i]
-    else:
-        for i in range(4):
-            values[outputs[9 + i]] = values[inputs[i]]
+    for i in range(4):
+        values[outputs[9 + i]] = x[i] if x[4] != 0.0 else values[inputs[i]]
     values[outputs[13]] = s0
     values[outputs[14]] = s1
     values[outputs[15]] = s2
     for i in range(3):
         values[outputs[16 + i]] = x[16 + i]
     return 0
+
+
+@njit(cache=True, inline="always", plain_first=True)
+def _raw_torque(c, a0, a1, a2, adq4, w0, w1, w2, wd0, wd1, wd2, sb0, sb1, sb2):
+    """Eq. 72 (or the printed script line) before quantization, as evaluate computes it; a = sign(dq4)
+    dq_1:3."""
+    b0, b1, b2 = w0 + wd0, w1 + wd1, w2 + wd2
+    c0, c1, c2 = a1 * b2 - a2 * b1, a2 * b0 - a0 * b2, a0 * b1 - a1 * b0
+    J00, J01, J02, J10, J11, J12, J20, J21, J22 = c[13], c[14], c[15], c[16], c[17], c[18], c[19], c[20], c[21]
+    h0 = J00 * w0 + J01 * w1 + J02 * w2
+    h1 = J10 * w0 + J11 * w1 + J12 * w2
+    h2 = J20 * w0 + J21 * w1 + J22 * w2
+    g0, g1, g2 = w1 * h2 - w2 * h1, w2 * h0 - w0 * h2, w0 * h1 - w1 * h0
+    k = c[0]
+    if c[31] == 0.0:  # eq72
+        half_k = 0.5 * k
+        u0 = half_k * (adq4 * (wd0 - w0) - c0) + c[7] - c[1] * sb0
+        u1 = half_k * (adq4 * (wd1 - w1) - c1) + c[8] - c[2] * sb1
+        u2 = half_k * (adq4 * (wd2 - w2) - c2) + c[9] - c[3] * sb2
+        return (J00 * u0 + J01 * u1 + J02 * u2 + g0, J10 * u0 + J11 * u1 + J12 * u2 + g1,
+                J20 * u0 + J21 * u1 + J22 * u2 + g2)
+    f = 0.5 * k * adq4  # the printed script line
+    v0, v1, v2 = f * (wd0 - w0), f * (wd1 - w1), f * (wd2 - w2)
+    return (J00 * v0 + J01 * v1 + J02 * v2 - c0 + c[7] - c[1] * sb0 + g0,
+            J10 * v0 + J11 * v1 + J12 * v2 - c1 + c[8] - c[2] * sb1 + g1,
+            J20 * v0 + J21 * v1 + J22 * v2 - c2 + c[9] - c[3] * sb2 + g2)

@@ -1,7 +1,7 @@
 """numba only makes the kernels faster: with it switched off (NEIGHBOR_COSIM_NUMBA=0, the path
 a host without numba takes) the atmospheres, the Cowell orbit, the orbit-averaged model, the
 attitude filter's matrix arithmetic, the estimator's compiled step and the attitude models'
-steps on shared arrays (rigid body, thruster pairs, detumble law) give the same results to 1e-12,
+steps on shared arrays (rigid body, thruster pairs, detumble and tracking laws) give the same results to 1e-12,
 and the attitude models' (the kernels declared plain_first) the same bits."""
 import json
 import os
@@ -87,6 +87,21 @@ for integrator in ("euler", "rk4"):
             assert body.step_and_publish(values, np.arange(9), np.arange(60, 82), 0.015)
         outputs.extend(values.tolist())
     out["attitude_" + integrator] = outputs
+# the de-orbit tracking law's step and publish (its boundary layer's and pointing error's hypot:
+# math.hypot in plain Python, cpython_math's compiled)
+from components.attitude import deorbit_tracking
+law = deorbit_tracking.DeorbitTrackingController(J, knowledge_sigmas=3.0, impulse_bits=1.0, rate_sigma=1e-4)
+values, outputs = np.zeros(40), []
+inputs, published = np.arange(18), np.arange(20, 39)
+for k in range(200):
+    values[0:4] = rotations.normalized((0.1 + 1e-3 * math.sin(k), 0.2, 0.3, 0.9))
+    values[4:7], values[7] = (1e-3 * math.cos(k), 2e-3, -1e-3), float(k % 50 != 7)
+    values[8:12], values[12:15] = rotations.normalized((0.1, 0.2 + 0.01 * (k // 30), 0.3, 0.9)), (0.0, 1.1e-3, 0.0)
+    values[15:18] = (1e-3 * (1 + math.sin(k)), 2e-3, 5e-4 * (1 + math.cos(k)))
+    outputs.append(deorbit_tracking.tracking_into(law.constants, law.x, values, inputs, published, 0.0, False, True))
+    outputs.append(deorbit_tracking.tracking_into(law.constants, law.x, values, inputs, published, 0.015, True, True))
+    outputs.extend(values.tolist())
+out["tracking"] = outputs
 print(json.dumps(out))
 """
 
@@ -107,7 +122,7 @@ def test_plain_python_kernels_equal_the_compiled_ones():
     assert compiled["cowell_exponential"] != compiled["cowell_jacchia_roberts"]  # the cases differ
     # the attitude models' kernels are declared plain_first: a short run takes them as plain Python
     # before numba is loaded (components.core.jit), which must not change a bit
-    for key in ("attitude_euler", "attitude_rk4"):
+    for key in ("attitude_euler", "attitude_rk4", "tracking"):
         assert plain[key] == compiled[key], key
 
 
