@@ -3,7 +3,9 @@
 Wraps components.sensing.sensors.Gyro (thesis 3.3.1, Bosch BMG160 [44]). One noise sample per
 communication step, drawn in do_step; the output depends directly on the true rate. A fault
 (appended last): `bias_jump` added to the bias once the gyro has operated `jump_time` seconds (the
-sum of its steps; zero jump: none).
+sum of its steps; zero jump: none). Once numba is in the process the binary takes the step and
+publishes the output without Python (components.sensing.native_steps.gyro; the samples come from
+the model's block of noise, which the Python step refills).
 """
 from neighbor_fmu_support import NeighborSlave
 
@@ -35,6 +37,7 @@ class Gyro(NeighborSlave):
                        "bias_jump applies (>= 0)")
         self.share_values()
         self._outputs_at = self.shared_slice((("omega_meas_B", 3),))
+        self._native_at = (self.shared_indices((("omega_BN_B", 3),)), self.shared_indices((("omega_meas_B", 3),)))
 
     def build_model(self):
         return sensors.Gyro(self.vector("bias", 3), self.values["sigma"], self.values["seed"],
@@ -47,6 +50,11 @@ class Gyro(NeighborSlave):
     def do_step(self, current_time, step_size):
         self.model.step(step_size)
         self.publish_after_step()  # the new noise sample
+        if not self.share_native[0] and self.native_ready():
+            from components.sensing import native_steps  # numba is loaded: the same step, no Python
+            model = self.model
+            self.arm_native(native_steps.step("gyro"), model.constants, model.x, model.block, self.shared,
+                            *self._native_at, self.share_flags, publish=native_steps.step("gyro_publish"))
         return True
 
     def publish(self):

@@ -4,8 +4,6 @@ Imported once numba is in the process; `step(name)` compiles only the step asked
 first time on a machine) or loads it from numba's cache (milliseconds once numba runs)."""
 import math
 
-from numba import cfunc
-
 from ..core import jit, native
 from . import deorbit_tracking, detumble, mass_properties, rigid_body as body, thrusters
 
@@ -127,14 +125,7 @@ def _tracking_law(context, h, stepping):
     return 0
 
 
-_STEPS = {}
-
-
-def step(name):
-    """The cfunc of the step or publish `name` (rigid_body, rigid_body_following, thruster_pairs,
-    thruster_pairs_publish, detumble_law, detumble_law_publish, tracking_law,
-    tracking_law_publish)."""
-    compiled = _STEPS.get(name)
-    if compiled is None:
-        compiled = _STEPS[name] = cfunc(native.STEP, cache=True)(globals()[name])
-    return compiled
+# step(name): the cfunc of the step or publish `name` (rigid_body, rigid_body_following,
+# thruster_pairs, thruster_pairs_publish, detumble_law, detumble_law_publish, tracking_law,
+# tracking_law_publish)
+step = native.compiler(globals())

@@ -12,6 +12,7 @@ it, or raises the error the kernel's code stands for).
 Imported once numba is in the process (NeighborSlave.native_ready, arm_native): it needs numba itself.
 """
 import numpy as np
+import numba
 from numba import carray, types
 from numba.core.extending import intrinsic
 
@@ -66,3 +67,16 @@ def context(*arrays):
         if not a.flags.c_contiguous:
             raise ValueError("a native step's arrays must be C-contiguous")
     return np.array([v for a in arrays for v in (a.ctypes.data, a.size)], dtype=np.int64)
+
+
+def compiler(namespace):
+    """`step(name)` for a module of native steps (its globals(), `namespace`): the cfunc of its
+    function `name`, compiled at the first request (or loaded from numba's cache) and kept."""
+    compiled = {}
+
+    def step(name):
+        if name not in compiled:
+            compiled[name] = numba.cfunc(STEP, cache=True)(namespace[name])
+        return compiled[name]
+
+    return step

@@ -26,8 +26,17 @@ import numpy as np
 
 from ..core import rotations
 from ..core.checks import finite_vector
+from ..core.jit import njit
 
 TWO_PI = 2.0 * math.pi
+
+
+def _state_view(at, n=1):
+    """A property over x[at] (a float), or x[at:at + n] (a tuple of floats)."""
+    if n == 1:
+        return property(lambda self: float(self.x[at]), lambda self, value: self.x.__setitem__(at, value))
+    return property(lambda self: tuple(self.x[at:at + n].tolist()),
+                    lambda self, value: self.x.__setitem__(slice(at, at + n), value))
 
 
 def check_sigma(name, value, unit):
@@ -190,6 +199,12 @@ class SunSensor(_VectorSensor):
         return self._measure(true_B), True
 
 
+NOISE_BLOCK = 1024  # gyro samples drawn at once: the generator gives the numbers of one draw a step
+# Gyro.x, the state its FMU's native step reads and writes (gyro_into): the noise scale, the
+# operating time, the jump flag, the bias (3), the sample (3), the next row of the noise block
+_SCALE, _TIME, _JUMPED, _BIAS, _SAMPLE, _ROW = 0, 1, 2, 3, 6, 9
+
+
 class Gyro(_Seeded):
     """3-axis rate gyro (thesis 3.3.1, Bosch BMG160 [44]): omega + bias + white noise.
 
@@ -202,21 +217,43 @@ class Gyro(_Seeded):
     A fault: `bias_jump` (rad/s) is added to the bias once the gyro has operated `jump_time`
     seconds (the sum of its steps: a host that steps it only while it is powered counts its
     powered time), a sudden bias shift such as a shock or a temperature step gives a MEMS gyro.
-    Zero (the default) is no fault."""
+    Zero (the default) is no fault.
+
+    The samples are drawn NOISE_BLOCK at a time into `block` (numpy's standard normals come one
+    after the other from the generator: the same numbers as one draw a step), and the state lives
+    in the array `x` (the attributes are properties over it), so that the FMU's native step can
+    take a sample without Python; get_state gives the generator's state at the sample in use."""
 
     def __init__(self, bias=(0.0, 0.0, 0.0), sigma=5.5e-4, seed=0, sigma_sample_time=0.0, bias_jump=(0.0, 0.0, 0.0),
                  jump_time=0.0):
+        self.x = np.zeros(10)
+        self.x[_ROW] = NOISE_BLOCK  # no block drawn yet
+        self.block = np.zeros((NOISE_BLOCK, 3))
+        self._block_state = None  # the generator's state before the block was drawn
         self.bias = finite_vector(bias, 3, "bias")
         self.sigma = check_sigma("sigma", sigma, "rad/s")
         self.sigma_sample_time = check_sigma("sigma_sample_time", sigma_sample_time, "s")
         self.bias_jump = finite_vector(bias_jump, 3, "bias_jump")
         self.jump_time = check_sigma("jump_time", jump_time, "s")
+        self.constants = np.array([self.sigma, self.sigma_sample_time, self.jump_time, *self.bias_jump])
         self.scale = self.sigma
         self.jumped = False
         super().__init__(seed)
 
+    scale = _state_view(_SCALE)
+    operating_time = _state_view(_TIME)
+    jumped = property(lambda self: bool(self.x[_JUMPED]), lambda self, value: self.x.__setitem__(_JUMPED, value))
+    bias = _state_view(_BIAS, 3)
+    sample = _state_view(_SAMPLE, 3)
+
     def _draw(self):
-        return tuple(self.rng.standard_normal(3).tolist())
+        row = int(self.x[_ROW])
+        if row >= NOISE_BLOCK:
+            self._block_state = self.rng.bit_generator.state
+            self.block[:] = self.rng.standard_normal(3 * NOISE_BLOCK).reshape(NOISE_BLOCK, 3)
+            row = 0
+        self.x[_ROW] = row + 1
+        return tuple(self.block[row].tolist())
 
     def step(self, h=None):
         """The next sample, h seconds of operation after the last."""
@@ -232,14 +269,55 @@ class Gyro(_Seeded):
         b, n, s = self.bias, self.sample, self.scale
         return (w[0] + b[0] + s * n[0], w[1] + b[1] + s * n[1], w[2] + b[2] + s * n[2])
 
+    def _generator_state(self):
+        """The generator's state after the sample in use (as if it had been drawn alone)."""
+        row = int(self.x[_ROW])
+        if self._block_state is None or row >= NOISE_BLOCK:
+            return self.rng.bit_generator.state
+        replay = np.random.Generator(type(self.rng.bit_generator)())
+        replay.bit_generator.state = self._block_state
+        replay.standard_normal(3 * row)
+        return replay.bit_generator.state
+
     def get_state(self):
-        return {**super().get_state(), "scale": self.scale, "jumped": self.jumped, "bias": list(self.bias)}
+        return {**super().get_state(), "rng": self._generator_state(), "scale": self.scale, "jumped": self.jumped,
+                "bias": list(self.bias)}
 
     def set_state(self, state):
         super().set_state(state)
+        self.x[_ROW], self._block_state = NOISE_BLOCK, None  # the next sample from the restored generator
         self.scale = float(state["scale"])
         self.jumped = bool(state["jumped"])
         self.bias = tuple(float(x) for x in state["bias"])
+
+
+@njit(cache=True, plain_first=True)
+def gyro_into(c, x, block, values, inputs, outputs, h, stepping):
+    """Gyro's FMU step on its constants c (sigma, sigma_sample_time, jump_time, bias_jump), state x
+    and noise block (flat, 3 a row): with `stepping`, step(h) with the block's next row; then
+    values[outputs] = measure(values[inputs]). The same operations as those methods. Returns 0;
+    1 when the block is used up (nothing changed: the Python step draws the next); 2 when the rate
+    is not finite (stepped, nothing written: the Python publish raises the error)."""
+    if stepping:
+        row = int(x[_ROW])
+        if 3 * row >= block.size:
+            return 1
+        if c[1] > 0.0 and h > 0.0:
+            x[_SCALE] = c[0] * math.sqrt(c[1] / h)
+        x[_TIME] += h
+        for i in range(3):
+            x[_SAMPLE + i] = block[3 * row + i]
+        x[_ROW] = row + 1
+        if x[_JUMPED] == 0.0 and (c[3] != 0.0 or c[4] != 0.0 or c[5] != 0.0) and x[_TIME] >= c[2] - 1e-9:
+            x[_JUMPED] = 1.0
+            for i in range(3):
+                x[_BIAS + i] = x[_BIAS + i] + c[3 + i]
+    for i in range(3):
+        if not math.isfinite(values[inputs[i]]):
+            return 2
+    for i in range(3):
+        values[outputs[i]] = values[inputs[i]] + x[_BIAS + i] + x[_SCALE] * x[_SAMPLE + i]
+    return 0
 
 
 class GpsReceiver(_Seeded):

@@ -1,8 +1,8 @@
 """Native steps (components.core.native, NeighborSlave.arm_native): once numba is in the process,
-RigidBody, RcsThrusters, DetumbleController and TrackingController hand the binary a compiled step
-that it calls instead of their Python do_step, and the three laws with outputs that depend on
-inputs a compiled publish it calls instead of their Python publish (a get after a set, as
-Gauss-Seidel does). The tracking law runs as the mission runs it: its target and boundary layer
+RigidBody, RcsThrusters, DetumbleController, TrackingController and Gyro hand the binary a compiled
+step that it calls instead of their Python do_step, and the three laws and the gyro, with outputs
+that depend on inputs, a compiled publish it calls instead of their Python publish (a get after a
+set, as Gauss-Seidel does). The tracking law runs as the mission runs it: its target and boundary layer
 from the inputs.
 
 Through the binary (FMPy loading the built FMUs, FMI 2.0 and 3.0, numba loaded as in a long
@@ -21,10 +21,11 @@ import pytest
 
 pytest.importorskip("numba")
 
-MODELS = ("RigidBody", "RcsThrusters", "DetumbleController", "TrackingController")
+MODELS = ("RigidBody", "RcsThrusters", "DetumbleController", "TrackingController", "Gyro")
 # parameters set before the run, and inputs kept >= 0 (the estimator's sigmas)
 SETUP = {"TrackingController": {"booleans": {"target_from_input": True}, "nonnegative": ["sigma_attitude_B"],
-                                "reals": {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4}}}
+                                "reals": {"knowledge_sigmas": 3.0, "impulse_bits": 1.0, "rate_sigma": 1e-4}},
+         "Gyro": {"reals": {"sigma_sample_time": 0.1}}}
 STEPS = 300
 
 RUN = r"""
@@ -152,8 +153,9 @@ def test_native_step_gives_the_python_steps_bits(fmu_paths, fmu3_paths, tmp_path
     assert native["entered"]["do_step"] == 3
     if model != "RigidBody":  # its outputs depend on no input: a set leaves them fresh
         assert python["entered"]["publish"] >= STEPS + STEPS // 2 + 10
-        # before each of the three Python steps (the step not armed yet) the publish is Python too
-        assert native["entered"]["publish"] == 3
+        # before each of the three Python steps (the step not armed yet) the publish is Python too,
+        # and inside them for a step that ends with publish_after_step
+        assert native["entered"]["publish"] == (6 if model == "Gyro" else 3)
     assert len({tuple(r) for r in native["rows"]}) > 5  # the outputs moved (the laws quantize them)
 
 

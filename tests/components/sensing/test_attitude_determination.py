@@ -171,6 +171,57 @@ def test_noise_is_reproducible_and_state_restores_the_generator():
         assert _outputs(other, 10, *args) == first
 
 
+def _one_draw_a_step(seed, n):
+    """The gyro's noise as one standard_normal(3) a step would draw it (before the block)."""
+    rng = np.random.default_rng(seed)
+    return [tuple(rng.standard_normal(3).tolist()) for _ in range(n)], rng
+
+
+@pytest.mark.parametrize("compiled", [False, True], ids=["plain", "numba"])
+def test_gyro_noise_block_and_native_kernel_give_one_draw_a_steps_bits(compiled):
+    """The gyro draws its noise sensors.NOISE_BLOCK samples at a time: the same samples as one draw a
+    step, across refills, and get_state gives the generator's state of one draw a step (a state
+    restored there draws on). gyro_into, the FMU's native step (plain and compiled), takes the
+    Python step's bits: the sampling step's scale, the bias jump, the next block's first row, a
+    rate that is not finite (stepped, nothing written)."""
+    n = 2 * sensors.NOISE_BLOCK + 10
+    draws, rng = _one_draw_a_step(5, n + 1)
+    gyro = sensors.Gyro((1e-3, 0.0, -1e-3), 5.5e-4, seed=5, sigma_sample_time=0.1, bias_jump=(0.0, 2e-3, 0.0),
+                        jump_time=3.0)
+    assert gyro.sample == draws[0]
+    for k in range(1, sensors.NOISE_BLOCK + 5):
+        gyro.step(0.015)
+        assert gyro.sample == draws[k], k
+    state = gyro.get_state()
+    assert state["rng"] == _one_draw_a_step(5, sensors.NOISE_BLOCK + 5)[1].bit_generator.state
+    restored = sensors.Gyro(seed=9)
+    restored.set_state(json.loads(json.dumps(state)))
+    restored.step(0.015)
+    assert restored.sample == draws[sensors.NOISE_BLOCK + 5]
+    # the kernel against the methods
+    law = sensors.gyro_into if compiled else sensors.gyro_into.py_func
+    python = sensors.Gyro((1e-3, 0.0, -1e-3), 5.5e-4, seed=5, sigma_sample_time=0.1, bias_jump=(0.0, 2e-3, 0.0),
+                          jump_time=3.0)
+    native = sensors.Gyro((1e-3, 0.0, -1e-3), 5.5e-4, seed=5, sigma_sample_time=0.1, bias_jump=(0.0, 2e-3, 0.0),
+                          jump_time=3.0)
+    values, inputs, outputs = np.zeros(6), np.arange(3), np.arange(3, 6)
+    refills = 0
+    for k in range(n):
+        values[:3] = (0.1 * math.sin(k), -0.05, 0.02 * math.cos(k)) if k != 50 else (math.nan, 0.0, 0.0)
+        python.step(0.015)
+        status = law(native.constants, native.x, native.block.ravel(), values, inputs, outputs, 0.015, True)
+        if status == 1:  # the block used up: the Python step draws the next
+            refills += 1
+            native.step(0.015)
+            status = law(native.constants, native.x, native.block.ravel(), values, inputs, outputs, 0.0, False)
+        assert native.x.tolist() == python.x.tolist(), k
+        if k == 50:
+            assert status == 2
+            continue
+        assert status == 0 and values[3:].tolist() == list(python.measure(values[:3])), k
+    assert refills == 2 and python.jumped and python.bias == (1e-3, 2e-3, -1e-3)
+
+
 def test_bad_parameters_name_the_parameter():
     with pytest.raises(ValueError, match="sigma"):
         sensors.HorizonSensor(sigma=-1.0)
