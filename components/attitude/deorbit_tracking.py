@@ -45,7 +45,7 @@ import math
 
 import numpy as np
 
-from ..core import rotations
+from ..core import rotations, state_views
 from ..core.constants import MU_EARTH, R_EQ
 from ..core.cpython_math import hypot
 from ..core.jit import njit
@@ -145,41 +145,20 @@ class DeorbitTrackingController:
         self.anchor = None  # the last target taken by follow()
 
     # ---- the state, kept in self.x (tracking_into's layout) ----------------------------------
-    @property
-    def q_d(self):
-        return tuple(self.x[0:4].tolist()) if self.x[4] else None
-
-    @q_d.setter
-    def q_d(self, value):
-        if value is not None:
-            self.x[0:4] = value
-        self.x[4] = value is not None
-
-    @property
-    def omega_d(self):
-        return tuple(self.x[5:8].tolist())
-
-    @omega_d.setter
-    def omega_d(self, value):
-        self.x[5:8] = value
+    q_d = state_views.optional(0, 4, 4)
+    omega_d = state_views.view(5, 3)
+    anchor_q, anchor_omega = state_views.view(9, 4), state_views.view(13, 3)
+    e = state_views.view(16, 3)
 
     @property
     def anchor(self):
-        return (tuple(self.x[9:13].tolist()), tuple(self.x[13:16].tolist())) if self.x[8] else None
+        return (self.anchor_q, self.anchor_omega) if self.x[8] else None
 
     @anchor.setter
     def anchor(self, value):
         if value is not None:
-            self.x[9:13], self.x[13:16] = value
+            self.anchor_q, self.anchor_omega = value
         self.x[8] = value is not None
-
-    @property
-    def e(self):
-        return tuple(self.x[16:19].tolist())
-
-    @e.setter
-    def e(self, value):
-        self.x[16:19] = value
 
     # ---- boundary layer sized for estimates -------------------------------------------------
     def boundary_layer(self, sigma_attitude):

@@ -38,7 +38,7 @@ import math
 
 import numpy as np
 
-from ..core import rotations
+from ..core import rotations, state_views
 from ..core.jit import njit
 from . import mass_properties
 
@@ -80,17 +80,6 @@ _INPUT_NAMES = ("torque_B", "wheel_torque_B", "wheel_momentum_B", "disturbance_t
 NINE = np.arange(9)  # step()'s inputs: the whole of its own array
 
 
-def _state_view(start, n):
-    """A property over x[start:start + n], read as a tuple of floats."""
-    def get(self):
-        return tuple(self.x[start:start + n].tolist())
-
-    def put(self, value):
-        self.x[start:start + n] = value
-
-    return property(get, put)
-
-
 class RigidBody:
     """Attitude state (q_BN, omega_BN_B) of a rigid body under a body-frame torque.
 
@@ -98,11 +87,11 @@ class RigidBody:
     centre of mass, J and its inverse) so that the compiled RK4 step and publish_into work on it
     in place; the attributes are views of it."""
 
-    q = _state_view(Q, 4)
-    omega = _state_view(OMEGA, 3)
-    omega_dot = _state_view(OMEGA_DOT, 3)
-    euler_integrated = _state_view(ANGLES, 3)
-    center_of_mass = _state_view(CENTER, 3)
+    q = state_views.view(Q, 4)
+    omega = state_views.view(OMEGA, 3)
+    omega_dot = state_views.view(OMEGA_DOT, 3)
+    euler_integrated = state_views.view(ANGLES, 3)
+    center_of_mass = state_views.view(CENTER, 3)
 
     def __init__(self, inertia, q0=(0.0, 0.0, 0.0, 1.0), omega0=(0.0, 0.0, 0.0), integrator="rk4",
                  max_substep=0.005, euler0=None):

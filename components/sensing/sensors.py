@@ -24,19 +24,11 @@ import math
 
 import numpy as np
 
-from ..core import rotations
+from ..core import rotations, state_views
 from ..core.checks import finite_vector
 from ..core.jit import njit
 
 TWO_PI = 2.0 * math.pi
-
-
-def _state_view(at, n=1):
-    """A property over x[at] (a float), or x[at:at + n] (a tuple of floats)."""
-    if n == 1:
-        return property(lambda self: float(self.x[at]), lambda self, value: self.x.__setitem__(at, value))
-    return property(lambda self: tuple(self.x[at:at + n].tolist()),
-                    lambda self, value: self.x.__setitem__(slice(at, at + n), value))
 
 
 def check_sigma(name, value, unit):
@@ -240,11 +232,11 @@ class Gyro(_Seeded):
         self.jumped = False
         super().__init__(seed)
 
-    scale = _state_view(_SCALE)
-    operating_time = _state_view(_TIME)
-    jumped = property(lambda self: bool(self.x[_JUMPED]), lambda self, value: self.x.__setitem__(_JUMPED, value))
-    bias = _state_view(_BIAS, 3)
-    sample = _state_view(_SAMPLE, 3)
+    scale = state_views.view(_SCALE)
+    operating_time = state_views.view(_TIME)
+    jumped = state_views.flag(_JUMPED)
+    bias = state_views.view(_BIAS, 3)
+    sample = state_views.view(_SAMPLE, 3)
 
     def _draw(self):
         row = int(self.x[_ROW])
