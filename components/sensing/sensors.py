@@ -18,7 +18,8 @@ built (the sample for the start time) and then once per step (`step`), so the ou
 communication point are f(current inputs, current sample). Samples are drawn as standard
 normals and uniforms and scaled by sigma afterwards, so the random stream does not depend on
 sigma (sigma = 0 gives the exact measurement). get_state/set_state capture the generator
-state (rng.bit_generator.state, a JSON-able dict) and the current sample.
+state (rng.bit_generator.state, a JSON-able dict) and the current sample. The gyro draws its
+samples a block at a time (the same samples, see Gyro).
 """
 import math
 

@@ -1,7 +1,7 @@
 """Native steps (components.core.native, NeighborSlave.arm_native): once numba is in the process,
 RigidBody, RcsThrusters, DetumbleController, TrackingController and Gyro hand the binary a compiled
-step that it calls instead of their Python do_step, and the three laws and the gyro, with outputs
-that depend on inputs, a compiled publish it calls instead of their Python publish (a get after a
+step that it calls instead of their Python do_step, and the thruster pairs, the two laws and the
+gyro, with outputs that depend on inputs, a compiled publish it calls instead of their Python publish (a get after a
 set, as Gauss-Seidel does). The tracking law runs as the mission runs it: its target and boundary layer
 from the inputs.
 
