@@ -311,7 +311,7 @@ READS = (("q_BN", 4), ("omega_BN_B", 3), ("enabled", 1), ("q_target_BN", 4), ("o
          ("sigma_attitude_B", 3))
 PUBLISHED = (("torque_cmd_B", 3), ("thrust_flag", 3), ("done", 1), ("attitude_error", 1), ("pointing_error", 1),
              ("q_d", 4), ("sliding_vector", 3), ("boundary_layer", 3))
-# what tracking_into returns when it changed nothing, for the Python methods to raise the error
+# what tracking_into returns when it refused an input, for the Python methods to raise the error
 FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION = 1, 2, 3
 
 
@@ -340,7 +340,8 @@ def tracking_into(c, x, values, inputs, outputs, h, stepping, follow_input):
     (READS): with `follow_input` and enabled, follow the target inputs; then with `stepping`
     advance q_d by h and write nothing, else size e (boundary_layer) and write values[outputs]
     (PUBLISHED: the gated command, done, the errors, q_d, s, e). The same operations as those
-    methods. Returns 0, or FOLLOW_REFUSED, LAYER_REFUSED, ZERO_QUATERNION having changed nothing."""
+    methods. Returns 0; FOLLOW_REFUSED having changed nothing; LAYER_REFUSED or ZERO_QUATERNION having
+    written no output (a new target already followed, as the methods would have followed it)."""
     enabled = values[inputs[7]] != 0.0
     if follow_input and enabled and not _follow(x, values, inputs):
         return FOLLOW_REFUSED
