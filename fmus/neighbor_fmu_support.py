@@ -130,6 +130,7 @@ class NeighborSlave(Fmi2Slave):
         self._get_plans = {cls: {} for cls in _KINDS}  # type -> {value references: plan (_get_plan)}
         self._set_plans = {cls: {} for cls in _KINDS}  # type -> {value references: input names or None}
         self.shared = None  # share_values: every Real/Integer/Boolean input and output by value reference
+        self.shares_outputs = False
         self.share_native = None  # share_values: the native step's two slots (arm_native)
         self._native_arrays = self._native_context = None
 
@@ -195,7 +196,7 @@ class NeighborSlave(Fmi2Slave):
                 self.publish()
             return list(map(kind, self.shared[index].tolist()))
         if self.shared is not None:
-            self._input_version += 1  # inputs written in the array do not count versions
+            self.count_shared_inputs()
         return self._values_of_plan(plan, kind)
 
     def _values_of_plan(self, plan, kind):
@@ -341,7 +342,8 @@ class NeighborSlave(Fmi2Slave):
             self._input_version += 1
 
         variability = Fmi2Variability.continuous if kind is float else Fmi2Variability.discrete
-        var = self._register(name, kind, Fmi2Causality.input, variability, unit, description, setter=setter)
+        var = self._register(name, kind, Fmi2Causality.input, variability, unit, description,
+                             getter=lambda: self.input_value(name), setter=setter)
         self._input_names.setdefault(_TYPES[kind], {})[var.value_reference] = name
         self._input_vrs[name] = var.value_reference
         return name
@@ -467,15 +469,19 @@ class NeighborSlave(Fmi2Slave):
     # read while stale (after a parameter, a state or, for one that depends on inputs, an input
     # changed) is published first. The getters stay the outputs' definition: the generic publish
     # evaluates them, and a wrapper's faster publish must write the same values.
-    def share_values(self) -> None:
+    def share_values(self, outputs: bool = True) -> None:
         """Keep the inputs and outputs in the shared array from now on (call it last in __init__,
-        after every declaration)."""
+        after every declaration). With `outputs` false only the inputs: the outputs stay getters
+        that each get evaluates, for a model whose many outputs cost more to publish at every step
+        than the few a master reads (the binary's sets still do not enter Python)."""
         n = len(self.vars)
+        self.shares_outputs = outputs
         self.shared = np.zeros(n)
         self.share_codes = np.zeros(n, np.int32)
         self.share_flags = np.zeros(2, np.int32)  # FRESH_STATE, FRESH_FEEDTHROUGH
         self.share_native = np.zeros(3, np.int64)  # the step's address (0: none), its context's, a publish's
-        outputs = {cls: [] for cls in _SHARED_KINDS}
+        published = {cls: [] for cls in _SHARED_KINDS}
+        self._shared_inputs = {}  # input name -> (value reference, its Python type)
         for vr, var in self.vars.items():
             code = _SHARED_KINDS.get(type(var))
             if code is None:
@@ -483,16 +489,19 @@ class NeighborSlave(Fmi2Slave):
             meta = self.fmu_meta[var.name]
             if meta["causality"] == "input":
                 role = SHARED_INPUT
-                self.shared[vr] = self.values[var.name]
-            elif meta["causality"] == "output":
+                # the input lives in the array only: a wrapper that still read it from self.values
+                # would fail loudly rather than read its start value for ever
+                self.shared[vr] = self.values.pop(var.name)
+                self._shared_inputs[var.name] = (vr, _KINDS[type(var)])
+            elif meta["causality"] == "output" and outputs:
                 role = SHARED_FEEDTHROUGH_OUTPUT if meta["depends_on"] else SHARED_STATE_OUTPUT
-                outputs[type(var)].append(vr)
+                published[type(var)].append(vr)
             else:
                 continue
             self.share_codes[vr] = role | code << 4
         self._vr_of = {var.name: vr for vr, var in self.vars.items()}
         self._publish_plans = [(vrs, self._get_plan(cls, tuple(vrs)), _KINDS[cls])
-                               for cls, vrs in outputs.items() if vrs]
+                               for cls, vrs in published.items() if vrs]
         self._vector_keys = {}  # input vectors now read from the array
 
     def publish(self) -> None:
@@ -507,7 +516,10 @@ class NeighborSlave(Fmi2Slave):
     def publish_after_step(self) -> None:
         """The end of a sharing wrapper's do_step: publish, or when an output cannot be computed
         from the inputs as they are, leave the outputs stale so that the get that reads them
-        raises the error (where it was raised before the values were shared)."""
+        raises the error (where it was raised before the values were shared). Nothing to do for a
+        wrapper whose values are not shared (its getters compute the outputs when read)."""
+        if self.shared is None or not self.shares_outputs:
+            return
         try:
             self.publish()
         except Exception:
@@ -583,12 +595,30 @@ class NeighborSlave(Fmi2Slave):
         names = [e for name, n in variables for e in (element_names(name, n) if n > 1 else (name,))]
         return np.array([self._vr_of[name] for name in names], dtype=np.int64)
 
+    def variable_values(self) -> dict:
+        """Every parameter's and input's current value by name (the inputs from the shared array
+        when values are shared): the start values a model description declares."""
+        return {**self.values, **{name: self.input_value(name) for name in self._input_vrs}}
+
+    def count_shared_inputs(self) -> None:
+        """Inputs written in the shared array count no versions (feedthrough's cache key): count
+        one now. A wrapper that shares only its inputs counts one only if an input was set since
+        the last count (the binary's set clears the flag that no published output uses then), so
+        that one set of inputs is one computation, as before its inputs were shared."""
+        if self.shared is None:
+            return
+        if self.shares_outputs:
+            self._input_version += 1
+        elif not self.share_flags[FRESH_FEEDTHROUGH]:
+            self._input_version += 1
+            self.share_flags[FRESH_FEEDTHROUGH] = 1
+
     def input_value(self, name: str) -> Scalar:
         """The current value of input `name` (from the shared array when values are shared)."""
-        if self.shared is None:
+        at = None if self.shared is None else self._shared_inputs.get(name)
+        if at is None:  # values not shared, or a String input (never shared)
             return self.values[name]
-        vr = self._input_vrs[name]
-        return _KINDS[type(self.vars[vr])](self.shared[vr])
+        return at[1](self.shared.item(at[0]))
 
     # ---- helpers for wrappers -----------------------------------------------------------
     def feedthrough(self, compute: Callable[[], Any]) -> Any:

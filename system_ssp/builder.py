@@ -397,7 +397,8 @@ def build_fmu(script, dest_dir, fmi_version=2):
     instance.guid = guid
     options = {"needsExecutionTool": "false", "canGetAndSetFMUstate": cls.can_get_and_set_state}
     xml = ET.tostring(instance.to_xml(options), encoding="utf-8")
-    description = complete_model_description(xml, instance.fmu_meta, cls.can_get_and_set_state, instance.values)
+    description = complete_model_description(xml, instance.fmu_meta, cls.can_get_and_set_state,
+                                              instance.variable_values())
     fmi3 = None
     if fmi_version == 3:
         guid = "{" + guid + "}"
