@@ -36,6 +36,11 @@ from components.attitude import rigid_body
 from components.core.names import element_names
 from components.sensing import mekf, triad
 
+# a step's inputs in mekf's U_* order ((name, n): n > 1 an array)
+PACKED_INPUTS = (("nadir_B", 3), ("nadir_valid", 1), ("sun_B", 3), ("sun_valid", 1), ("r_BN_N", 3), ("r_SN_N", 3),
+                 ("omega_meas_B", 3), ("torque_cmd_B", 3), ("coarse_sun_B", 3), ("coarse_sun_valid", 1),
+                 ("q_true_BN", 4), ("omega_true_B", 3))
+
 
 class AttitudeEstimator(NeighborSlave):
     description = ("Attitude estimator: TRIAD initialization from the nadir and Sun vectors, then a multiplicative "
@@ -134,12 +139,12 @@ class AttitudeEstimator(NeighborSlave):
                        "The history's fix is taken only once its largest 1-sigma attitude error per axis is this or "
                        "less, else tried again after 120 s more history (>= 0; 0: any)")
         # a step's inputs packed in mekf's U_* order, and its outputs (Y_*)
-        self._pick_packed = itemgetter(*element_names("nadir_B", 3), "nadir_valid", *element_names("sun_B", 3),
-                                       "sun_valid", *element_names("r_BN_N", 3), *element_names("r_SN_N", 3),
-                                       *element_names("omega_meas_B", 3), *element_names("torque_cmd_B", 3),
-                                       *element_names("coarse_sun_B", 3), "coarse_sun_valid",
-                                       *element_names("q_true_BN", 4), *element_names("omega_true_B", 3))
+        self._pick_packed = itemgetter(*(e for name, n in PACKED_INPUTS
+                                         for e in (element_names(name, n) if n > 1 else (name,))))
         self._packed, self._packed_out = np.zeros(mekf.U_SIZE), np.zeros(mekf.Y_SIZE)
+        self.share_values(outputs=False)
+        # the same inputs by their places in the shared array (values the binary wrote there)
+        self._packed_at = None if self.shared is None else self.shared_indices(PACKED_INPUTS)
 
     def build_model(self):
         v = self.values
@@ -198,12 +203,11 @@ class AttitudeEstimator(NeighborSlave):
         self._refresh()
 
     def do_step(self, current_time, step_size):
-        v = self.values
-        if v["truth_feedback"]:
+        if self.values["truth_feedback"]:
             self._refresh()
             return True
         model, u = self.model, self._packed
-        u[:] = self._pick_packed(v)
+        u[:] = self._pick_packed(self.values) if self._packed_at is None else self.shared[self._packed_at]
         # the step, the NEES against q_true_BN and the outputs, compiled between vector updates
         if model.step_packed(u, step_size, True, self._packed_out) == 0:
             self._out = self._packed_out.tolist()

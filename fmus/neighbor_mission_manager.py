@@ -116,6 +116,7 @@ class MissionManager(NeighborSlave):
         self.output("safe_reason", lambda: self.model.safe_reason, None,
                     "Why the de-orbit was abandoned for the safe state: 0 it was not, 1 no valid attitude for the slew "
                     "or the burn", int)
+        self.share_values(outputs=False)
 
     def _powered(self):
         model = self.model
@@ -130,6 +131,6 @@ class MissionManager(NeighborSlave):
         return mm.MissionManager(params, self.start_time)
 
     def do_step(self, current_time, step_size):
-        inputs = {name: self.values[name] for name, _, _, _ in INPUTS + APPENDED_INPUTS}
+        inputs = {name: self.input_value(name) for name, _, _, _ in INPUTS + APPENDED_INPUTS}
         self.model.step(current_time, step_size, inputs)
         return True

@@ -39,13 +39,13 @@ class Propulsion(NeighborSlave):
         self.input("burn_enable", False, None, "Burn command: thrusters fire while true and propellant remains",
                    bool)
         deps = ["burn_enable"]
-        self.output_array("F_thrust_B", 3, lambda: self.model.force_B(self.values["burn_enable"]), "N",
+        self.output_array("F_thrust_B", 3, lambda: self.model.force_B(self.input_value("burn_enable")), "N",
                           "Thrust force on the spacecraft in B (zero when not burning)", depends_on=deps)
-        self.output("mdot", lambda: self.model.mdot(self.values["burn_enable"]), "kg/s",
+        self.output("mdot", lambda: self.model.mdot(self.input_value("burn_enable")), "kg/s",
                     "Propellant mass flow (>= 0; zero when not burning)", depends_on=deps)
-        self.output("burning", lambda: self.model.burning(self.values["burn_enable"]), None,
+        self.output("burning", lambda: self.model.burning(self.input_value("burn_enable")), None,
                     "True while burn_enable is true and the budget is not spent", bool, depends_on=deps)
-        self.output("mass", lambda: self.model.mass_with(self.values["rcs_propellant"]), "kg",
+        self.output("mass", lambda: self.model.mass_with(self.input_value("rcs_propellant")), "kg",
                     "Current total spacecraft mass: mass0 - propellant_used - rcs_propellant (one tank)",
                     depends_on=["rcs_propellant"])
         self.output("propellant_used", lambda: self.model.used, "kg", "Propellant used so far")
@@ -60,6 +60,7 @@ class Propulsion(NeighborSlave):
                    "attitude control (off-pulsing), summed over the thrusters, from the thruster FMU")
         self.output("on_fraction", lambda: self.model.on_fraction, "1",
                     "Fraction of the thrust and flow applied over the current step (1 unless off-pulsed)")
+        self.share_values(outputs=False)
 
     def build_model(self):
         v = self.values
@@ -67,5 +68,5 @@ class Propulsion(NeighborSlave):
                                         v["propellant_budget"], self.vector("axis_B", 3))
 
     def do_step(self, current_time, step_size):
-        self.model.step(self.values["burn_enable"], step_size, self.values["axial_off_time"])
+        self.model.step(self.input_value("burn_enable"), step_size, self.input_value("axial_off_time"))
         return True

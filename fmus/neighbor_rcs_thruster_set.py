@@ -127,6 +127,7 @@ class RcsThrusterSet(NeighborSlave):
         self.output_array("impulse_B", 3, lambda: self.model.impulse, "N.s",
                           "Running total of the force beyond the propulsion's nominal thrust, in B: the RCS net force "
                           "and the axial thrusters' force error and misalignment in the burn (for the orbit)")
+        self.share_values(outputs=False)
 
     def build_model(self):
         v = self.values
@@ -153,12 +154,13 @@ class RcsThrusterSet(NeighborSlave):
         return self.model.flags(self.vector("torque_cmd_B", 3))
 
     def _force_torque(self):
-        self.model.set_main_propellant(self.values[PROPELLANT_USED])
-        return self.model.force_and_torque(self.feedthrough(self._flags), self.values["axial_firing"])
+        self.model.set_main_propellant(self.input_value(PROPELLANT_USED))
+        return self.model.force_and_torque(self.feedthrough(self._flags), self.input_value(AXIAL_FIRING))
 
     def do_step(self, current_time, step_size):
-        flags, burn = self.feedthrough(self._flags), self.values["axial_firing"]
-        self.model.set_main_propellant(self.values[PROPELLANT_USED])
+        self.count_shared_inputs()  # inputs the binary set since the last get: a new feedthrough version
+        flags, burn = self.feedthrough(self._flags), self.input_value(AXIAL_FIRING)
+        self.model.set_main_propellant(self.input_value(PROPELLANT_USED))
         if self.model.monitor is not None:
             self.model.watch(current_time, self.vector("omega_meas_B", 3), flags, step_size, burn)
         self.model.step(flags, step_size, burn)

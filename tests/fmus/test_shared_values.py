@@ -160,6 +160,65 @@ SCENARIOS = {
 }
 
 
+
+
+def _propulsion_inputs(rng, k):
+    return {"burn_enable": bool(k % 50 < 35), "rcs_propellant": 2e-6 * k, "axial_off_time": 0.004 * (k // 3)}
+
+
+def _manager_inputs(rng, k):
+    v = {name: bool(rng.random() < p) for name, p in (
+        ("heartbeat", 0.3), ("ground_contact", 0.5), ("ground_command", 0.5), ("detumble_done", 0.2),
+        ("slew_done", 0.2), ("budget_spent", 0.05), ("reentered", 0.005), ("attitude_valid", 0.7))}
+    v["state_of_charge"] = float(rng.uniform(0.05, 1.0))
+    return v
+
+
+def _thruster_set_inputs(rng, k):
+    v = _thruster_inputs(rng, k)
+    v.update({f"omega_meas_B[{i}]": float(x) for i, x in enumerate(rng.uniform(-0.02, 0.02, 3), 1)})
+    v["axial_firing"] = bool(k % 60 >= 30)
+    v["propellant_used"] = 1e-4 * k
+    return v
+
+
+def _estimator_inputs(rng, k):
+    """A body turning slowly, seen by noisy nadir and Sun vectors (now and then invalid), and the gyro."""
+    angle = 0.002 * k
+    q = [0.0, 0.0, math.sin(angle / 2), math.cos(angle / 2)]
+    A = np.array([[math.cos(angle), math.sin(angle), 0.0], [-math.sin(angle), math.cos(angle), 0.0], [0.0, 0.0, 1.0]])
+    r, sun = np.array([6.8e6, 0.0, 0.0]), np.array([0.3, 0.9, 0.3]) * 1.496e11
+    nadir_B = A @ (-r / np.linalg.norm(r)) + rng.normal(0.0, 0.004, 3)
+    sun_B = A @ (sun / np.linalg.norm(sun)) + rng.normal(0.0, 0.003, 3)
+    v = {f"q_true_BN[{i}]": x for i, x in enumerate(q, 1)}
+    v.update({f"omega_true_B[{i}]": x for i, x in enumerate((0.0, 0.0, 0.002 / 0.015), 1)})
+    v.update({f"omega_meas_B[{i}]": float(x) for i, x in enumerate(rng.normal((0.0, 0.0, 0.002 / 0.015), 5e-4), 1)})
+    v.update({f"nadir_B[{i}]": float(x) for i, x in enumerate(nadir_B / np.linalg.norm(nadir_B), 1)})
+    v.update({f"sun_B[{i}]": float(x) for i, x in enumerate(sun_B / np.linalg.norm(sun_B), 1)})
+    v.update({f"r_BN_N[{i}]": float(x) for i, x in enumerate(r, 1)})
+    v.update({f"r_SN_N[{i}]": float(x) for i, x in enumerate(sun, 1)})
+    v["nadir_valid"], v["sun_valid"] = bool(k % 13 != 7), bool(k % 29 < 20)
+    v.update({f"torque_cmd_B[{i}]": float(rng.choice([-1.0, 0.0, 1.0]) * LEVEL) for i in (1, 2, 3)})
+    return v
+
+
+# FMU -> ([(parameters, inputs(rng, step))], step size): the wrappers that share only their inputs
+# (share_values(outputs=False): their outputs are getters evaluated when read, as a step would
+# publish many more than a master reads)
+INPUTS_SHARED = {
+    "Propulsion": ([({}, _propulsion_inputs), ({"propellant_budget": 5e-3}, _propulsion_inputs)], 1.0),
+    "MissionManager": ([({"initial_mode": 5, "attitude_determination_duration": 1.0, "detumble_timeout": 3.0,
+                          "slew_timeout": 3.0}, _manager_inputs),
+                        ({"grace_period": 86400.0}, _manager_inputs)], 0.25),
+    "RcsThrusterSet": ([({}, _thruster_set_inputs),
+                        ({"min_on_time": 0.04, "off_pulsing": True, "force_error[3]": 0.1, "misalignment_1[14]": 0.05,
+                          "propellant_mass_properties": True}, _thruster_set_inputs),
+                        ({"stuck_thruster": 6, "stuck_on": True, "stuck_time": 0.3, "fault_detection": True},
+                         _thruster_set_inputs)], 0.015),
+    "AttitudeEstimator": ([({}, _estimator_inputs), ({"fault_window": 20, "use_coarse_sun": True}, _estimator_inputs),
+                           ({"truth_feedback": True}, _estimator_inputs)], 0.015),
+}
+
 # every output depends on inputs, which a master sets after the step: the step leaves them stale
 PUBLISHED_WHEN_READ = ("TrackingController",)
 
@@ -185,7 +244,46 @@ def _generic_publish(slave):
 
 
 def test_every_sharing_wrapper_has_a_scenario():
-    assert _sharing_wrappers() == sorted(SCENARIOS)
+    assert _sharing_wrappers() == sorted([*SCENARIOS, *INPUTS_SHARED])
+    for name in [*SCENARIOS, *INPUTS_SHARED]:
+        cls = builder._import_wrapper(build_fmus.FMU_SOURCES / f"neighbor_{_snake(name)}.py")
+        assert cls(instance_name="probe", resources=str(builder.FMU_SOURCES)).shares_outputs == (name in SCENARIOS)
+
+
+def _outputs(slave):
+    """Every output's value, read by type as a master reads them."""
+    by_type = {}
+    for vr, var in slave.vars.items():
+        if slave.fmu_meta[var.name]["causality"] == "output":
+            by_type.setdefault(type(var).__name__, []).append(vr)
+    getters = {"Real": slave.get_real, "Integer": slave.get_integer, "Boolean": slave.get_boolean}
+    return {kind: getters[kind](vrs) for kind, vrs in sorted(by_type.items())}
+
+
+@pytest.mark.parametrize("name", sorted(INPUTS_SHARED))
+def test_shared_inputs_give_the_outputs_of_inputs_kept_in_python(name, monkeypatch):
+    """The same wrapper twice: sharing its inputs, and with share_values() doing nothing (every
+    input in self.values, as before it shared them). Same inputs, same steps: the same outputs bit
+    for bit, read after the inputs changed and after each step."""
+    base = next(klass for klass in builder._import_wrapper(
+        build_fmus.FMU_SOURCES / f"neighbor_{_snake(name)}.py").__mro__ if klass.__name__ == "NeighborSlave")
+    scenarios, h = INPUTS_SHARED[name]
+    rng = np.random.default_rng(314)
+    for parameters, inputs in scenarios:
+        shared = _slave(name, parameters)
+        with monkeypatch.context() as m:
+            m.setattr(base, "share_values", lambda self, outputs=True: None)
+            kept = _slave(name, parameters)
+        assert shared.shared is not None and kept.shared is None
+        assert repr(_outputs(shared)) == repr(_outputs(kept)), (name, parameters)
+        for k in range(200):
+            values = inputs(rng, k)
+            _set(shared, values)
+            _set(kept, values)
+            if k % 9 == 4:  # inputs changed, no step: the outputs that depend on them follow
+                assert repr(_outputs(shared)) == repr(_outputs(kept)), (name, parameters, k)
+            assert shared.do_step(k * h, h) and kept.do_step(k * h, h)
+            assert repr(_outputs(shared)) == repr(_outputs(kept)), (name, parameters, k)
 
 
 @pytest.mark.parametrize("name", sorted(SCENARIOS))
@@ -206,6 +304,30 @@ def test_a_compiled_publish_writes_what_the_getters_define(name):
                 slave.get_real(real_outputs)
             assert slave.share_flags[0] and slave.share_flags[1]  # the step published, or the get
             assert slave.shared.tobytes() == _generic_publish(slave).tobytes(), (name, parameters, k)
+
+
+def test_a_wrapper_sharing_only_inputs_computes_its_outputs_when_read(fmu_paths, tmp_path):
+    """Through the binary: the inputs are written in the shared array, and an output that depends
+    on one follows it without a step, computed by its getter."""
+    fmu, vr = instantiate(fmu_paths["Propulsion"], tmp_path, "propulsion", initialize=True)
+    try:
+        force, flow = [vr[f"F_thrust_B[{i}]"] for i in (1, 2, 3)], vr["mdot"]
+        assert fmu.getReal(force + [flow]) == [0.0] * 4
+        fmu.setBoolean([vr["burn_enable"]], [True])
+        thrust = fmu.getReal(force + [flow])
+        assert thrust[0] > 0.0 and thrust[1:3] == [0.0, 0.0] and thrust[3] > 0.0
+        assert fmu.getBoolean([vr["burn_enable"], vr["burning"]]) == [True, True]
+        fmu.doStep(0.0, 10.0)
+        assert fmu.getReal([vr["burn_time"]]) == [10.0]
+        assert fmu.getReal([vr["propellant_used"]])[0] == pytest.approx(10.0 * thrust[3], rel=1e-12)
+        mass0, used = fmu.getReal([vr["mass0"], vr["propellant_used"]])
+        fmu.setReal([vr["rcs_propellant"]], [0.01])  # the mass depends on it: follows without a step
+        assert fmu.getReal([vr["mass"]])[0] == pytest.approx(mass0 - used - 0.01, rel=1e-15)
+        fmu.setBoolean([vr["burn_enable"]], [False])
+        assert fmu.getReal(force + [flow]) == [0.0] * 4
+    finally:
+        fmu.terminate()
+        fmu.freeInstance()
 
 
 def _read(fmu, vr, names):
