@@ -199,6 +199,8 @@ class ThrusterSet:
         # (y sign, z sign) of the torque each axial thruster adds when switched off: (-z, y)
         self._off_signs = {i: (-_sign(self.layout[i][1][2]), _sign(self.layout[i][1][1])) for i in self.axial}
         self.fire_time = [0.0] * n
+        self._firings = 0  # counts the changes of fire_time: the key of the propellant's last sum
+        self._propellant_at = (-1, 0.0)
         self.on_left = [0.0] * n  # minimum on-time still owed after a firing started
         self.axial_off_time = 0.0  # thruster-seconds the axial thrusters were switched off in the burn
         self.rcs = [i for i in range(n) if i not in self.axial]
@@ -405,6 +407,8 @@ class ThrusterSet:
                 self.on_left[i] = left
                 self._plan_version += 1  # a minimum on-time owed, or paid
         fx = fy = fz = 0.0
+        if firing:
+            self._firings += 1
         for i in firing:
             self.fire_time[i] += h
             f = self.forces[i]
@@ -423,8 +427,11 @@ class ThrusterSet:
 
     def propellant_mass(self):
         """Propellant spent by the RCS so far (kg), Eq. 74 thruster by thruster."""
-        impulse = sum(map(operator.mul, self.force_norms, self.fire_time))  # in order, as a generator would
-        return impulse / (self.isp * self.g0)
+        # read at every step (the propulsion's and the body's mass): summed again only after a firing
+        if self._propellant_at[0] != self._firings:
+            impulse = sum(map(operator.mul, self.force_norms, self.fire_time))  # in order, as a generator would
+            self._propellant_at = (self._firings, impulse / (self.isp * self.g0))
+        return self._propellant_at[1]
 
     def get_state(self):
         return {"fire_time": list(self.fire_time), "on_left": list(self.on_left), "axial_off_time": self.axial_off_time,
@@ -435,6 +442,7 @@ class ThrusterSet:
 
     def set_state(self, state):
         self.fire_time = list(state["fire_time"])
+        self._firings += 1
         self.on_left = list(state["on_left"])
         self._plan_version += 1
         self.axial_off_time = float(state["axial_off_time"])
