@@ -104,7 +104,7 @@ def test_coarse_sun_sensors_equal_basilisks(record_property, monkeypatch):
         sun = messaging.SpicePlanetStateMsgPayload()
         sun.PositionVector = r_S.tolist()
         eclipse = messaging.EclipseMsgPayload()
-        eclipse.shadowFactor = shadow
+        eclipse.illuminationFactor = shadow  # 1 fully sunlit (its shadowFactor, deprecated)
         keep = [messaging.SpicePlanetStateMsg().write(sun), _state_msg(messaging, q, r_B),
                 messaging.EclipseMsg().write(eclipse)]
         for i, normal in enumerate(normals):
